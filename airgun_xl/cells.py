@@ -1,0 +1,100 @@
+"""The cell map: every parameter cell ArtSim reads, as one table.
+
+ArtSim (ARL-TR-3559, Appendix A) reads its inputs from fixed cells of the active sheet and starts
+its result columns at H1. This table is the single place that knows those addresses. Each row
+gives the cell, the field name used in :class:`airgun_xl.params.ShotParams`, the label the
+report's sheet shows next to it, the unit, what it means, and the check applied on reading.
+
+Checks
+------
+``positive``     finite and > 0
+``negative``     finite and < 0 (stiffness cells are negative by the sheet's convention)
+``nonnegative``  finite and >= 0
+``fraction``     finite, > 0 and <= 1
+``any``          finite
+
+``limit`` bounds the magnitude. The limits are far beyond any air gun shot; they exist so that a
+typo such as ``1e300`` is reported on its cell instead of overflowing somewhere in the kernel.
+"""
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Cell:
+    address: str
+    name: str
+    label: str
+    unit: str
+    meaning: str
+    check: str
+    limit: float
+
+
+#: The parameter cells, in the order the macro reads them (ArtSim.bas, head of the Sub).
+CELLS = (
+    Cell("A2", "m1", "M1", "kg", "MEM mass, without the mitigator", "positive", 1e9),
+    Cell("B2", "m31", "M31", "kg", "OBR front plate mass", "positive", 1e9),
+    Cell("C2", "m32", "M32", "kg", "OBR back plate mass", "positive", 1e9),
+    Cell("D2", "m33", "M33", "kg", "test item mass", "positive", 1e9),
+    Cell("B6", "k2", "K2", "N/m", "spring between m31 and m32, negative by the sheet's convention",
+         "negative", 1e16),
+    Cell("C6", "k3", "K3", "N/m", "spring between m32 and m33, negative by the sheet's convention",
+         "negative", 1e16),
+    Cell("E2", "delta", "Timestep", "s", "time step", "positive", 1.0),
+    Cell("E6", "max_time", "Max Time", "s", "simulated duration", "positive", 1e3),
+    Cell("E10", "rho", "Density of Honeycomb", "kg/m^3", "honeycomb density", "positive", 1e5),
+    Cell("E13", "rcone", "Radius of Mitigator", "m", "mitigator radius", "positive", 10.0),
+    Cell("E16", "hcone", "Length of Wedge Part", "m", "wedge (cone) length", "positive", 100.0),
+    Cell("E19", "hcylinder", "Length of Cylindrical Part", "m", "cylinder length",
+         "nonnegative", 100.0),
+    Cell("E25", "mmitigator", "Mass of Mitigator", "kg", "mitigator mass, added to M1",
+         "nonnegative", 1e9),
+    Cell("E28", "vcone", "Volume of Conical Mitigator", "m^3",
+         "initial crushed 'volume', used by the macro as a mass term", "nonnegative", 1e3),
+    Cell("E31", "E", "Elastic Modulus of Mitigator", "Pa", "elastic modulus for unloading",
+         "positive", 1e13),
+    Cell("E34", "filter_frequency", "Filter Frequency", "Hz",
+         "sampling frequency of the filtered acceleration", "positive", 1e12),
+    Cell("E37", "ec", "Compacting Strain", "", "honeycomb compacting strain", "fraction", 1.0),
+    Cell("E40", "sigmay", "Yield Stress", "Pa", "honeycomb static crush stress", "positive", 1e12),
+    Cell("E43", "zeta", "Damping Factor (Zeta)", "", "damping ratio of the OBR springs",
+         "nonnegative", 1e3),
+    Cell("A27", "v1", "Initial Velocity Matrix (Y1)", "m/s", "MEM initial velocity", "any", 1e4),
+    Cell("A28", "v31", "Initial Velocity Matrix (Y31)", "m/s", "OBR front plate initial velocity",
+         "any", 1e4),
+    Cell("A29", "v32", "Initial Velocity Matrix (Y32)", "m/s", "OBR back plate initial velocity",
+         "any", 1e4),
+    Cell("A30", "v33", "Initial Velocity Matrix (Y33)", "m/s", "test item initial velocity",
+         "any", 1e4),
+)
+
+#: The cell where the macro starts writing (its ActiveCell); it must be blank or hold "Time".
+TIME_HEADER = Cell("H1", "time_header", "Time", "", "first result column header", "text", 0.0)
+
+BY_ADDRESS = {c.address: c for c in CELLS}
+BY_NAME = {c.name: c for c in CELLS}
+
+#: Most steps a run may take: ~100 bytes a step keep 5e7 steps within a few GB of memory.
+MAX_STEPS = 50_000_000
+
+#: Columns of the parameter block copied to the output (the macro writes from H on).
+PARAMETER_COLUMNS = 7
+
+_NOUNS = {"kg": "kg", "N/m": "N/m", "s": "seconds", "kg/m^3": "kg/m^3", "m": "metres",
+          "m^3": "m^3", "Pa": "Pa", "Hz": "Hz", "m/s": "m/s", "": ""}
+
+
+def expectation(cell):
+    """The 'expected ...' phrase for a cell, e.g. ``'a positive number of seconds'``."""
+    noun = _NOUNS[cell.unit]
+    of = f" of {noun}" if noun else ""
+    base = {
+        "positive": f"a positive number{of}",
+        "negative": f"a negative number{of} (the sheet's sign convention)",
+        "nonnegative": f"zero or a positive number{of}",
+        "fraction": "a number greater than 0 and at most 1",
+        "any": f"a number{of}",
+    }[cell.check]
+    if cell.check == "fraction":
+        return base
+    return f"{base}, at most {cell.limit:g} in magnitude"

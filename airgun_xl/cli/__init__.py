@@ -1,0 +1,50 @@
+"""The ``airgun-xl`` command: parses arguments and hands off to one module per subcommand."""
+import argparse
+import sys
+
+from .. import __version__
+from ..errors import AirgunXlError, OptionError
+from . import fill, template
+
+COMMANDS = (fill, template)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but a usage mistake becomes one line through the error tree."""
+
+    def error(self, message):
+        raise OptionError(f"{self.prog}: {message}")
+
+
+def build_parser():
+    parser = _Parser(prog="airgun-xl",
+                     description="ArtSim air gun impact simulation, from the report's workbook "
+                                 "to a new workbook.")
+    parser.add_argument("--version", action="version", version=f"airgun-xl {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    for module in COMMANDS:
+        module.add_parser(sub)
+    return parser
+
+
+def main(argv=None):
+    """Run the CLI; return the exit code (0 ok, 2 bad input)."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+        if args.command is None:
+            parser.print_help()
+            return 2
+        return args.run(args)
+    except AirgunXlError as exc:
+        print(f"airgun-xl: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print("airgun-xl: interrupted", file=sys.stderr)
+        return 130
+
+
+def warn(messages):
+    """Print warnings, one line each, to stderr."""
+    for message in messages:
+        print(f"airgun-xl: warning: {message}", file=sys.stderr)

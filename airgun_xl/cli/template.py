@@ -1,0 +1,18 @@
+"""``airgun-xl template OUT.xlsx [--force]``: write a fresh shot A template."""
+
+
+def add_parser(sub):
+    p = sub.add_parser("template", help="write a fresh template in the report's layout (shot A)",
+                       description="Write the report's parameter sheet, filled with shot A as "
+                                   "the report's appendix ran it, with live formulas.")
+    p.add_argument("output", metavar="OUT.xlsx", help="where to write the template")
+    p.add_argument("--force", action="store_true", help="overwrite OUT.xlsx if it exists")
+    p.set_defaults(run=run)
+
+
+def run(args):
+    from ..workbook.template import write_template
+
+    write_template(args.output, force=args.force)
+    print(f"wrote {args.output}")
+    return 0

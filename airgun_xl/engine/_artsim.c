@@ -1,0 +1,212 @@
+/*
+ * Faithful port of ArtSim's position loop (ARL-TR-3559, Appendix A; shared/seed/ArtSim.bas).
+ *
+ * The macro walks a cell cursor down columns I..M; sheet row r is computed from rows r-1 and
+ * r-2. Here sheet row k + 2 is array index k: index 0 is t = -delta, index 1 is t = 0. Names
+ * follow the macro (xPlastic, cPlastic, crushFactor, dforce, forceCounter, maxmitdef, yPrime2,
+ * ...) so the two can be read side by side. Every expression keeps the macro's operand order:
+ * the port is judged to the last digits against the macro's own output. Build with
+ * -ffp-contract=off so that no multiply-add is fused.
+ *
+ * Python interface (module airgun_xl.engine._artsim):
+ *   legacy_kernel(params, rows, t, y1, y31, y32, y33, crush, m31, defl, xp, force, m1)
+ *     params: a sequence of 21 floats in the order of PARAM_NAMES below;
+ *     the other arguments: writable, C-contiguous float64 buffers of length >= rows.
+ *     Returns (final M1, final m31). The GIL is released while stepping.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+
+/* The macro's value of pi (3.141592653, not M_PI). */
+#define PI_MACRO 3.141592653
+
+enum { P_M1, P_M31, P_M32, P_M33, P_K2, P_K3, P_DELTA, P_RHO, P_RCONE, P_HCONE, P_HCYL,
+       P_MMIT, P_VCONE, P_E, P_EC, P_SIGMAY, P_ZETA, P_V1, P_V31, P_V32, P_V33, P_COUNT };
+
+typedef struct {
+    double *t, *y1, *y31, *y32, *y33, *crush, *m31, *defl, *xp, *force, *m1;
+} Columns;
+
+/* Strain-rate amplification of the crush force, Eq. (8), with the macro's coefficients. */
+static double crush_factor_poly(double Vobr)
+{
+    double V = Vobr;
+    return (2.627437E-13) * (V * V * V * V * V * V) - (0.000000000125438) * (V * V * V * V * V)
+           + (0.0000000159241) * (V * V * V * V) + (0.0000005551838) * (V * V * V)
+           - (0.0001897436) * (V * V) + (0.008340218) * (V) + 1.257647;
+}
+
+static void legacy_steps(const double *p, Py_ssize_t rows, Columns c, double *finals)
+{
+    const double m32 = p[P_M32], m33 = p[P_M33], k2 = p[P_K2], k3 = p[P_K3];
+    const double delta = p[P_DELTA], rho = p[P_RHO], rcone = p[P_RCONE], hcone = p[P_HCONE];
+    const double hcylinder = p[P_HCYL], E = p[P_E], ec = p[P_EC], sigmay = p[P_SIGMAY];
+    const double zeta = p[P_ZETA];
+    /* Start: masses; damping from the initial masses, once. */
+    double M1 = p[P_M1] + p[P_MMIT];
+    double m31 = p[P_M31];
+    const double c2 = 2 * zeta * sqrt(-k2 * (m31 + m32));
+    const double c3 = 2 * zeta * sqrt(-k3 * (m32 + m33));
+    double vcone = p[P_VCONE]; /* E28 is the starting "vcone"; a wedge step overwrites it */
+    double xPlastic = 0, maxmitdef = 0, mitigatordeflection = 0, forceCounter = 0;
+    double dforce = 0, Force = 0;
+    double crushFactor = NAN; /* Variant Empty until the first loading step */
+    double currentTime = -delta;
+    Py_ssize_t k;
+
+    /* Time starts at -delta and accumulates by repeated addition. */
+    for (k = 0; k < rows; k++) {
+        c.t[k] = currentTime;
+        currentTime = currentTime + delta;
+    }
+    /* Y(-delta) = -delta * v0, Y(0) = 0. */
+    if (rows > 0) {
+        c.y1[0] = -delta * p[P_V1];
+        c.y31[0] = -delta * p[P_V31];
+        c.y32[0] = -delta * p[P_V32];
+        c.y33[0] = -delta * p[P_V33];
+    }
+    if (rows > 1)
+        c.y1[1] = c.y31[1] = c.y32[1] = c.y33[1] = 0;
+
+    for (k = 2; k < rows; k++) {
+        double L = hcone + hcylinder - mitigatordeflection; /* previous step's deflection */
+        double y1 = c.y1[k - 1], yn1 = c.y1[k - 2];
+        double y31 = c.y31[k - 1], yn31 = c.y31[k - 2];
+        double y32 = c.y32[k - 1], y33 = c.y33[k - 1];
+        /* Backward-difference relative velocities, from the two previous rows. */
+        double yPrime2 = ((y32 - c.y32[k - 2]) - (y31 - c.y31[k - 2])) / delta;
+        double yPrime3 = ((y33 - c.y33[k - 2]) - (y32 - c.y32[k - 2])) / delta;
+        double cPlastic, springValue, Area, k1;
+        /* Plastic front: advances only when the relative increment is >= 0. */
+        cPlastic = (c.y31[k - 1] - c.y31[k - 2] - c.y1[k - 1] + c.y1[k - 2]) / (ec * delta);
+        if (cPlastic >= 0)
+            xPlastic = xPlastic + (cPlastic * delta);
+        mitigatordeflection = y31 - y1;
+        if (mitigatordeflection < maxmitdef) {
+            /* Unloading: elastic over the full area; the masses stay frozen. */
+            Area = PI_MACRO * rcone * rcone;
+            k1 = -((Area * E) / (L));
+            if (forceCounter == 0) {
+                Force = -k1 * (mitigatordeflection - hcone);
+                dforce = Force - dforce;    /* offset that keeps F continuous at the turn */
+                forceCounter = 0 + 1;       /* macro: fourcecounter + 1, a typo: Empty + 1 */
+            }
+            Force = -k1 * (mitigatordeflection - hcone) - dforce;
+        } else {
+            /* Loading: plastic crush with mass transfer. */
+            double h, temp, Vobr;
+            maxmitdef = mitigatordeflection;
+            if (xPlastic <= hcone) {
+                h = xPlastic;
+                Area = (PI_MACRO * rcone * rcone) * (h / hcone);
+                temp = ((rho * Area * h) / 3.0);
+                vcone = temp; /* the wedge's crushed mass replaces the E28 "volume" */
+            } else {
+                Area = PI_MACRO * rcone * rcone;
+                h = xPlastic - hcone;
+                temp = vcone + (rho * Area * h);
+            }
+            M1 = p[P_M1] + p[P_MMIT] - temp; /* Range("A2") + Range("E25") - temp */
+            m31 = p[P_M31] + temp;
+            Vobr = (((y31 - yn31) - (y1 - yn1)) / delta);
+            crushFactor = crush_factor_poly(Vobr);
+            if (crushFactor < 1)
+                crushFactor = 1;
+            Force = sigmay * Area * crushFactor;
+            dforce = Force;
+        }
+        if (Force < 0)
+            Force = 0;
+        /* Central-difference updates, the four lines of the macro. */
+        springValue = ((delta * delta) / M1) * (Force);
+        c.y1[k] = 2 * y1 - yn1 + springValue;
+        springValue = ((delta * delta) / m31) * (-Force + (k2 * (y31 - y32)) + (c2 * yPrime2));
+        c.y31[k] = 2 * y31 - c.y31[k - 2] + springValue;
+        springValue = ((delta * delta) / m32) * ((-k2 * y31) + (y32 * (k2 + k3)) - (k3 * y33)
+                                                 - (c2 * yPrime2) + (c3 * yPrime3));
+        c.y32[k] = 2 * y32 - c.y32[k - 2] + springValue;
+        springValue = ((delta * delta) / m33) * ((k3 * y33) - (k3 * y32) - (c3 * yPrime3));
+        c.y33[k] = 2 * y33 - c.y33[k - 2] + springValue;
+        c.crush[k] = crushFactor;
+        c.m31[k] = m31;
+        c.defl[k] = mitigatordeflection;
+        c.xp[k] = xPlastic;
+        c.force[k] = Force;
+        c.m1[k] = M1;
+    }
+    finals[0] = M1;
+    finals[1] = m31;
+}
+
+#define N_COLUMNS 11
+
+static PyObject *py_legacy_kernel(PyObject *self, PyObject *args)
+{
+    PyObject *params, *seq, *objs[N_COLUMNS];
+    Py_buffer views[N_COLUMNS];
+    double p[P_COUNT], finals[2];
+    double *ptrs[N_COLUMNS];
+    Py_ssize_t rows, i;
+    int got = 0;
+    Columns c;
+
+    if (!PyArg_ParseTuple(args, "OnOOOOOOOOOOO", &params, &rows, &objs[0], &objs[1], &objs[2],
+                          &objs[3], &objs[4], &objs[5], &objs[6], &objs[7], &objs[8], &objs[9],
+                          &objs[10]))
+        return NULL;
+    seq = PySequence_Fast(params, "params must be a sequence of floats");
+    if (seq == NULL)
+        return NULL;
+    if (PySequence_Fast_GET_SIZE(seq) != P_COUNT) {
+        Py_DECREF(seq);
+        return PyErr_Format(PyExc_ValueError, "params must hold %d values", P_COUNT);
+    }
+    for (i = 0; i < P_COUNT; i++) {
+        p[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, i));
+        if (p[i] == -1.0 && PyErr_Occurred()) {
+            Py_DECREF(seq);
+            return NULL;
+        }
+    }
+    Py_DECREF(seq);
+    if (rows < 0)
+        return PyErr_Format(PyExc_ValueError, "rows must be >= 0");
+    for (got = 0; got < N_COLUMNS; got++) {
+        if (PyObject_GetBuffer(objs[got], &views[got], PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS
+                               | PyBUF_FORMAT) < 0)
+            goto fail;
+        if (views[got].itemsize != sizeof(double) || views[got].format == NULL
+            || strcmp(views[got].format, "d") != 0 || views[got].len < rows * (Py_ssize_t)sizeof(double)) {
+            PyBuffer_Release(&views[got]);
+            PyErr_SetString(PyExc_ValueError, "columns must be float64 buffers of length >= rows");
+            goto fail;
+        }
+        ptrs[got] = (double *)views[got].buf;
+    }
+    c.t = ptrs[0]; c.y1 = ptrs[1]; c.y31 = ptrs[2]; c.y32 = ptrs[3]; c.y33 = ptrs[4];
+    c.crush = ptrs[5]; c.m31 = ptrs[6]; c.defl = ptrs[7]; c.xp = ptrs[8]; c.force = ptrs[9];
+    c.m1 = ptrs[10];
+    Py_BEGIN_ALLOW_THREADS
+    legacy_steps(p, rows, c, finals);
+    Py_END_ALLOW_THREADS
+    for (i = 0; i < N_COLUMNS; i++)
+        PyBuffer_Release(&views[i]);
+    return Py_BuildValue("dd", finals[0], finals[1]);
+fail:
+    for (i = 0; i < got; i++)
+        PyBuffer_Release(&views[i]);
+    return NULL;
+}
+
+static PyMethodDef methods[] = {
+    {"legacy_kernel", py_legacy_kernel, METH_VARARGS,
+     "legacy_kernel(params, rows, t, y1, y31, y32, y33, crush, m31, defl, xp, force, m1)\n"
+     "Run ArtSim's position loop into the given float64 buffers; return (M1, m31)."},
+    {NULL, NULL, 0, NULL}};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_artsim",
+                                    "Compiled ArtSim kernel (faithful port).", -1, methods};
+
+PyMODINIT_FUNC PyInit__artsim(void) { return PyModule_Create(&module); }

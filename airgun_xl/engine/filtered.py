@@ -1,0 +1,98 @@
+"""The macro's filtered acceleration (column AB), cursor moves followed literally.
+
+The macro walks a cursor down AB from the t = -delta row, ``counter = 3 To rows - 2*samplerate``.
+Every time an inner counter exceeds ``samplerate`` it reads Y33 at the cursor, moves the cursor by
+``Offset(-samplerate)``, ``Offset(2*samplerate)``, ``Offset(-samplerate)``, reading at each stop,
+and writes a second difference where the cursor ends; other visited rows get "".
+
+Spreadsheet hosts disagree on a fractional Offset argument: Excel rounds it half to even (the OLE
+conversion to Long), so the stencil turns one-sided and the cursor drifts a row per sample;
+LibreOffice Calc ignores the move, so every sample is 0. ``host`` picks which one to reproduce.
+"""
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+HOSTS = ("excel", "calc")
+
+
+@dataclass
+class Filtered:
+    """Filtered samples: ``rows`` are array indices (sheet row - 2), ``values`` in m/s^2."""
+
+    rows: np.ndarray
+    values: np.ndarray
+    warnings: list = field(default_factory=list)
+
+
+def _offset(n, host):
+    """Rows a macro ``Offset(n, 0)`` moves by, in the given host."""
+    if float(n).is_integer():
+        return int(n)
+    if host == "calc":
+        return 0  # Calc ignores a fractional Offset argument
+    return round(n)  # Excel: nearest integer, halves to even (Python's round does the same)
+
+
+def filtered_acceleration(y33, delta, samplerate, host="excel"):
+    """Resample the test-item acceleration as ArtSim's last loop does.
+
+    Parameters
+    ----------
+    y33 : numpy.ndarray
+        Test-item displacement [m], one entry per time row (index 0 is t = -delta).
+    delta : float
+        Time step [s].
+    samplerate : float
+        ``1 / (E2 * E34)`` [rows], kept as a double.
+    host : {"excel", "calc"}
+        Whose Offset rounding to reproduce.
+
+    Returns
+    -------
+    Filtered
+        The sample rows and values; ``warnings`` says when the column is ill-defined.
+    """
+    if host not in HOSTS:
+        raise ValueError(f"host must be one of {HOSTS}")
+    n = len(y33)
+    warnings = []
+    # The loop visits `iterations` rows from index 0 (sheet row 2).
+    last = n - (2 * samplerate)  # `introwcount - (2 * samplerate)`, a double
+    iterations = max(0, math.floor(last) - 3 + 1)
+    period = math.floor(samplerate) + 1  # innercounter > samplerate, innercounter an Integer
+    up, both = _offset(-samplerate, host), _offset(2 * samplerate, host)
+    if not float(samplerate).is_integer():
+        warnings.append(
+            f"samplerate 1/(E2*E34) = {samplerate:.6g} is not a whole number of rows: the legacy "
+            f"filtered column is ill-defined (Excel rounds the offsets and drifts a row per "
+            f"sample; LibreOffice writes zeros); reproducing {host}")
+    scale = 1.0 / (delta * delta * samplerate * samplerate)
+    written = {}  # array index -> value; a later "" write empties a cell again
+    cursor = 0  # array index of the cursor
+    done = 0
+    top = -1  # highest row holding a sample
+    while done + period <= iterations:
+        if written and top >= cursor:  # rows written "" before the sample
+            for blank in range(cursor, cursor + period - 1):
+                written.pop(blank, None)
+        cursor += period - 1
+        done += period
+        r0 = cursor
+        r1 = r0 + up
+        r2 = r1 + both
+        r3 = r2 + up
+        if min(r1, r2, r3) < 0:  # index -1 is the header row: a type mismatch in the macro
+            warnings.append("the filter stencil reaches the header row, where the legacy macro "
+                            "stops with an error; later samples are left out")
+            break
+        un1 = y33[r0]
+        un2 = y33[r1] if r1 < n else 0.0  # cells below the data are empty, read as 0
+        un = y33[r2] if r2 < n else 0.0
+        written[r3] = scale * (un2 + un - 2 * un1)
+        top = max(top, r3)
+        cursor = r3 + 1
+    rows = sorted(written)
+    values = [written[r] for r in rows]
+    return Filtered(np.array(rows, dtype=np.int64), np.array(values, dtype=float), warnings)

@@ -1,0 +1,98 @@
+"""Integrators behind one small interface.
+
+An integrator is a function ``f(params) -> History`` that time-steps the shot and records the
+step values. ``legacy`` is the faithful port of ArtSim's central-difference loop; a robust scheme
+registers itself in :data:`INTEGRATORS` under its own name and is then selectable everywhere.
+"""
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from ..errors import OptionError
+from ._artsim import legacy_kernel
+
+#: Order of the parameters the compiled kernel takes (``_artsim.c``, enum at its top).
+KERNEL_PARAMS = ("m1", "m31", "m32", "m33", "k2", "k3", "delta", "rho", "rcone", "hcone",
+                 "hcylinder", "mmitigator", "vcone", "E", "ec", "sigmay", "zeta", "v1", "v31",
+                 "v32", "v33")
+
+
+@dataclass
+class History:
+    """Per-row values of one run; index ``k`` is sheet row ``k + 2`` (index 0 is t = -delta).
+
+    Attributes
+    ----------
+    time : numpy.ndarray
+        Time [s], from -delta, accumulated by repeated addition as the macro does.
+    y1, y31, y32, y33 : numpy.ndarray
+        Displacements of MEM, OBR front plate, OBR back plate, test item [m].
+    crush_factor : numpy.ndarray
+        Crush factor [-] (NaN where the macro writes nothing).
+    m31, m1 : numpy.ndarray
+        The macro's m31 and M1 [kg] in each step.
+    deflection : numpy.ndarray
+        Mitigator deflection used in the step [m].
+    x_plastic : numpy.ndarray
+        Plastic wave front after its update [m].
+    force : numpy.ndarray
+        Mitigator force [N], after the clamp at 0.
+    final_m1, final_m31 : float
+        The masses the macro writes below column I [kg].
+    kernel_seconds : float
+        Wall time of the time-stepping kernel [s].
+    """
+
+    time: np.ndarray
+    y1: np.ndarray
+    y31: np.ndarray
+    y32: np.ndarray
+    y33: np.ndarray
+    crush_factor: np.ndarray
+    m31: np.ndarray
+    deflection: np.ndarray
+    x_plastic: np.ndarray
+    force: np.ndarray
+    m1: np.ndarray
+    final_m1: float
+    final_m31: float
+    kernel_seconds: float
+
+
+def run_legacy(p):
+    """Time-step the shot with ArtSim's own scheme (the compiled port in ``_artsim.c``).
+
+    Parameters
+    ----------
+    p : airgun_xl.params.ShotParams
+        The checked parameters.
+
+    Returns
+    -------
+    History
+    """
+    rows = p.rows
+    arrays = [np.zeros(rows) for _ in range(5)] + [np.full(rows, np.nan) for _ in range(6)]
+    started = time.perf_counter()
+    final_m1, final_m31 = legacy_kernel([getattr(p, name) for name in KERNEL_PARAMS], rows,
+                                        *arrays)
+    elapsed = time.perf_counter() - started
+    return History(*arrays, final_m1, final_m31, elapsed)
+
+
+INTEGRATORS = {"legacy": run_legacy}
+
+
+def get_integrator(name):
+    """The integrator registered under ``name``.
+
+    Raises
+    ------
+    OptionError
+        For an unknown name, listing the known ones.
+    """
+    try:
+        return INTEGRATORS[name]
+    except KeyError:
+        raise OptionError(f"--integrator: found {name!r}, expected one of "
+                          f"{', '.join(sorted(INTEGRATORS))}") from None

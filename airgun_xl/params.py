@@ -1,0 +1,184 @@
+"""A shot's parameters, checked in one place.
+
+:class:`ShotParams` holds the values of the cells in :data:`airgun_xl.cells.CELLS`, in SI units,
+with the sign conventions of the legacy sheet. :func:`check_value` and :meth:`ShotParams.check`
+are the only input checks; readers and the API call them, the kernel trusts them.
+"""
+import math
+from dataclasses import asdict, dataclass, fields, replace
+
+from .cells import BY_NAME, CELLS, MAX_STEPS, expectation
+from .errors import CellError
+
+
+def describe(raw):
+    """How a raw cell value is named in an error message."""
+    if raw is None or (isinstance(raw, str) and raw.strip() == ""):
+        return "a blank cell"
+    if isinstance(raw, bool):
+        return "TRUE" if raw else "FALSE"
+    if isinstance(raw, str) and raw.startswith("#"):
+        return f"the error {raw}"
+    if isinstance(raw, str):
+        return repr(raw)
+    if isinstance(raw, float) and not math.isfinite(raw):
+        return f"the non-finite value {raw}"
+    return repr(raw)
+
+
+def check_value(cell, raw):
+    """Check one raw cell value against its row of the cell map.
+
+    Parameters
+    ----------
+    cell : airgun_xl.cells.Cell
+        The cell's row of the map.
+    raw : object
+        The value as read: a number, a string, None for blank, or an error string like ``#DIV/0!``.
+
+    Returns
+    -------
+    float
+        The value, as a float.
+
+    Raises
+    ------
+    CellError
+        When the value is not a number, not finite, or outside the cell's check.
+    """
+    if isinstance(raw, bool) or not isinstance(raw, (int, float)):
+        raise CellError(cell.address, cell.label, describe(raw), expectation(cell))
+    value = float(raw)
+    ok = math.isfinite(value) and abs(value) <= cell.limit
+    if ok:
+        ok = {
+            "positive": value > 0,
+            "negative": value < 0,
+            "nonnegative": value >= 0,
+            "fraction": 0 < value <= 1,
+            "any": True,
+        }[cell.check]
+    if not ok:
+        raise CellError(cell.address, cell.label, describe(raw), expectation(cell))
+    return value
+
+
+@dataclass(frozen=True)
+class ShotParams:
+    """The inputs of one shot, as ArtSim reads them.
+
+    Attributes
+    ----------
+    m1 : float
+        MEM mass without the mitigator [kg]; A2. The macro's M1 is ``m1 + mmitigator``.
+    m31, m32, m33 : float
+        OBR front plate, OBR back plate and test item masses [kg]; B2, C2, D2.
+    k2 : float
+        Spring between m31 and m32 [N/m], negative as in the legacy sheet; B6, Eq. (1).
+    k3 : float
+        Spring between m32 and m33 [N/m], negative as in the legacy sheet; C6, Eq. (1).
+    delta : float
+        Time step [s]; E2.
+    max_time : float
+        Simulated duration [s]; E6.
+    rho : float
+        Honeycomb density [kg/m^3]; E10.
+    rcone : float
+        Mitigator radius [m]; E13.
+    hcone, hcylinder : float
+        Wedge and cylinder lengths [m]; E16, E19.
+    mmitigator : float
+        Mitigator mass [kg]; E25.
+    vcone : float
+        "Volume of conical mitigator" [m^3]; E28. The macro adds it to a mass (a quirk).
+    E : float
+        Elastic modulus of the mitigator [Pa]; E31, Eq. (9).
+    filter_frequency : float
+        Sampling frequency of the filtered acceleration [Hz]; E34.
+    ec : float
+        Compacting strain [-]; E37, Eq. (4).
+    sigmay : float
+        Static crush (yield) stress [Pa]; E40, Eq. (6).
+    zeta : float
+        Damping ratio [-]; E43, Eq. (18).
+    v1, v31, v32, v33 : float
+        Initial velocities of Y1, Y31, Y32, Y33 [m/s]; A27..A30.
+    """
+
+    m1: float
+    m31: float
+    m32: float
+    m33: float
+    k2: float
+    k3: float
+    delta: float
+    max_time: float
+    rho: float
+    rcone: float
+    hcone: float
+    hcylinder: float
+    mmitigator: float
+    vcone: float
+    E: float
+    filter_frequency: float
+    ec: float
+    sigmay: float
+    zeta: float
+    v1: float
+    v31: float
+    v32: float
+    v33: float
+
+    @classmethod
+    def from_cells(cls, raw_by_address):
+        """Build from raw cell values keyed by address; every value is checked.
+
+        Raises
+        ------
+        CellError
+            On the first cell (in the macro's reading order) that fails its check.
+        """
+        values = {c.name: check_value(c, raw_by_address.get(c.address)) for c in CELLS}
+        return cls(**values).check()
+
+    def check(self):
+        """Check each field and the relations between fields; return self.
+
+        Raises
+        ------
+        CellError
+            Naming the cell at fault.
+        """
+        for f in fields(self):
+            check_value(BY_NAME[f.name], getattr(self, f.name))
+        if self.delta > self.max_time:
+            c = BY_NAME["delta"]
+            raise CellError(c.address, c.label, repr(self.delta),
+                            f"a time step no longer than E6 (Max Time) = {self.max_time!r} s")
+        steps = self.max_time / self.delta
+        if steps > MAX_STEPS:
+            c = BY_NAME["max_time"]
+            raise CellError(c.address, c.label, f"{self.max_time!r} s, {steps:.3g} steps of E2",
+                            f"at most {MAX_STEPS:,} steps (E6/E2)")
+        return self
+
+    @property
+    def rows(self):
+        """Number of time rows the macro writes (t = -delta first).
+
+        The macro's ``For i = 1 To delCounter + 2`` compares the counter with the double
+        ``E6/E2 + 2``, so 5e-3/5e-6 = 999.9999999999999 gives 1,001 rows, not 1,002.
+        """
+        return int(math.floor(self.max_time / self.delta + 2))
+
+    @property
+    def samplerate(self):
+        """Rows between filtered samples, ``1/(E2*E34)``, a double as in the macro."""
+        return 1 / (self.delta * self.filter_frequency)
+
+    def replace(self, **changes):
+        """A copy with some fields changed, checked again."""
+        return replace(self, **changes).check()
+
+    def as_dict(self):
+        return asdict(self)

@@ -1,0 +1,94 @@
+"""The result of a run: the macro's columns and the step values, as arrays and DataFrames."""
+from dataclasses import dataclass
+
+import numpy as np
+
+#: DataFrame column -> unit, in the order of :meth:`Result.to_frame`.
+FRAME_UNITS = {
+    "y1": "m", "y31": "m", "y32": "m", "y33": "m", "crush_factor": "-", "m31": "kg",
+    "deflection": "m", "x_plastic": "m", "force": "N", "m1": "kg", "accel": "m/s^2",
+    "velocity": "m/s", "accel_kg": "kG", "filtered_accel": "m/s^2",
+}
+
+
+@dataclass
+class Result:
+    """A run of a :class:`airgun_xl.shot.Shot`.
+
+    Attributes
+    ----------
+    shot : Shot
+    integrator : str
+    history : airgun_xl.engine.History
+        Per-row values from the integrator.
+    accel, velocity, accel_kg : numpy.ndarray
+        Test-item acceleration [m/s^2], velocity [m/s] and acceleration [kG] (columns S, T, U).
+    filtered : airgun_xl.engine.filtered.Filtered
+        The filtered samples (column AB).
+    warnings : list of str
+    """
+
+    shot: object
+    integrator: str
+    history: object
+    accel: np.ndarray
+    velocity: np.ndarray
+    accel_kg: np.ndarray
+    filtered: object
+    warnings: list
+
+    @property
+    def params(self):
+        return self.shot.params
+
+    @property
+    def rows(self):
+        """Number of time rows (the sheet's rows 2..rows+1)."""
+        return len(self.history.time)
+
+    @property
+    def filtered_column(self):
+        """Filtered acceleration per row [m/s^2], NaN where the macro leaves AB empty."""
+        out = np.full(self.rows, np.nan)
+        inside = self.filtered.rows < self.rows
+        out[self.filtered.rows[inside]] = self.filtered.values[inside]
+        return out
+
+    @property
+    def peak_kg(self):
+        """Largest value of the Acceleration (kG's) column."""
+        return float(np.nanmax(self.accel_kg)) if np.isfinite(self.accel_kg).any() else np.nan
+
+    @property
+    def time_of_peak(self):
+        """Time of :attr:`peak_kg` [s] (first row if it repeats)."""
+        if not np.isfinite(self.accel_kg).any():
+            return np.nan
+        return float(self.history.time[int(np.nanargmax(self.accel_kg))])
+
+    def to_frame(self):
+        """All per-row values as a pandas DataFrame indexed by time [s].
+
+        Columns are those of :data:`FRAME_UNITS`; ``frame.attrs["units"]`` maps each to its
+        unit. Cells the macro leaves empty are NaN.
+        """
+        import pandas as pd
+
+        h = self.history
+        data = {
+            "y1": h.y1, "y31": h.y31, "y32": h.y32, "y33": h.y33,
+            "crush_factor": h.crush_factor, "m31": h.m31, "deflection": h.deflection,
+            "x_plastic": h.x_plastic, "force": h.force, "m1": h.m1, "accel": self.accel,
+            "velocity": self.velocity, "accel_kg": self.accel_kg,
+            "filtered_accel": self.filtered_column,
+        }
+        frame = pd.DataFrame(data, index=pd.Index(h.time, name="time"))
+        frame.attrs["units"] = dict(FRAME_UNITS, time="s")
+        frame.attrs["integrator"] = self.integrator
+        return frame
+
+    def write(self, path, force=False):
+        """Write the legacy workbook (see :func:`airgun_xl.workbook.writer.write_workbook`)."""
+        from .workbook.writer import write_workbook
+
+        return write_workbook(self, path, force=force)

@@ -1,0 +1,67 @@
+"""The hub objects: a :class:`Shot` (parameters and where they came from) runs into a
+:class:`airgun_xl.result.Result`, which the writers turn into files."""
+from dataclasses import dataclass, field
+
+from .engine import filtered_acceleration, get_integrator, test_item_derivatives
+from .params import ShotParams
+
+
+@dataclass
+class Shot:
+    """One shot: checked parameters, their source workbook (if any), and reading warnings.
+
+    Parameters
+    ----------
+    params : ShotParams
+    source : airgun_xl.workbook.reader.Source or None
+        The workbook the parameters were read from; None for a shot built in code.
+    warnings : list of str
+        What reading the workbook found worth saying (e.g. stale cached formula values).
+    """
+
+    params: ShotParams
+    source: object = None
+    warnings: list = field(default_factory=list)
+
+    @classmethod
+    def from_workbook(cls, path):
+        """Read a shot from a workbook in the report's layout.
+
+        Raises
+        ------
+        airgun_xl.errors.AirgunXlError
+            A :class:`~airgun_xl.errors.CellError` naming the cell, or a
+            :class:`~airgun_xl.errors.WorkbookError` for the file.
+        """
+        from .workbook.reader import read_params
+
+        params, source, warnings = read_params(path)
+        return cls(params, source, warnings)
+
+    def with_params(self, **changes):
+        """The same shot with some parameters changed (checked again)."""
+        return Shot(self.params.replace(**changes), self.source, list(self.warnings))
+
+    def run(self, integrator="legacy", host="excel"):
+        """Time-step the shot and derive the macro's columns.
+
+        Parameters
+        ----------
+        integrator : str
+            Name in :data:`airgun_xl.engine.INTEGRATORS`; ``"legacy"`` is ArtSim's scheme.
+        host : {"excel", "calc"}
+            Whose Offset rounding the filtered column reproduces when ``1/(E2*E34)`` is not a
+            whole number.
+
+        Returns
+        -------
+        airgun_xl.result.Result
+        """
+        from .result import Result
+
+        p = self.params
+        history = get_integrator(integrator)(p)
+        accel, vel, kg = test_item_derivatives(history.y33, p.delta)
+        filtered = filtered_acceleration(history.y33, p.delta, p.samplerate, host)
+        return Result(self, integrator, history, accel, vel, kg, filtered,
+                      list(self.warnings) + filtered.warnings)

@@ -1,0 +1,183 @@
+"""Evaluate cell formulas with the ``formulas`` package, one cell and its precedents at a time.
+
+Each formula is parsed and compiled by ``formulas``; its inputs (cells and ranges) are resolved
+recursively through a :class:`SheetView`, so only the cells a parameter depends on are computed.
+Whole-column ranges such as ``I:I`` are cut to the sheet's used rows.
+"""
+import logging
+from contextlib import contextmanager
+from functools import lru_cache
+
+import numpy as np
+from openpyxl.utils.cell import range_boundaries
+
+
+class FormulaFailure(Exception):
+    """A formula could not be evaluated (unsupported function, bad reference, a cycle)."""
+
+
+class SheetView:
+    """Read access to the cells of a workbook for the evaluator.
+
+    Parameters
+    ----------
+    sheets : dict
+        Upper-cased sheet name -> ``{(row, col): (value, formula)}``; ``formula`` is the formula
+        text (starting with ``=``) or None.
+    default : str
+        Upper-cased name of the sheet that unqualified references point to.
+    columns : dict, optional
+        ``{(sheet, col): sequence}`` of whole columns given as values for rows 1..n, e.g. the
+        result columns of a run; they take precedence over ``sheets``.
+    limits : dict, optional
+        ``{sheet: max_col}``: references beyond the columns that were read fail rather than
+        read as blank.
+    """
+
+    def __init__(self, sheets, default, columns=None, limits=None):
+        self.sheets = sheets
+        self.default = default
+        self.columns = columns if columns is not None else {}
+        self.limits = limits or {}
+        self.max_row = {name: max((r for r, _ in cells), default=1)
+                        for name, cells in sheets.items()}
+        self.max_col = {name: max((c for _, c in cells), default=1)
+                        for name, cells in sheets.items()}
+        for (name, col), values in self.columns.items():
+            self.max_row[name] = max(self.max_row.get(name, 1), len(values))
+            self.max_col[name] = max(self.max_col.get(name, 1), col)
+
+    def cell(self, sheet, row, col):
+        """``(value, formula)`` of a cell."""
+        column = self.columns.get((sheet, col))
+        if column is not None:
+            return (column[row - 1] if row <= len(column) else None), None
+        limit = self.limits.get(sheet)
+        if limit is not None and col > limit and (row, col) not in self.sheets[sheet]:
+            raise FormulaFailure("refers to a cell outside the parameter block")
+        return self.sheets.get(sheet, {}).get((row, col), (None, None))
+
+
+def _reason(exc):
+    """One short line for why ``formulas`` failed."""
+    if "NotImplemented" in repr(exc):
+        return "unsupported function"
+    text = str(exc).splitlines()[0].rstrip(": ") if str(exc).strip() else type(exc).__name__
+    return text.lower()
+
+
+@contextmanager
+def _quiet():
+    """Silence schedula, which logs a traceback for every unsupported function."""
+    log = logging.getLogger("schedula")
+    level = log.level
+    log.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        log.setLevel(level)
+
+
+@lru_cache(maxsize=256)
+def _compile(formula):
+    import formulas  # heavy import, only when a workbook holds a formula
+
+    with _quiet():  # compiling a formula without inputs already evaluates it
+        try:
+            return formulas.Parser().ast(formula)[1].compile()
+        except Exception as exc:  # formulas raises its own types for bad syntax
+            raise FormulaFailure(f"cannot evaluate {formula}: {_reason(exc)}") from None
+
+
+def _scalar(result):
+    """A Python value from a ``formulas`` result: float, str, bool, None, or '#ERR!' text."""
+    value = np.asarray(result, dtype=object)
+    value = value.reshape(-1)[0] if value.size else None
+    if value is None:
+        return None
+    if value is _empty():
+        return 0.0  # a formula that points at a blank cell shows 0
+    text = str(value)
+    if text.startswith("#") and text.endswith(("!", "?", "A")):
+        return text  # an Excel error such as #DIV/0!, #NAME?, #N/A
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, float, np.integer, np.floating)):
+        return float(value)
+    if type(value).__name__ == "_Empty" or text == "":
+        return None
+    return text
+
+
+class Evaluator:
+    """Evaluates formula cells of a :class:`SheetView`, memoising each cell's value."""
+
+    def __init__(self, view):
+        self.view = view
+        self._values = {}
+        self._active = set()
+
+    def value(self, sheet, row, col):
+        """The value of a cell: its constant, or its formula's result."""
+        key = (sheet, row, col)
+        if key in self._values:
+            return self._values[key]
+        value, formula = self.view.cell(sheet, row, col)
+        if formula is not None:
+            if key in self._active:
+                raise FormulaFailure("circular reference")
+            self._active.add(key)
+            try:
+                value = self.evaluate(formula, sheet)
+            finally:
+                self._active.discard(key)
+        self._values[key] = value
+        return value
+
+    def evaluate(self, formula, sheet):
+        """Evaluate formula text (``=...``) as if it stood on ``sheet``."""
+        func = _compile(formula)
+        args = [self._resolve(ref, sheet) for ref in func.inputs]
+        with _quiet():
+            try:
+                return _scalar(func(*args))
+            except Exception as exc:
+                raise FormulaFailure(f"cannot evaluate {formula}: {_reason(exc)}") from None
+
+    def _resolve(self, ref, sheet):
+        if "!" in ref:
+            sheet, ref = ref.rsplit("!", 1)
+            sheet = sheet.strip("'").upper()
+        sheet = sheet or self.view.default
+        if sheet not in self.view.sheets:
+            raise FormulaFailure(f"unknown sheet in reference {ref}")
+        try:
+            min_col, min_row, max_col, max_row = range_boundaries(ref.replace("$", ""))
+        except ValueError:
+            raise FormulaFailure(f"unsupported reference {ref}") from None
+        min_row = min_row or 1
+        min_col = min_col or 1
+        max_row = max_row or self.view.max_row[sheet]
+        max_col = max_col or self.view.max_col[sheet]
+        if min_row == max_row and min_col == max_col:
+            value = self.value(sheet, min_row, min_col)
+            return np.array([[_empty() if value is None else value]], dtype=object)
+        column = self.view.columns.get((sheet, min_col))
+        if column is not None and min_col == max_col:  # a result column: slice, not cell by cell
+            part = np.full(max_row - min_row + 1, _empty(), dtype=object)
+            values = column[min_row - 1:max_row]
+            part[:len(values)] = values
+            part[np.equal(part, None)] = _empty()
+            return part.reshape(-1, 1)
+        block = np.empty((max_row - min_row + 1, max_col - min_col + 1), dtype=object)
+        for r in range(min_row, max_row + 1):
+            for c in range(min_col, max_col + 1):
+                v = self.value(sheet, r, c)
+                block[r - min_row, c - min_col] = _empty() if v is None else v
+        return block
+
+
+def _empty():
+    import schedula  # formulas' dependency; its EMPTY token marks a blank cell
+
+    return schedula.EMPTY
