@@ -11,8 +11,14 @@ from .cells import BY_NAME, CELLS, MAX_STEPS, expectation
 from .errors import CellError
 
 
+class Found(str):
+    """A reader's own description of what a cell holds, used verbatim in messages."""
+
+
 def describe(raw):
     """How a raw cell value is named in an error message."""
+    if isinstance(raw, Found):
+        return str(raw)
     if raw is None or (isinstance(raw, str) and raw.strip() == ""):
         return "a blank cell"
     if isinstance(raw, bool):

@@ -87,9 +87,7 @@ def filtered_acceleration(y33, delta, samplerate, host="excel"):
             warnings.append("the filter stencil reaches the header row, where the legacy macro "
                             "stops with an error; later samples are left out")
             break
-        un1 = y33[r0]
-        un2 = y33[r1] if r1 < n else 0.0  # cells below the data are empty, read as 0
-        un = y33[r2] if r2 < n else 0.0
+        un1, un2, un = (y33[r] if r < n else 0.0 for r in (r0, r1, r2))  # below the data: 0
         written[r3] = scale * (un2 + un - 2 * un1)
         top = max(top, r3)
         cursor = r3 + 1

@@ -10,14 +10,13 @@ are recomputed.
 """
 import hashlib
 import io
-import math
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..cells import CELLS, PARAMETER_COLUMNS, TIME_HEADER, expectation
+from ..cells import CELLS, PARAMETER_COLUMNS, TIME_HEADER
 from ..errors import CellError, WorkbookError
-from ..params import ShotParams, check_value, describe
+from ..params import Found, ShotParams, describe
 from .formula_eval import Evaluator, FormulaFailure, SheetView
 
 ZIP_MAGIC = b"PK\x03\x04"
@@ -56,9 +55,10 @@ class Source:
         """A :class:`SheetView` over the parameter sheet and the other sheets."""
         sheets = dict(self.other_sheets)
         sheets[self.sheet_title.upper()] = self.block
-        limit = None if extra_columns is not None else PARAMETER_COLUMNS
-        return SheetView(sheets, self.sheet_title.upper(), {} if extra_columns is None else extra_columns,
-                         {self.sheet_title.upper(): limit})
+        if extra_columns is None:  # only the block was read: references beyond it must fail
+            return SheetView(sheets, self.sheet_title.upper(), {},
+                             {self.sheet_title.upper(): PARAMETER_COLUMNS})
+        return SheetView(sheets, self.sheet_title.upper(), extra_columns)
 
 
 def _sniff(path):
@@ -187,12 +187,13 @@ def parameter_values(source):
     A formula cell is evaluated with the ``formulas`` engine. Without a cached value the result
     is used as it is; when a cached value disagrees, a warning says so and the evaluated value
     is used (spreadsheet apps recalculate on open, so that is what the macro would read). When a
-    formula cannot be evaluated, its cached value is used with a warning.
+    formula cannot be evaluated, its cached value is used with a warning. Nothing is raised
+    here: a bad value is left for :meth:`ShotParams.from_cells` to report, in cell order.
 
     Returns
     -------
     raw : dict
-        Address -> raw value (number, text, None, or an error text such as ``#DIV/0!``).
+        Address -> raw value (number, text, None, or a :class:`Found` description).
     warnings : list of str
     """
     evaluator = Evaluator(source.view())
@@ -211,16 +212,16 @@ def parameter_values(source):
                 warnings.append(f"{cell.address} ({cell.label}): {exc}; using the cached value "
                                 f"{cached!r}")
                 raw[cell.address] = cached
-                continue
-            raise CellError(cell.address, cell.label, f"the formula {formula} ({exc})",
-                            expectation(cell)) from None
+            else:
+                raw[cell.address] = Found(f"the formula {formula} ({exc})")
+            continue
         if isinstance(value, float) and (cached is not None) and _disagrees(cached, value):
             warnings.append(f"{cell.address} ({cell.label}): the cached value {describe(cached)} "
                             f"disagrees with {formula} = {value!r}; using the evaluated value")
-        if not isinstance(value, float) or not math.isfinite(value):
-            raise CellError(cell.address, cell.label, f"{describe(value)} from {formula}",
-                            expectation(cell))
-        raw[cell.address] = value
+        if isinstance(value, float):
+            raw[cell.address] = value
+        else:
+            raw[cell.address] = Found(f"{describe(value)} from {formula}")
     return raw, warnings
 
 

@@ -21,14 +21,13 @@ I       final M1, final m31         rows+3 and rows+4
 import datetime
 
 import numpy as np
+from xlsxwriter.utility import xl_rowcol_to_cell
 
 from ..cells import PARAMETER_COLUMNS
 from ..errors import OutputError
 from .atomic import atomic_path, check_output
+from .columns_sheet import SHEET_ROWS, ColumnsWorksheet, fast_deflate
 from .formula_eval import Evaluator, FormulaFailure
-
-#: Rows of a worksheet (Excel and xlsxwriter limit).
-SHEET_ROWS = 1_048_576
 
 #: Fixed document properties, so the same run gives the same bytes.
 PROPERTIES = {
@@ -53,7 +52,7 @@ def new_workbook(path):
     """An xlsxwriter Workbook with the project's fixed options and properties."""
     import xlsxwriter
 
-    wb = xlsxwriter.Workbook(str(path), {"nan_inf_to_errors": True})
+    wb = xlsxwriter.Workbook(str(path), {"nan_inf_to_errors": True, "in_memory": True})
     wb.set_properties(PROPERTIES)
     return wb
 
@@ -132,9 +131,7 @@ def _block_values(result):
 
 
 def _a1(row, col):
-    from openpyxl.utils.cell import get_column_letter
-
-    return f"{get_column_letter(col)}{row}"
+    return xl_rowcol_to_cell(row - 1, col - 1)
 
 
 def _write_block(ws, result):
@@ -160,16 +157,20 @@ def _write_block(ws, result):
     return warnings
 
 
+def finite_runs(values):
+    """``(start, stop)`` index pairs of the runs of finite values in ``values``."""
+    finite = np.concatenate(([False], np.isfinite(values), [False]))
+    edges = np.flatnonzero(np.diff(finite.astype(np.int8)))
+    return list(zip(edges[0::2].tolist(), edges[1::2].tolist()))
+
+
 def _write_results(ws, result):
     for col, text in HEADERS.items():
         ws.write_string(0, col, text)
     for col, (first, values) in result_columns(result).items():
-        finite = np.isfinite(values)
-        if finite.all():
-            ws.write_column(first, col, values.tolist())
-        else:  # the macro leaves these cells empty (e.g. Crush Factor before any loading)
-            for i in np.flatnonzero(finite).tolist():
-                ws.write_number(first + i, col, float(values[i]))
+        # NaN marks cells the macro leaves empty (e.g. Crush Factor before any loading)
+        for start, stop in finite_runs(values):
+            ws.write_number_column(first + start, col, values[start:stop])
     n = result.rows
     ws.write_number(n + 2, 8, result.history.final_m1)
     ws.write_number(n + 3, 8, result.history.final_m31)
@@ -204,8 +205,10 @@ def write_workbook(result, path, force=False):
                           "or a shorter E6")
     with atomic_path(path) as tmp:
         wb = new_workbook(tmp)
-        ws = wb.add_worksheet(source.sheet_title if source is not None else "Sheet1")
+        ws = wb.add_worksheet(source.sheet_title if source is not None else "Sheet1",
+                              worksheet_class=ColumnsWorksheet)
         warnings = _write_block(ws, result)
         _write_results(ws, result)
-        wb.close()
+        with fast_deflate():
+            wb.close()
     return warnings
