@@ -19,6 +19,7 @@ I       final M1, final m31         rows+3 and rows+4
 ======  ==========================  =====================================================
 """
 import datetime
+import math
 
 import numpy as np
 from xlsxwriter.utility import xl_rowcol_to_cell
@@ -148,8 +149,10 @@ def _write_block(ws, result):
             ws.write_formula(r, c, formula, None, "" if value is None else value)
         elif isinstance(cached, bool):
             ws.write_boolean(r, c, cached)
+        elif isinstance(cached, (int, float)) and math.isfinite(cached):
+            ws.write_number_column(r, c, [cached])  # exact: xlsxwriter keeps 16 digits
         elif isinstance(cached, (int, float)):
-            ws.write_number(r, c, cached)
+            ws.write_number(r, c, cached)  # NaN/inf: written as an error cell
         elif isinstance(cached, (datetime.date, datetime.time)):
             ws.write(r, c, str(cached))
         else:
