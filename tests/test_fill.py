@@ -191,6 +191,19 @@ def test_libreoffice_reads_the_output(shot_copy, tmp_path):
     assert float(rows[3].split(",")[12]) == pytest.approx(3.42657950207454, rel=1e-9)
 
 
+@pytest.mark.skipif(shutil.which("soffice") is None, reason="LibreOffice is not installed")
+def test_libreoffice_reads_the_template(tmp_path):
+    """The committed template opens in LibreOffice with its cached formula values."""
+    done = subprocess.run(["soffice", f"-env:UserInstallation=file://{tmp_path}/lo",
+                           "--headless", "--convert-to", "csv", "--outdir", str(tmp_path),
+                           str(TEMPLATE)], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    rows = [r.split(",") for r in (tmp_path / "shot_a.csv").read_text().splitlines()]
+    assert rows[24][4] == "8.75483609"  # E25 = E10*E22
+    assert rows[28][0] == "243.53532"  # A29 = A28
+    assert float(rows[21][0]) == pytest.approx(1 / (680.388555 + 8.75483609), rel=1e-13)  # A22
+
+
 def test_readme_names_the_setup_commands():
     text = (ROOT / "README.md").read_text()
     assert "airgun-xl fill templates/shot_a.xlsx" in text
