@@ -9,10 +9,10 @@ Load a shot from a workbook in the report's layout, run it, and get the result::
 """
 __version__ = "0.1.0"
 
-from .errors import AirgunXlError, CellError, OptionError, OutputError, WorkbookError  # noqa: E402
-from .params import ShotParams  # noqa: E402
-from .result import Result  # noqa: E402
-from .shot import Shot  # noqa: E402
+from .errors import AirgunXlError, CellError, OptionError, OutputError, WorkbookError
+from .params import ShotParams
+from .result import Result
+from .shot import Shot
 
 
 def load(path):
@@ -20,5 +20,15 @@ def load(path):
     return Shot.from_workbook(path)
 
 
-__all__ = ["AirgunXlError", "CellError", "OptionError", "OutputError", "Result", "Shot",
-           "ShotParams", "WorkbookError", "load", "__version__"]
+__all__ = [
+    "AirgunXlError",
+    "CellError",
+    "OptionError",
+    "OutputError",
+    "Result",
+    "Shot",
+    "ShotParams",
+    "WorkbookError",
+    "__version__",
+    "load",
+]

@@ -175,7 +175,7 @@ class ShotParams:
         The macro's ``For i = 1 To delCounter + 2`` compares the counter with the double
         ``E6/E2 + 2``, so 5e-3/5e-6 = 999.9999999999999 gives 1,001 rows, not 1,002.
         """
-        return int(math.floor(self.max_time / self.delta + 2))
+        return math.floor(self.max_time / self.delta + 2)
 
     @property
     def samplerate(self):

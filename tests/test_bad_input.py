@@ -8,10 +8,10 @@ import zipfile
 
 import openpyxl
 import pytest
+from conftest import TEMPLATE
 
 from airgun_xl.cells import CELLS, TIME_HEADER
 from airgun_xl.cli import main
-from conftest import TEMPLATE
 
 #: kind -> (value written, text expected after "found ")
 KINDS = {

@@ -9,10 +9,10 @@ import numpy as np
 import openpyxl
 import pytest
 import xlsxwriter
+from conftest import LEGACY_RTOL, REFERENCE, ROOT, TEMPLATE, column, sheet_values
 
 import airgun_xl
 from airgun_xl.cli import main
-from conftest import LEGACY_RTOL, REFERENCE, ROOT, TEMPLATE, column, sheet_values
 
 DATA = Path(__file__).parent / "data"
 

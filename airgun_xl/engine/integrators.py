@@ -8,6 +8,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+
 from ..errors import OptionError
 from ._artsim import legacy_kernel
 

@@ -72,7 +72,7 @@ class ColumnsWorksheet(Worksheet):
                 bulk_rows[i].append(cell)
                 bulk_cols[i].append(col)
         for row, (texts, cols) in enumerate(zip(bulk_rows, bulk_cols), start=first_row):
-            table = self.table[row] if row in self.table else None
+            table = self.table.get(row)  # .get: the defaultdict must not grow
             if not texts and not table:
                 if row in self.row_info:
                     self._write_empty_row(row, None, self.row_info[row])

@@ -85,7 +85,7 @@ def _compile(formula):
     with _quiet():  # compiling a formula without inputs already evaluates it
         try:
             return formulas.Parser().ast(formula)[1].compile()
-        except Exception as exc:  # formulas raises its own types for bad syntax
+        except Exception as exc:  # noqa: BLE001 - formulas raises its own types for bad syntax
             raise FormulaFailure(f"cannot evaluate {formula}: {_reason(exc)}") from None
 
 
@@ -141,7 +141,7 @@ class Evaluator:
         with _quiet():
             try:
                 return _scalar(func(*args))
-            except Exception as exc:
+            except Exception as exc:  # noqa: BLE001 - any failure inside formulas
                 raise FormulaFailure(f"cannot evaluate {formula}: {_reason(exc)}") from None
 
     def _resolve(self, ref, sheet):

@@ -143,7 +143,7 @@ def _read_xls(path, data):
                     if value is not None and value != "":
                         cells[(r, c)] = (value, None)
             sheets[name] = cells
-    except Exception as exc:  # calamine raises its own error types for broken files
+    except Exception as exc:  # noqa: BLE001 - calamine raises its own types for broken files
         raise WorkbookError(f"{path}: is not a readable .xls workbook ({exc})") from None
     if not sheets:
         raise WorkbookError(f"{path}: has no worksheet, expected the report's parameter sheet")

@@ -100,7 +100,7 @@ def sheet_column(result, col):
     if col in cols:
         first, values = cols[col]
         for i, v in enumerate(values.tolist()):
-            out[first + i] = None if v != v else v
+            out[first + i] = None if math.isnan(v) else v
     if col == 8:
         out[n + 2], out[n + 3] = result.history.final_m1, result.history.final_m31
     if col == 27:
