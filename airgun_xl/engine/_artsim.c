@@ -9,10 +9,14 @@
  * -ffp-contract=off so that no multiply-add is fused.
  *
  * Python interface (module airgun_xl.engine._artsim):
- *   legacy_kernel(params, rows, t, y1, y31, y32, y33, crush, m31, defl, xp, force, m1)
- *     params: a sequence of 21 floats in the order of PARAM_NAMES below;
- *     the other arguments: writable, C-contiguous float64 buffers of length >= rows.
+ *   legacy_kernel(params, rows, t, y1, y31, y32, y33, crush, m31, defl, xp, force, m1, v1, v31)
+ *     params: a sequence of 21 floats in the order of the enum below;
+ *     the other arguments: writable, C-contiguous float64 buffers of length >= rows. The
+ *     tracked columns from crush on may be None: they are then neither computed nor stored.
  *     Returns (final M1, final m31). The GIL is released while stepping.
+ *   render_cells(column, first_row, values) -> list of str
+ *     '<c r="I5"><v>...</v></c>' for each value (finite float64), rows counted from
+ *     first_row (1-based), numbers with 17 significant digits (exact round trip).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -25,7 +29,7 @@ enum { P_M1, P_M31, P_M32, P_M33, P_K2, P_K3, P_DELTA, P_RHO, P_RCONE, P_HCONE, 
        P_MMIT, P_VCONE, P_E, P_EC, P_SIGMAY, P_ZETA, P_V1, P_V31, P_V32, P_V33, P_COUNT };
 
 typedef struct {
-    double *t, *y1, *y31, *y32, *y33, *crush, *m31, *defl, *xp, *force, *m1;
+    double *t, *y1, *y31, *y32, *y33, *crush, *m31, *defl, *xp, *force, *m1, *v1, *v31;
 } Columns;
 
 /* Strain-rate amplification of the crush force, Eq. (8), with the macro's coefficients. */
@@ -129,18 +133,23 @@ static void legacy_steps(const double *p, Py_ssize_t rows, Columns c, double *fi
         c.y32[k] = 2 * y32 - c.y32[k - 2] + springValue;
         springValue = ((delta * delta) / m33) * ((k3 * y33) - (k3 * y32) - (c3 * yPrime3));
         c.y33[k] = 2 * y33 - c.y33[k - 2] + springValue;
-        c.crush[k] = crushFactor;
-        c.m31[k] = m31;
-        c.defl[k] = mitigatordeflection;
-        c.xp[k] = xPlastic;
-        c.force[k] = Force;
-        c.m1[k] = M1;
+        /* Tracked values (not in the macro): NULL columns are skipped. */
+        if (c.crush) c.crush[k] = crushFactor;
+        if (c.m31) c.m31[k] = m31;
+        if (c.defl) c.defl[k] = mitigatordeflection;
+        if (c.xp) c.xp[k] = xPlastic;
+        if (c.force) c.force[k] = Force;
+        if (c.m1) c.m1[k] = M1;
+        /* central-difference velocities of MEM and OBR front plate, at the row before */
+        if (c.v1) c.v1[k - 1] = (c.y1[k] - c.y1[k - 2]) / (2 * delta);
+        if (c.v31) c.v31[k - 1] = (c.y31[k] - c.y31[k - 2]) / (2 * delta);
     }
     finals[0] = M1;
     finals[1] = m31;
 }
 
-#define N_COLUMNS 11
+#define N_COLUMNS 13
+#define N_REQUIRED 5
 
 static PyObject *py_legacy_kernel(PyObject *self, PyObject *args)
 {
@@ -152,9 +161,9 @@ static PyObject *py_legacy_kernel(PyObject *self, PyObject *args)
     int got = 0;
     Columns c;
 
-    if (!PyArg_ParseTuple(args, "OnOOOOOOOOOOO", &params, &rows, &objs[0], &objs[1], &objs[2],
-                          &objs[3], &objs[4], &objs[5], &objs[6], &objs[7], &objs[8], &objs[9],
-                          &objs[10]))
+    if (!PyArg_ParseTuple(args, "OnOOOOOOOOOOOOO", &params, &rows, &objs[0], &objs[1],
+                          &objs[2], &objs[3], &objs[4], &objs[5], &objs[6], &objs[7], &objs[8],
+                          &objs[9], &objs[10], &objs[11], &objs[12]))
         return NULL;
     seq = PySequence_Fast(params, "params must be a sequence of floats");
     if (seq == NULL)
@@ -174,6 +183,11 @@ static PyObject *py_legacy_kernel(PyObject *self, PyObject *args)
     if (rows < 0)
         return PyErr_Format(PyExc_ValueError, "rows must be >= 0");
     for (got = 0; got < N_COLUMNS; got++) {
+        if (got >= N_REQUIRED && objs[got] == Py_None) {
+            views[got].obj = NULL;
+            ptrs[got] = NULL;
+            continue;
+        }
         if (PyObject_GetBuffer(objs[got], &views[got], PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS
                                | PyBUF_FORMAT) < 0)
             goto fail;
@@ -187,23 +201,73 @@ static PyObject *py_legacy_kernel(PyObject *self, PyObject *args)
     }
     c.t = ptrs[0]; c.y1 = ptrs[1]; c.y31 = ptrs[2]; c.y32 = ptrs[3]; c.y33 = ptrs[4];
     c.crush = ptrs[5]; c.m31 = ptrs[6]; c.defl = ptrs[7]; c.xp = ptrs[8]; c.force = ptrs[9];
-    c.m1 = ptrs[10];
+    c.m1 = ptrs[10]; c.v1 = ptrs[11]; c.v31 = ptrs[12];
     Py_BEGIN_ALLOW_THREADS
     legacy_steps(p, rows, c, finals);
     Py_END_ALLOW_THREADS
     for (i = 0; i < N_COLUMNS; i++)
-        PyBuffer_Release(&views[i]);
+        if (views[i].obj != NULL)
+            PyBuffer_Release(&views[i]);
     return Py_BuildValue("dd", finals[0], finals[1]);
 fail:
     for (i = 0; i < got; i++)
-        PyBuffer_Release(&views[i]);
+        if (views[i].obj != NULL)
+            PyBuffer_Release(&views[i]);
     return NULL;
+}
+
+/* Sheet XML for a run of numeric cells: the writer's fast path (columns_sheet.py). */
+static PyObject *py_render_cells(PyObject *self, PyObject *args)
+{
+    const char *column;
+    Py_ssize_t first_row, n, i;
+    int len, j;
+    PyObject *values, *out;
+    Py_buffer view;
+    char buf[128];
+
+    if (!PyArg_ParseTuple(args, "snO", &column, &first_row, &values))
+        return NULL;
+    if (PyObject_GetBuffer(values, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0)
+        return NULL;
+    if (view.itemsize != sizeof(double) || view.format == NULL || strcmp(view.format, "d")) {
+        PyBuffer_Release(&view);
+        PyErr_SetString(PyExc_ValueError, "values must be a float64 buffer");
+        return NULL;
+    }
+    n = view.len / (Py_ssize_t)sizeof(double);
+    out = PyList_New(n);
+    for (i = 0; out != NULL && i < n; i++) {
+        double x = ((double *)view.buf)[i];
+        PyObject *cell;
+        if (!isfinite(x)) {
+            PyErr_SetString(PyExc_ValueError, "values must be finite");
+            Py_CLEAR(out);
+            break;
+        }
+        /* 17 significant digits always read back as the same double */
+        len = snprintf(buf, sizeof buf, "<c r=\"%s%zd\"><v>%.17g</v></c>", column,
+                       first_row + i, x);
+        for (j = 0; j < len; j++)
+            if (buf[j] == ',')
+                buf[j] = '.'; /* a caller's setlocale() must not change the XML */
+        cell = PyUnicode_FromString(buf);
+        if (cell == NULL) {
+            Py_CLEAR(out);
+            break;
+        }
+        PyList_SET_ITEM(out, i, cell);
+    }
+    PyBuffer_Release(&view);
+    return out;
 }
 
 static PyMethodDef methods[] = {
     {"legacy_kernel", py_legacy_kernel, METH_VARARGS,
-     "legacy_kernel(params, rows, t, y1, y31, y32, y33, crush, m31, defl, xp, force, m1)\n"
-     "Run ArtSim's position loop into the given float64 buffers; return (M1, m31)."},
+     "legacy_kernel(params, rows, t, y1, y31, y32, y33, crush, m31, defl, xp, force, m1, v1, "
+     "v31)\nRun ArtSim's position loop into the given float64 buffers; return (M1, m31)."},
+    {"render_cells", py_render_cells, METH_VARARGS,
+     "render_cells(column, first_row, values) -> list of '<c r=...><v>...</v></c>' strings"},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_artsim",

@@ -1,7 +1,8 @@
 """Integrators behind one small interface.
 
-An integrator is a function ``f(params) -> History`` that time-steps the shot and records the
-step values. ``legacy`` is the faithful port of ArtSim's central-difference loop; a robust scheme
+An integrator is a function ``f(params, track=TRACKED) -> History`` that time-steps the shot
+and records the displacements and, for the names in ``track``, the step values; the others are
+None, neither computed nor stored. ``legacy`` is the faithful port of ArtSim's central-difference loop; a robust scheme
 registers itself in :data:`INTEGRATORS` under its own name and is then selectable everywhere.
 """
 import time
@@ -28,16 +29,18 @@ class History:
         Time [s], from -delta, accumulated by repeated addition as the macro does.
     y1, y31, y32, y33 : numpy.ndarray
         Displacements of MEM, OBR front plate, OBR back plate, test item [m].
-    crush_factor : numpy.ndarray
+    crush_factor : numpy.ndarray or None
         Crush factor [-] (NaN where the macro writes nothing).
-    m31, m1 : numpy.ndarray
+    m31, m1 : numpy.ndarray or None
         The macro's m31 and M1 [kg] in each step.
-    deflection : numpy.ndarray
+    deflection : numpy.ndarray or None
         Mitigator deflection used in the step [m].
-    x_plastic : numpy.ndarray
+    x_plastic : numpy.ndarray or None
         Plastic wave front after its update [m].
-    force : numpy.ndarray
+    force : numpy.ndarray or None
         Mitigator force [N], after the clamp at 0.
+    v1, v31 : numpy.ndarray or None
+        MEM and OBR front plate velocities [m/s], central differences (NaN at both ends).
     final_m1, final_m31 : float
         The masses the macro writes below column I [kg].
     kernel_seconds : float
@@ -55,25 +58,34 @@ class History:
     x_plastic: np.ndarray
     force: np.ndarray
     m1: np.ndarray
+    v1: np.ndarray
+    v31: np.ndarray
     final_m1: float
     final_m31: float
     kernel_seconds: float
 
 
-def run_legacy(p):
+#: The step values an integrator can record, in :class:`History` order.
+TRACKED = ("crush_factor", "m31", "deflection", "x_plastic", "force", "m1", "v1", "v31")
+
+
+def run_legacy(p, track=TRACKED):
     """Time-step the shot with ArtSim's own scheme (the compiled port in ``_artsim.c``).
 
     Parameters
     ----------
     p : airgun_xl.params.ShotParams
         The checked parameters.
+    track : collection of str
+        Names from :data:`TRACKED` to record.
 
     Returns
     -------
     History
     """
     rows = p.rows
-    arrays = [np.zeros(rows) for _ in range(5)] + [np.full(rows, np.nan) for _ in range(6)]
+    arrays = [np.zeros(rows) for _ in range(5)] + [
+        np.full(rows, np.nan) if name in track else None for name in TRACKED]
     started = time.perf_counter()
     final_m1, final_m31 = legacy_kernel([getattr(p, name) for name in KERNEL_PARAMS], rows,
                                         *arrays)

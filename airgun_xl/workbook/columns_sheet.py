@@ -4,8 +4,9 @@ xlsxwriter stores every cell as an object and writes it through a generic per-ce
 15 us a cell here: 2 s for the 150,000 result cells of shot A at 0.5 us, which was most of a
 fill. :class:`ColumnsWorksheet` keeps numeric columns as arrays and renders them straight into
 the ``<row>`` elements when xlsxwriter writes the sheet; everything else (labels, formulas,
-sparse cells) still goes through xlsxwriter. Numbers are written with Python's shortest
-round-trip ``repr``, so every double reads back exactly.
+sparse cells) still goes through xlsxwriter. Numbers are rendered in C
+(``_artsim.render_cells``) with 17 significant digits, so every double reads back exactly
+(xlsxwriter itself keeps 16).
 
 It hooks ``Worksheet._write_rows``, an xlsxwriter internal; the legacy comparison tests read
 every output back, so a change there cannot pass unnoticed.
@@ -18,6 +19,8 @@ import numpy as np
 import xlsxwriter.workbook
 from xlsxwriter.utility import xl_col_to_name
 from xlsxwriter.worksheet import Worksheet
+
+from ..engine._artsim import render_cells
 
 #: Rows in a worksheet (Excel's limit; xlsxwriter refuses beyond it).
 SHEET_ROWS = 1_048_576
@@ -56,41 +59,50 @@ class ColumnsWorksheet(Worksheet):
             raise ValueError("write_number_column takes finite numbers only")
         self._check_dimensions(first_row, col)
         self._check_dimensions(last, col)
-        letter = xl_col_to_name(col)
-        self._bulk.append((col, first_row, [f'<c r="{letter}{r}"><v>{v!r}</v></c>' for r, v in
-                                            zip(range(first_row + 1, last + 2), values.tolist())]))
+        self._bulk.append((col, first_row, render_cells(xl_col_to_name(col), first_row + 1,
+                                                        np.ascontiguousarray(values))))
         return 0
+
+    def _bulk_rows(self):
+        """{row: (cols, joined XML)} of the bulk cells, joined row by row at C speed."""
+        runs = sorted(self._bulk, key=lambda run: run[0])
+        edges = sorted({first for _, first, _ in runs} | {first + len(c) for _, first, c in runs})
+        rows = {}
+        for lo, hi in zip(edges, edges[1:]):  # the set of covering runs is fixed in [lo, hi)
+            cover = [(col, cells[lo - first:hi - first]) for col, first, cells in runs
+                     if first <= lo and hi <= first + len(cells)]
+            if cover:
+                cols = [col for col, _ in cover]
+                for row, parts in enumerate(zip(*(cells for _, cells in cover)), start=lo):
+                    rows[row] = (cols, parts)
+        return rows
 
     def _write_rows(self):
         if not self._bulk:
             return super()._write_rows()
-        first_row = self.dim_rowmin
-        bulk_rows = [[] for _ in range(self.dim_rowmax - first_row + 1)]
-        bulk_cols = [[] for _ in bulk_rows]
-        for col, first, cells in sorted(self._bulk, key=lambda run: run[0]):
-            for i, cell in enumerate(cells, start=first - first_row):
-                bulk_rows[i].append(cell)
-                bulk_cols[i].append(col)
-        for row, (texts, cols) in enumerate(zip(bulk_rows, bulk_cols), start=first_row):
+        bulk = self._bulk_rows()
+        write = self.fh.write
+        for row in range(self.dim_rowmin, self.dim_rowmax + 1):
             table = self.table.get(row)  # .get: the defaultdict must not grow
-            if not texts and not table:
+            cols, parts = bulk.get(row, ((), ()))
+            if not parts and not table:
                 if row in self.row_info:
                     self._write_empty_row(row, None, self.row_info[row])
                 continue
             if row in self.row_info:
                 self._write_row(row, None, self.row_info[row])
             else:
-                self.fh.write(f'<row r="{row + 1}">')
+                write(f'<row r="{row + 1}">')
             if table:  # merge xlsxwriter's own cells in column order
-                by_col = dict(zip(cols, texts))
+                by_col = dict(zip(cols, parts))
                 for col in sorted(set(table) | set(cols)):
                     if col in table:
                         self._write_cell(row, col, table[col])
                     else:
-                        self.fh.write(by_col[col])
+                        write(by_col[col])
             else:
-                self.fh.write("".join(texts))
-            self.fh.write("</row>")
+                write("".join(parts))
+            write("</row>")
 
 
 class _FastZipFile(zipfile.ZipFile):
