@@ -28,18 +28,21 @@ class Cell:
     meaning: str
     check: str
     limit: float
+    alternative: str = ""  # a second accepted form, for the reduced models
 
 
 #: The parameter cells, in the order the macro reads them (ArtSim.bas, head of the Sub).
 CELLS = (
     Cell("A2", "m1", "M1", "kg", "MEM mass, without the mitigator", "positive", 1e9),
     Cell("B2", "m31", "M31", "kg", "OBR front plate mass", "positive", 1e9),
-    Cell("C2", "m32", "M32", "kg", "OBR back plate mass", "positive", 1e9),
-    Cell("D2", "m33", "M33", "kg", "test item mass", "positive", 1e9),
+    Cell("C2", "m32", "M32", "kg", "OBR back plate mass", "positive", 1e9,
+         "blank or 0 with B6, C6 blank and D2 blank or 0, for an OBR of one mass"),
+    Cell("D2", "m33", "M33", "kg", "test item mass", "positive", 1e9,
+         "blank or 0 with C6 blank, for a scene without a test item"),
     Cell("B6", "k2", "K2", "N/m", "spring between m31 and m32, negative by the sheet's convention",
-         "negative", 1e16),
+         "negative", 1e16, "blank with C2, C6 and D2 blank, for an OBR of one mass"),
     Cell("C6", "k3", "K3", "N/m", "spring between m32 and m33, negative by the sheet's convention",
-         "negative", 1e16),
+         "negative", 1e16, "blank with D2 blank or 0, for a scene without a test item"),
     Cell("E2", "delta", "Timestep", "s", "time step", "positive", 1.0),
     Cell("E6", "max_time", "Max Time", "s", "simulated duration", "positive", 1e3),
     Cell("E10", "rho", "Density of Honeycomb", "kg/m^3", "honeycomb density", "positive", 1e5),
@@ -95,6 +98,6 @@ def expectation(cell):
         "fraction": "a number greater than 0 and at most 1",
         "any": f"a number{of}",
     }[cell.check]
-    if cell.check == "fraction":
-        return base
-    return f"{base}, at most {cell.limit:g} in magnitude"
+    if cell.check != "fraction":
+        base = f"{base}, at most {cell.limit:g} in magnitude"
+    return f"{base}; or {cell.alternative}" if cell.alternative else base

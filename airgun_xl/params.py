@@ -69,6 +69,24 @@ def check_value(cell, raw):
     return value
 
 
+def _absent(value):
+    return value is None or (isinstance(value, str) and not value.strip()) or (
+        isinstance(value, (int, float)) and not isinstance(value, bool) and value == 0)
+
+
+def _blank(value):
+    return value is None or (isinstance(value, str) and not value.strip())
+
+
+def bird_masses(raw):
+    """The bird model a sheet's raw cells describe: 3, 2 or 1 masses (see ShotParams)."""
+    if _absent(raw.get("D2")) and _blank(raw.get("C6")):
+        if _absent(raw.get("C2")) and _blank(raw.get("B6")):
+            return 1
+        return 2
+    return 3
+
+
 @dataclass(frozen=True)
 class ShotParams:
     """The inputs of one shot, as ArtSim reads them.
@@ -144,7 +162,16 @@ class ShotParams:
         CellError
             On the first cell (in the macro's reading order) that fails its check.
         """
-        values = {c.name: check_value(c, raw_by_address.get(c.address)) for c in CELLS}
+        raw = dict(raw_by_address)
+        masses = bird_masses(raw)
+        reduced = {3: (), 2: ("D2", "C6"), 1: ("C2", "D2", "B6", "C6")}[masses]
+        for address in reduced:
+            raw[address] = 0.0  # the model leaves these masses and springs out
+        for mass, velocity, previous in (("C2", "A29", "A28"), ("D2", "A30", "A29")):
+            if mass in reduced and raw.get(velocity) is None:
+                raw[velocity] = raw.get(previous)  # a left-out mass moves with its neighbour
+        values = {c.name: 0.0 if c.address in reduced else check_value(c, raw.get(c.address))
+                  for c in CELLS}
         return cls(**values).check()
 
     def check(self):
@@ -155,8 +182,10 @@ class ShotParams:
         CellError
             Naming the cell at fault.
         """
+        left_out = {3: (), 2: ("m33", "k3"), 1: ("m32", "m33", "k2", "k3")}[self.bird_masses]
         for f in fields(self):
-            check_value(BY_NAME[f.name], getattr(self, f.name))
+            if f.name not in left_out:
+                check_value(BY_NAME[f.name], getattr(self, f.name))
         if self.delta > self.max_time:
             c = BY_NAME["delta"]
             raise CellError(c.address, c.label, repr(self.delta),
@@ -167,6 +196,23 @@ class ShotParams:
             raise CellError(c.address, c.label, f"{self.max_time!r} s, {steps:.3g} steps of E2",
                             f"at most {MAX_STEPS:,} steps (E6/E2)")
         return self
+
+    @property
+    def bird_masses(self):
+        """Masses in the bird's chain: 3 (ArtSim), 2 (no test item) or 1 (OBR as one mass).
+
+        A left-out mass and its spring are 0; any other zero is caught by :meth:`check`.
+        """
+        if self.m33 == 0 and self.k3 == 0:
+            return 1 if (self.m32 == 0 and self.k2 == 0) else 2
+        return 3
+
+    @property
+    def model(self):
+        """Which model runs, in words."""
+        return {3: "4-mass (ArtSim: MEM, OBR front plate, OBR back plate, test item)",
+                2: "3-mass (no test item: MEM, OBR front plate, OBR back plate)",
+                1: "2-mass (OBR as one mass: MEM, OBR)"}[self.bird_masses]
 
     @property
     def rows(self):

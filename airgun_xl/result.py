@@ -6,7 +6,8 @@ import numpy as np
 #: DataFrame column -> unit, in the order of :meth:`Result.to_frame`.
 FRAME_UNITS = {
     "y1": "m", "y31": "m", "y32": "m", "y33": "m", "crush_factor": "-", "m31": "kg",
-    "deflection": "m", "x_plastic": "m", "force": "N", "m1": "kg", "accel": "m/s^2",
+    "deflection": "m", "x_plastic": "m", "force": "N", "m1": "kg", "v1": "m/s",
+    "v31": "m/s", "accel": "m/s^2",
     "velocity": "m/s", "accel_kg": "kG", "filtered_accel": "m/s^2",
 }
 
@@ -26,6 +27,8 @@ class Result:
     filtered : airgun_xl.engine.filtered.Filtered
         The filtered samples (column AB).
     warnings : list of str
+    run_seconds : float
+        Wall time of :meth:`Shot.run`: stepping and the derived columns [s].
     """
 
     shot: object
@@ -36,6 +39,7 @@ class Result:
     accel_kg: np.ndarray
     filtered: object
     warnings: list
+    run_seconds: float = float("nan")
 
     @property
     def params(self):
@@ -66,29 +70,34 @@ class Result:
             return np.nan
         return float(self.history.time[int(np.nanargmax(self.accel_kg))])
 
+    def frame_columns(self):
+        """Per-row arrays by :data:`FRAME_UNITS` name (None for series not tracked)."""
+        h = self.history
+        return {
+            "y1": h.y1, "y31": h.y31, "y32": h.y32, "y33": h.y33,
+            "crush_factor": h.crush_factor, "m31": h.m31, "deflection": h.deflection,
+            "x_plastic": h.x_plastic, "force": h.force, "m1": h.m1, "v1": h.v1, "v31": h.v31,
+            "accel": self.accel, "velocity": self.velocity, "accel_kg": self.accel_kg,
+            "filtered_accel": self.filtered_column,
+        }
+
     def to_frame(self):
         """All per-row values as a pandas DataFrame indexed by time [s].
 
-        Columns are those of :data:`FRAME_UNITS`; ``frame.attrs["units"]`` maps each to its
-        unit. Cells the macro leaves empty are NaN.
+        Columns are those of :data:`FRAME_UNITS` (``v1``, ``v31``: MEM and OBR front plate
+        velocities); ``frame.attrs["units"]`` maps each to its unit. Cells the macro leaves
+        empty are NaN; series a run did not track are left out.
         """
         import pandas as pd
 
-        h = self.history
-        data = {
-            "y1": h.y1, "y31": h.y31, "y32": h.y32, "y33": h.y33,
-            "crush_factor": h.crush_factor, "m31": h.m31, "deflection": h.deflection,
-            "x_plastic": h.x_plastic, "force": h.force, "m1": h.m1, "accel": self.accel,
-            "velocity": self.velocity, "accel_kg": self.accel_kg,
-            "filtered_accel": self.filtered_column,
-        }
-        frame = pd.DataFrame(data, index=pd.Index(h.time, name="time"))
+        data = {k: v for k, v in self.frame_columns().items() if v is not None}
+        frame = pd.DataFrame(data, index=pd.Index(self.history.time, name="time"))
         frame.attrs["units"] = dict(FRAME_UNITS, time="s")
         frame.attrs["integrator"] = self.integrator
         return frame
 
-    def write(self, path, force=False):
-        """Write the legacy workbook (see :func:`airgun_xl.workbook.writer.write_workbook`)."""
+    def write(self, path, force=False, **options):
+        """Write the workbook (see :func:`airgun_xl.workbook.writer.write_workbook`)."""
         from .workbook.writer import write_workbook
 
-        return write_workbook(self, path, force=force)
+        return write_workbook(self, path, force=force, **options)

@@ -1,9 +1,16 @@
 """The hub objects: a :class:`Shot` (parameters and where they came from) runs into a
 :class:`airgun_xl.result.Result`, which the writers turn into files."""
+import time
 from dataclasses import dataclass, field
 
 from .engine import filtered_acceleration, get_integrator, test_item_derivatives
+from .engine.integrators import TRACKED
 from .params import ShotParams
+
+
+def last_mass(history, p):
+    """Displacement of the bird's last mass: Y33, or Y32 / Y31 for a reduced model."""
+    return (history.y31, history.y32, history.y33)[p.bird_masses - 1]
 
 
 @dataclass
@@ -42,7 +49,7 @@ class Shot:
         """The same shot with some parameters changed (checked again)."""
         return Shot(self.params.replace(**changes), self.source, list(self.warnings))
 
-    def run(self, integrator="legacy", host="excel"):
+    def run(self, integrator="legacy", host="excel", track=TRACKED):
         """Time-step the shot and derive the macro's columns.
 
         Parameters
@@ -52,6 +59,9 @@ class Shot:
         host : {"excel", "calc"}
             Whose Offset rounding the filtered column reproduces when ``1/(E2*E34)`` is not a
             whole number.
+        track : collection of str
+            Step values to record (:data:`airgun_xl.engine.integrators.TRACKED`); the others
+            are None in the result.
 
         Returns
         -------
@@ -60,8 +70,11 @@ class Shot:
         from .result import Result
 
         p = self.params
-        history = get_integrator(integrator)(p)
-        accel, vel, kg = test_item_derivatives(history.y33, p.delta)
-        filtered = filtered_acceleration(history.y33, p.delta, p.samplerate, host)
+        started = time.perf_counter()
+        history = get_integrator(integrator)(p, track)
+        last = last_mass(history, p)  # the test item, or the last mass of a reduced model
+        accel, vel, kg = test_item_derivatives(last, p.delta)
+        filtered = filtered_acceleration(last, p.delta, p.samplerate, host)
         return Result(self, integrator, history, accel, vel, kg, filtered,
-                      list(self.warnings) + filtered.warnings)
+                      list(self.warnings) + filtered.warnings,
+                      time.perf_counter() - started)

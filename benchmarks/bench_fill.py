@@ -4,12 +4,15 @@
 
 Reports medians over N runs (after one warm-up run) and the machine they came from:
 - kernel throughput on shot A at dt = 5 ns (1.2M steps), the C loop alone;
-- `airgun-xl fill templates/shot_a.xlsx` end to end at dt = 0.5 us, as a fresh process;
-- where the time of a fill goes: imports, reading, kernel, derived columns, writing.
+- `airgun-xl fill templates/shot_a.xlsx` as a fresh process: the full default output (legacy
+  columns, Summary, Charts, Tracked, Spectrum), and a summary-only run for comparison;
+- the same fill at dt = 5 ns (1.2M steps): wall time and peak RSS (/usr/bin/time -v);
+- where the time of a full fill goes: imports, reading, kernel, derived, summary, writing.
 """
 import argparse
 import os
 import platform
+import re
 import statistics
 import subprocess
 import sys
@@ -33,6 +36,21 @@ def machine():
     return f"{platform.node()}: {cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
 
 
+def fill_cmd(shot, out, *flags):
+    return [sys.executable, "-m", "airgun_xl", "fill", str(shot), "-o", str(out), "--force",
+            *flags]
+
+
+def timed(cmd, repeat):
+    subprocess.run(cmd, check=True, capture_output=True)  # warm-up (OS file cache)
+    times = []
+    for _ in range(repeat):
+        started = time.perf_counter()
+        subprocess.run(cmd, check=True, capture_output=True)
+        times.append(time.perf_counter() - started)
+    return statistics.median(times), min(times)
+
+
 def bench_kernel(repeat):
     import airgun_xl
     from airgun_xl.engine.integrators import run_legacy
@@ -46,64 +64,77 @@ def bench_kernel(repeat):
              f"{steps / med:.3g} steps/s")]
 
 
-def bench_fill_process(repeat):
-    with tempfile.TemporaryDirectory() as tmp:
-        out = Path(tmp) / "o.xlsx"
-        cmd = [sys.executable, "-m", "airgun_xl", "fill", str(TEMPLATE), "-o", str(out),
-               "--force"]
-        subprocess.run(cmd, check=True, capture_output=True)  # warm-up (OS file cache)
-        times = []
-        for _ in range(repeat):
-            started = time.perf_counter()
-            subprocess.run(cmd, check=True, capture_output=True)
-            times.append(time.perf_counter() - started)
-    return [("airgun-xl fill shot A at 0.5 us (process)", "12,002 rows",
-             f"{statistics.median(times):.3f} s", f"min {min(times):.3f} s")]
+def bench_fills(repeat, tmp):
+    out = tmp / "o.xlsx"
+    full, full_min = timed(fill_cmd(TEMPLATE, out), repeat)
+    only, only_min = timed(fill_cmd(TEMPLATE, out, "--only", "summary"), repeat)
+    return [("fill shot A 0.5 us, full output (process)", "12,002 rows", f"{full:.3f} s",
+             f"min {full_min:.3f} s"),
+            ("fill shot A 0.5 us, --only summary", "12,002 rows", f"{only:.3f} s",
+             f"{full / only:.1f}x faster than full")]
+
+
+def bench_long(repeat, tmp):
+    import openpyxl
+
+    shot = tmp / "shot_5ns.xlsx"
+    wb = openpyxl.load_workbook(TEMPLATE)
+    wb["Sheet1"]["E2"] = 5e-9
+    wb.save(shot)
+    cmd = ["/usr/bin/time", "-v", *fill_cmd(shot, tmp / "o5.xlsx")]
+    walls, rss = [], []
+    subprocess.run(cmd, check=True, capture_output=True)
+    for _ in range(max(3, repeat // 2)):
+        started = time.perf_counter()
+        done = subprocess.run(cmd, check=True, capture_output=True, text=True)
+        walls.append(time.perf_counter() - started)
+        rss.append(int(re.search(r"Maximum resident set size \(kbytes\): (\d+)",
+                                 done.stderr).group(1)) / 1024)
+    return [("fill shot A 5 ns (1.2M steps, sheet 1 in 19 + sidecar)", "1,200,002 rows",
+             f"{statistics.median(walls):.3f} s", f"peak RSS {max(rss):.0f} MB")]
 
 
 STAGES = """
 import time, sys
 t0 = time.perf_counter()
 import airgun_xl
-from airgun_xl.engine import filtered_acceleration, get_integrator, test_item_derivatives
+from airgun_xl.engine.summary import summarize
 t1 = time.perf_counter()
 shot = airgun_xl.load(sys.argv[1])
 t2 = time.perf_counter()
-history = get_integrator("legacy")(shot.params)
-t3 = time.perf_counter()
 result = shot.run()
+t3 = time.perf_counter()
+summary = summarize(result)
 t4 = time.perf_counter()
-result.write(sys.argv[2], force=True)
+result.write(sys.argv[2], force=True, summary=summary)
 t5 = time.perf_counter()
-derived = (t4 - t3) - history.kernel_seconds
-print(t1 - t0, t2 - t1, history.kernel_seconds, derived, t5 - t4)
+kernel = result.history.kernel_seconds
+print(t1 - t0, t2 - t1, kernel, (t3 - t2) - kernel, t4 - t3, t5 - t4)
 """
 
 
-def bench_stages(repeat):
-    rows = []
-    with tempfile.TemporaryDirectory() as tmp:
-        out = str(Path(tmp) / "o.xlsx")
-        cmd = [sys.executable, "-c", STAGES, str(TEMPLATE), out]
-        subprocess.run(cmd, check=True, capture_output=True)
-        samples = [list(map(float, subprocess.run(cmd, check=True, capture_output=True,
-                                                   text=True).stdout.split()))
-                   for _ in range(repeat)]
+def bench_stages(repeat, tmp):
+    cmd = [sys.executable, "-c", STAGES, str(TEMPLATE), str(tmp / "s.xlsx")]
+    subprocess.run(cmd, check=True, capture_output=True)
+    samples = [list(map(float, subprocess.run(cmd, check=True, capture_output=True,
+                                               text=True).stdout.split()))
+               for _ in range(repeat)]
     names = ["imports (numpy, package)", "reading (openpyxl, formulas)", "kernel",
-             "derived + filtered columns", "writing (xlsxwriter)"]
+             "derived + filtered columns", "summary + spectrum", "writing (all sheets)"]
     medians = [statistics.median(s[i] for s in samples) for i in range(len(names))]
     total = sum(medians)
-    for name, med in zip(names, medians):
-        rows.append((f"  stage: {name}", "", f"{med * 1e3:.1f} ms", f"{med / total:.0%}"))
-    return rows
+    return [(f"  stage: {name}", "", f"{med * 1e3:.1f} ms", f"{med / total:.0%}")
+            for name, med in zip(names, medians)]
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7)
     args = parser.parse_args()
-    rows = bench_kernel(args.repeat) + bench_fill_process(args.repeat) + \
-        bench_stages(args.repeat)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        rows = bench_kernel(args.repeat) + bench_fills(args.repeat, tmp) + \
+            bench_long(args.repeat, tmp) + bench_stages(args.repeat, tmp)
     print(f"machine: {machine()}")
     print(f"medians of {args.repeat} runs after a warm-up\n")
     widths = [max(len(r[i]) for r in rows) for i in range(4)]

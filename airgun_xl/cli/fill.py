@@ -1,16 +1,24 @@
-"""``airgun-xl fill SHOT.xlsx [-o OUT.xlsx] [--force]``: run a shot into a new workbook."""
+"""``airgun-xl fill SHOT.xlsx [-o OUT.xlsx] [--force] [...]``: run a shot into a new workbook."""
+import sys
+import time
 from pathlib import Path
 
+from .. import __version__
 from ..engine.filtered import HOSTS
+from ..engine.summary import PULSE_FRACTION, summarize
+from ..outputs import GROUPS, SIDECAR_MODES, from_sheet
 from ..shot import Shot
 from ..workbook.atomic import check_output
+from ..workbook.sidecar import sidecar_path, write_history
 
 
 def add_parser(sub):
     p = sub.add_parser("fill", help="run the shot in a workbook and write a new filled workbook",
                        description="Read the report's parameter cells from SHOT, run ArtSim, and "
-                                   "write the macro's result columns into a new workbook. SHOT "
-                                   "itself is never modified.")
+                                   "write the macro's result columns, a summary and charts into "
+                                   "a new workbook. SHOT itself is never modified. The "
+                                   "workbook's Outputs sheet, if any, picks the outputs; the "
+                                   "flags below override it.")
     p.add_argument("shot", metavar="SHOT.xlsx", help="workbook in the report's layout")
     p.add_argument("-o", "--output", metavar="OUT.xlsx",
                    help="output workbook (default: SHOT.out.xlsx beside SHOT)")
@@ -18,6 +26,17 @@ def add_parser(sub):
     p.add_argument("--host", choices=HOSTS, default="excel",
                    help="whose Offset rounding the filtered column reproduces when 1/(E2*E34) "
                         "is fractional (default: excel)")
+    p.add_argument("--only", metavar="GROUPS",
+                   help=f"write only these comma-separated outputs: {', '.join(GROUPS)}")
+    p.add_argument("--no-charts", action="store_true", help="leave out the Charts sheet")
+    p.add_argument("--every", metavar="N", help="write every N-th time row to the sheets")
+    p.add_argument("--max-sheet-rows", metavar="N",
+                   help="most time rows on a sheet before every N-th row is written")
+    p.add_argument("--sidecar", choices=SIDECAR_MODES,
+                   help="full time history beside the output: auto (when rows are left out), "
+                        "always or never")
+    p.add_argument("--reproducible", action="store_true",
+                   help="leave run times out of the Summary, so equal inputs give equal bytes")
     p.set_defaults(run=run)
 
 
@@ -26,16 +45,55 @@ def default_output(shot_path):
     return shot_path.with_name(shot_path.stem + ".out.xlsx")
 
 
+def _ms(seconds):
+    return f"{seconds * 1e3:.4f} ms"
+
+
+def print_summary(output, result, summary, stride, sidecar):
+    s = summary
+    lines = [f"wrote {output}: {result.rows:,} rows"
+             + (f", 1 in {stride} on the sheets" if stride > 1 else "")
+             + f"; {result.params.model.split(' (')[0]} model, {result.integrator} integrator"]
+    if s is not None:
+        lines.append(f"  peak {s.peak_kg:.5f} kG at {_ms(s.time_of_peak)}; filtered "
+                     f"{s.filtered_peak_kg:.5f} kG at {_ms(s.time_of_filtered_peak)}")
+        lines.append(f"  pulse {_ms(s.pulse_duration)} (>= {PULSE_FRACTION:.0%} of peak), "
+                     f"max crush {s.max_crush:.4f} m, final length {s.final_length:.4f} m")
+        if s.spectrum.peaks:
+            lines.append("  dominant frequencies "
+                         + ", ".join(f"{f / 1e3:.2f}" for f in s.spectrum.peaks) + " kHz")
+    else:
+        lines.append(f"  peak {result.peak_kg:.5f} kG at {_ms(result.time_of_peak)}")
+    if sidecar is not None:
+        lines.append(f"  full history in {sidecar}")
+    print("\n".join(lines))
+
+
 def run(args):
     from . import warn
 
+    started = time.perf_counter()
     output = Path(args.output) if args.output else default_output(args.shot)
     shot = Shot.from_workbook(args.shot)
+    outputs = from_sheet(shot.source.outputs_block).with_flags(
+        args.only, args.no_charts, args.every, args.max_sheet_rows, args.sidecar)
+    rows = shot.params.rows
+    sidecar = sidecar_path(output) if outputs.writes_sidecar(rows) else None
     check_output(output, args.force, inputs=[args.shot])  # before the run, not after
+    if sidecar is not None:
+        check_output(sidecar, args.force, inputs=[args.shot])
     warn(shot.warnings)
-    result = shot.run(host=args.host)
+    result = shot.run(host=args.host, track=outputs.tracked_series(sidecar is not None))
     warn(result.warnings[len(shot.warnings):])
-    warn(result.write(output, force=args.force))
-    print(f"wrote {output}: {result.rows:,} rows, peak {result.peak_kg:.5f} kG at "
-          f"{result.time_of_peak * 1e3:.4f} ms")
+    needs_summary = outputs.groups & {"summary", "spectrum", "charts"}
+    summary = summarize(result) if needs_summary else None
+    info = {"version": __version__, "input": str(args.shot), "sha256": shot.source.sha256,
+            "command": " ".join(["airgun-xl", *sys.argv[1:]])}
+    if not args.reproducible:
+        info.update(kernel_seconds=result.history.kernel_seconds,
+                    run_seconds=time.perf_counter() - started)
+    warn(result.write(output, force=args.force, outputs=outputs, summary=summary, info=info))
+    if sidecar is not None:
+        write_history(result, sidecar)
+    print_summary(output, result, summary, outputs.stride(rows), sidecar)
     return 0

@@ -51,6 +51,11 @@ class Source:
     block: dict
     other_sheets: dict = field(default_factory=dict)
 
+    @property
+    def outputs_block(self):
+        """Cells of the workbook's Outputs sheet, if it has one."""
+        return self.other_sheets.get("OUTPUTS", {})
+
     def view(self, extra_columns=None):
         """A :class:`SheetView` over the parameter sheet and the other sheets."""
         sheets = dict(self.other_sheets)

@@ -9,9 +9,14 @@ column I, so they are left out here: finding them needs lookup functions (INDEX,
 evaluating any spreadsheet function makes ``formulas`` import scipy, which costs more than a
 whole run of shot A. Only operator formulas are used.
 
+A second sheet, Outputs, holds the output selection with its defaults
+(:mod:`airgun_xl.outputs`).
+
 Every formula is written with its evaluated value cached, because LibreOffice shows (and the
 legacy macro reads) cached values of .xlsx files without recalculating them.
 """
+from ..outputs import SHEET_NAME as OUTPUTS_SHEET
+from ..outputs import block_cells
 from .atomic import atomic_path, check_output
 from .formula_eval import Evaluator, SheetView
 from .writer import new_workbook
@@ -103,4 +108,27 @@ def write_template(path, force=False):
                 ws.write_string(address, content)
             else:
                 ws.write_number(address, content)
+        write_outputs_sheet(wb)
         wb.close()
+
+
+def write_outputs_sheet(wb):
+    """The Outputs block with its defaults: output, write?, what it is."""
+    ws = wb.add_worksheet(OUTPUTS_SHEET)
+    ws.set_column(0, 0, 16)
+    ws.set_column(1, 1, 10)
+    ws.set_column(2, 2, 90)
+    bold = wb.add_format({"bold": True})
+    for col, text in enumerate(("Output", "Write", "What")):
+        ws.write_string(0, col, text, bold)
+    for row, (label, value, what) in enumerate(block_cells(), start=1):
+        ws.write_string(row, 0, label)
+        if isinstance(value, bool):
+            ws.write_boolean(row, 1, value)
+        elif isinstance(value, int):
+            ws.write_number(row, 1, value)
+        else:
+            ws.write_string(row, 1, value)
+        ws.write_string(row, 2, what)
+    ws.write_string(len(block_cells()) + 2, 0, "airgun-xl fill reads this block; its flags "
+                    "--only, --no-charts, --every, --max-sheet-rows and --sidecar override it.")

@@ -17,6 +17,10 @@ AA      Time                        header only, as the macro
 AB      Filtered Acceleration       the sample rows
 I       final M1, final m31         rows+3 and rows+4
 ======  ==========================  =====================================================
+
+Then, as :class:`airgun_xl.outputs.Outputs` selects: Summary, Charts, Tracked, Spectrum,
+ChartData, and the input's Outputs block. A run longer than the sheets may hold writes every
+N-th row (N in the Summary) and, by default, its full history to a sidecar file.
 """
 import datetime
 import math
@@ -25,10 +29,20 @@ import numpy as np
 from xlsxwriter.utility import xl_rowcol_to_cell
 
 from ..cells import PARAMETER_COLUMNS
-from ..errors import OutputError
+from ..charts import add_charts, series_data
+from ..engine.summary import summarize
+from ..outputs import SHEET_NAME, Outputs
 from .atomic import atomic_path, check_output
-from .columns_sheet import SHEET_ROWS, ColumnsWorksheet, fast_deflate
+from .columns_sheet import ColumnsWorksheet, fast_deflate
 from .formula_eval import Evaluator, FormulaFailure
+from .sheets import (
+    Ref,
+    write_chart_data,
+    write_number_columns,
+    write_spectrum,
+    write_summary,
+    write_tracked,
+)
 
 #: Fixed document properties, so the same run gives the same bytes.
 PROPERTIES = {
@@ -58,65 +72,69 @@ def new_workbook(path):
     return wb
 
 
-def result_columns(result):
-    """0-based column index -> (first 0-based row, values) of the result columns."""
-    h = result.history
-    return {
-        7: (1, h.time), 8: (1, h.y1), 9: (1, h.y31), 10: (1, h.y32), 11: (1, h.y33),
-        12: (3, h.crush_factor[2:]), 13: (3, h.m31[2:]), 14: (3, h.deflection[2:]),
-        15: (3, h.x_plastic[2:]), 18: (2, result.accel[1:-1]), 19: (2, result.velocity[1:-1]),
-        20: (2, result.accel_kg[1:-1]),
-    }
+#: Sheet 1 result columns (0-based) -> (output group, History/Result attribute).
+SHEET1_COLUMNS = {
+    7: ("positions", "time"), 8: ("positions", "y1"), 9: ("positions", "y31"),
+    10: ("positions", "y32"), 11: ("positions", "y33"), 12: ("crush", "crush_factor"),
+    13: ("crush", "m31"), 14: ("crush", "deflection"), 15: ("crush", "x_plastic"),
+    18: ("accel", "accel"), 19: ("accel", "velocity"), 20: ("accel", "accel_kg"),
+}
+HEADER_GROUPS = {17: "accel", 26: "filtered", 27: "filtered"}
+
+
+def _values(result, name):
+    source = result if name in ("accel", "velocity", "accel_kg") else result.history
+    return getattr(source, name)
+
+
+def _sheet1_columns(result, outputs, keep):
+    """Column -> array over the kept rows; NaN for cells the macro leaves empty."""
+    cols = {col: _values(result, name)[keep] for col, (group, name) in SHEET1_COLUMNS.items()
+            if group in outputs and _values(result, name) is not None}
+    if cols and 7 not in cols:
+        cols[7] = result.history.time[keep]  # time goes with any sheet 1 group
+    return cols
+
+
+def _filtered_cells(result, stride):
+    """(sheet row, value) of the filtered samples that fall on written rows."""
+    return [(r // stride + 1, v) for r, v in zip(result.filtered.rows.tolist(),
+                                                  result.filtered.values.tolist())
+            if r % stride == 0]
 
 
 class _LazyColumns(dict):
-    """Result columns for the formula evaluator, built only when a formula reaches them."""
+    """Result columns for the formula evaluator, built only when a formula reaches them.
 
-    def __init__(self, result, sheet):
+    A column is a list of values for sheet rows 1.. (None for empty), header first.
+    """
+
+    def __init__(self, columns, sheet, finals):
         super().__init__()
-        self.result, self.sheet = result, sheet
+        self.columns, self.sheet, self.finals = columns, sheet, finals
 
     def get(self, key, default=None):
         if key in self:
             return self[key]
         sheet, col = key
-        if sheet != self.sheet or col <= PARAMETER_COLUMNS:
+        if sheet != self.sheet or col - 1 not in self.columns:
             return default
-        values = sheet_column(self.result, col - 1)
-        self[key] = values
-        return values
+        cells = [HEADERS.get(col - 1)] + [None if math.isnan(v) else v
+                                          for v in self.columns[col - 1].tolist()]
+        if col - 1 == 8 and self.finals is not None:
+            cells += [None, *self.finals]
+        self[key] = cells
+        return cells
 
     def items(self):  # sizes are not known up front; the view asks per column
         return ()
 
 
-def sheet_column(result, col):
-    """Values of 0-based column ``col`` for sheet rows 1.. as a list (None for empty)."""
-    n = result.rows
-    out = [None] * (n + 4)
-    if col in HEADERS:
-        out[0] = HEADERS[col]
-    cols = result_columns(result)
-    if col in cols:
-        first, values = cols[col]
-        for i, v in enumerate(values.tolist()):
-            out[first + i] = None if math.isnan(v) else v
-    if col == 8:
-        out[n + 2], out[n + 3] = result.history.final_m1, result.history.final_m31
-    if col == 27:
-        for r, v in zip(result.filtered.rows.tolist(), result.filtered.values.tolist()):
-            while len(out) <= r + 1:
-                out.append(None)
-            out[r + 1] = v
-    return out
-
-
-def _block_values(result):
+def _block_values(source, columns, rows, finals):
     """Cached values for the parameter block's formulas, evaluated against this run."""
-    source = result.shot.source
     sheet = source.sheet_title.upper()
-    view = source.view(extra_columns=_LazyColumns(result, sheet))
-    view.max_row[sheet] = max(view.max_row[sheet], result.rows + 4)
+    view = source.view(extra_columns=_LazyColumns(columns, sheet, finals))
+    view.max_row[sheet] = max(view.max_row[sheet], rows + 4)
     view.max_col[sheet] = max(view.max_col[sheet], 28)
     evaluator = Evaluator(view)
     values, warnings = {}, []
@@ -127,25 +145,21 @@ def _block_values(result):
             values[(row, col)] = evaluator.value(sheet, row, col)
         except FormulaFailure as exc:
             values[(row, col)] = cached
-            warnings.append(f"{_a1(row, col)}: {exc}; kept the input's cached value")
+            warnings.append(f"{xl_rowcol_to_cell(row - 1, col - 1)}: {exc}; kept the input's "
+                            "cached value")
     return values, warnings
 
 
-def _a1(row, col):
-    return xl_rowcol_to_cell(row - 1, col - 1)
+def write_cells(ws, cells, values=None):
+    """Copy ``{(row, col): (value, formula)}`` cells (1-based) as they were.
 
-
-def _write_block(ws, result):
-    source = result.shot.source
-    if source is None:
-        return []
-    values, warnings = _block_values(result)
-    for (row, col), (cached, formula) in sorted(source.block.items()):
-        if col > PARAMETER_COLUMNS:
-            continue
+    Formulas stay formulas, cached with ``values[(row, col)]``; numbers are written exactly.
+    """
+    values = values or {}
+    for (row, col), (cached, formula) in sorted(cells.items()):
         r, c = row - 1, col - 1
         if formula is not None:
-            value = values.get((row, col))
+            value = values.get((row, col), cached)
             ws.write_formula(r, c, formula, None, "" if value is None else value)
         elif isinstance(cached, bool):
             ws.write_boolean(r, c, cached)
@@ -157,31 +171,42 @@ def _write_block(ws, result):
             ws.write(r, c, str(cached))
         else:
             ws.write_string(r, c, str(cached))
-    return warnings
 
 
-def finite_runs(values):
-    """``(start, stop)`` index pairs of the runs of finite values in ``values``."""
-    finite = np.concatenate(([False], np.isfinite(values), [False]))
-    edges = np.flatnonzero(np.diff(finite.astype(np.int8)))
-    return list(zip(edges[0::2].tolist(), edges[1::2].tolist()))
+def _write_sheet1(wb, result, outputs, keep, stride):
+    """Sheet 1: the parameter block and the macro's columns; returns (refs, warnings)."""
+    source = result.shot.source
+    ws = wb.add_worksheet(source.sheet_title if source is not None else "Sheet1",
+                          worksheet_class=ColumnsWorksheet)
+    columns = _sheet1_columns(result, outputs, keep)
+    rows = len(keep)
+    finals = None
+    if "positions" in outputs:
+        finals = (result.history.final_m1, result.history.final_m31)
+    warnings = []
+    if source is not None:
+        block = {k: v for k, v in source.block.items() if k[1] <= PARAMETER_COLUMNS}
+        values, warnings = _block_values(source, columns, rows, finals)
+        write_cells(ws, block, values)
+    for col in sorted(set(columns) | {c for c, g in HEADER_GROUPS.items() if g in outputs}):
+        ws.write_string(0, col, HEADERS[col])
+    write_number_columns(ws, 1, columns)
+    if finals is not None:
+        ws.write_number(rows + 2, 8, finals[0])
+        ws.write_number(rows + 3, 8, finals[1])
+    if "filtered" in outputs:
+        for row, value in _filtered_cells(result, stride):
+            ws.write_number(row, 27, value)
+    refs = {}
+    if rows == result.rows:
+        title = ws.get_name()
+        for col, key in ((8, "y1"), (9, "y31"), (10, "y32"), (11, "y33"), (20, "accel_kg")):
+            if col in columns and np.isfinite(columns[col]).any():
+                refs[key] = Ref(title, 7, col, 1, rows, rows)
+    return refs, warnings
 
 
-def _write_results(ws, result):
-    for col, text in HEADERS.items():
-        ws.write_string(0, col, text)
-    for col, (first, values) in result_columns(result).items():
-        # NaN marks cells the macro leaves empty (e.g. Crush Factor before any loading)
-        for start, stop in finite_runs(values):
-            ws.write_number_column(first + start, col, values[start:stop])
-    n = result.rows
-    ws.write_number(n + 2, 8, result.history.final_m1)
-    ws.write_number(n + 3, 8, result.history.final_m31)
-    for r, v in zip(result.filtered.rows.tolist(), result.filtered.values.tolist()):
-        ws.write_number(r + 1, 27, v)
-
-
-def write_workbook(result, path, force=False):
+def write_workbook(result, path, force=False, outputs=Outputs(), summary=None, info=None):
     """Write ``result`` to a new .xlsx at ``path``, atomically.
 
     Parameters
@@ -190,6 +215,12 @@ def write_workbook(result, path, force=False):
     path : str or pathlib.Path
     force : bool
         Overwrite an existing file.
+    outputs : airgun_xl.outputs.Outputs
+        Which groups, sheets and charts to write, and the row stride.
+    summary : airgun_xl.engine.summary.Summary, optional
+        Computed here when a selected output needs it and none is given.
+    info : dict, optional
+        Provenance for the Summary sheet (input, SHA-256, run times, ...).
 
     Returns
     -------
@@ -202,16 +233,29 @@ def write_workbook(result, path, force=False):
     """
     source = result.shot.source
     check_output(path, force, inputs=[source.path] if source is not None else [])
-    if result.rows + 4 > SHEET_ROWS:
-        raise OutputError(f"{path}: the run has {result.rows:,} rows, more than a sheet holds "
-                          f"({SHEET_ROWS - 4:,} with the final masses); expected a larger E2 "
-                          "or a shorter E6")
+    stride = outputs.stride(result.rows)
+    keep = np.arange(0, result.rows, stride)
+    needs_summary = outputs.groups & {"summary", "spectrum", "charts"}
+    if summary is None and needs_summary:
+        summary = summarize(result)
+    info = dict(info or {}, every=stride, sheet_rows=len(keep))
     with atomic_path(path) as tmp:
         wb = new_workbook(tmp)
-        ws = wb.add_worksheet(source.sheet_title if source is not None else "Sheet1",
-                              worksheet_class=ColumnsWorksheet)
-        warnings = _write_block(ws, result)
-        _write_results(ws, result)
+        refs, warnings = _write_sheet1(wb, result, outputs, keep, stride)
+        if "summary" in outputs:
+            write_summary(wb, result, summary, info)
+        charts_ws = wb.add_worksheet("Charts") if "charts" in outputs else None
+        if "tracked" in outputs:
+            refs.update(write_tracked(wb, result, keep, ColumnsWorksheet))
+        if "spectrum" in outputs:
+            refs.update(write_spectrum(wb, summary.spectrum, ColumnsWorksheet))
+        if charts_ws is not None:
+            data = series_data(result, summary.spectrum)
+            placed = write_chart_data(wb, data, refs, ColumnsWorksheet)
+            add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]))
+        if source is not None and source.outputs_block:
+            write_cells(wb.add_worksheet(SHEET_NAME, worksheet_class=ColumnsWorksheet),
+                        source.outputs_block)
         with fast_deflate():
             wb.close()
     return warnings

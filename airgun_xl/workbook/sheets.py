@@ -1,0 +1,190 @@
+"""The sheets beyond the macro's: Tracked, Spectrum, Summary and ChartData.
+
+Each writer returns the :class:`Ref` of the series it holds, so charts can point at cells that
+are already written instead of copying them.
+"""
+import datetime
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..charts import COPY_POINTS, POINT_BUDGET
+from ..engine.decimate import minmax_indices
+from ..engine.summary import PEAK_MIN_HZ, PULSE_FRACTION, SPECTRUM_MAX_HZ
+from ..errors import OutputError
+
+
+@dataclass(frozen=True)
+class Ref:
+    """Where a chart series' cells are: a sheet, x and y columns, rows (0-based, inclusive)."""
+
+    sheet: str
+    x_col: int
+    y_col: int
+    first_row: int
+    last_row: int
+    total: int  # points of the full-resolution series
+
+    @property
+    def points(self):
+        return self.last_row - self.first_row + 1
+
+    def x_range(self):
+        return [self.sheet, self.first_row, self.x_col, self.last_row, self.x_col]
+
+    def y_range(self):
+        return [self.sheet, self.first_row, self.y_col, self.last_row, self.y_col]
+
+
+def write_number_columns(ws, first_row, columns):
+    """Write ``{col: array}`` down from ``first_row``; NaN cells are left empty."""
+    for col, values in columns.items():
+        values = np.asarray(values, dtype=float)
+        finite = np.concatenate(([False], np.isfinite(values), [False]))
+        edges = np.flatnonzero(np.diff(finite.astype(np.int8)))
+        for start, stop in zip(edges[0::2].tolist(), edges[1::2].tolist()):
+            if ws.write_number_column(first_row + start, col, values[start:stop]) == -1:
+                raise OutputError(f"{ws.get_name()}: {stop - start:,} rows from row "
+                                  f"{first_row + start + 1:,} pass the sheet's last row; "
+                                  "expected fewer rows (use --every)")
+
+
+TRACKED_COLUMNS = (
+    ("Time (s)", "time"), ("Mitigator force (N)", "force"),
+    ("Plastic wave front x_p (m)", "x_plastic"), ("Mitigator deflection (m)", "deflection"),
+    ("M1 (kg)", "m1"), ("m31 (kg)", "m31"), ("OBR front plate velocity (m/s)", "v31"),
+    ("MEM velocity (m/s)", "v1"),
+)
+
+
+def write_tracked(wb, result, keep, sheet_class):
+    """The Tracked sheet: step values the kernel recorded, every kept row."""
+    ws = wb.add_worksheet("Tracked", worksheet_class=sheet_class)
+    ws.set_column(0, len(TRACKED_COLUMNS) - 1, 16)
+    h = result.history
+    columns = {}
+    for col, (header, key) in enumerate(TRACKED_COLUMNS):
+        ws.write_string(0, col, header)
+        values = getattr(h, key)
+        if values is not None:
+            columns[col] = values[keep]
+    write_number_columns(ws, 1, columns)
+    full = len(keep) == result.rows
+    refs = {}
+    for col, (_, key) in enumerate(TRACKED_COLUMNS[1:], start=1):
+        if col in columns and full:
+            refs[key] = Ref("Tracked", 0, col, 1, len(keep), len(keep))
+    return refs
+
+
+def write_spectrum(wb, spectrum, sheet_class):
+    ws = wb.add_worksheet("Spectrum", worksheet_class=sheet_class)
+    ws.set_column(0, 1, 16)
+    ws.write_string(0, 0, "Frequency (Hz)")
+    ws.write_string(0, 1, "Amplitude (kG)")
+    ws.write_string(0, 3, f"Single-sided amplitude spectrum 2|FFT|/N (numpy.fft.rfft) of the "
+                          f"test-item acceleration in kG, 0-{SPECTRUM_MAX_HZ:,.0f} Hz")
+    write_number_columns(ws, 1, {0: spectrum.frequency, 1: spectrum.amplitude})
+    n = len(spectrum.frequency)
+    return {"spectrum": Ref("Spectrum", 0, 1, 1, n, n)} if n else {}
+
+
+def write_chart_data(wb, data, refs, sheet_class):
+    """Copies on ChartData of the series that have no usable home; decimated past the budget.
+
+    Returns the refs of all chart series, homes and copies.
+    """
+    ws = wb.add_worksheet("ChartData", worksheet_class=sheet_class)
+    ws.write_string(0, 0, f"Chart series not on another sheet at full resolution; a series "
+                          f"longer than {POINT_BUDGET:,} points is cut to {COPY_POINTS:,}, "
+                          "the min and max of each bucket of consecutive points.")
+    out = {}
+    col = 0
+    for key, (x, y) in data.items():
+        home = refs.get(key)
+        if home is not None and home.points <= POINT_BUDGET:
+            out[key] = home
+            continue
+        index = minmax_indices(y, COPY_POINTS if len(y) > POINT_BUDGET else POINT_BUDGET)
+        ws.write_string(1, col, f"{key} x")
+        ws.write_string(1, col + 1, key)
+        write_number_columns(ws, 2, {col: x[index], col + 1: y[index]})
+        out[key] = Ref("ChartData", col, col + 1, 2, 1 + len(index), len(y))
+        col += 2
+    return out
+
+
+def _summary_rows(result, summary, timings):
+    p = result.params
+    s = summary
+    rows = [
+        ("Peak acceleration (raw)", s.peak_kg, "kG", "largest Acceleration (kG's), column U"),
+        ("Time of peak", s.time_of_peak, "s", ""),
+        ("Peak acceleration (filtered)", s.filtered_peak_kg, "kG",
+         "largest Filtered Acceleration (column AB) / -9800"),
+        ("Time of filtered peak", s.time_of_filtered_peak, "s", ""),
+        ("Pulse duration", s.pulse_duration, "s",
+         f"from the first to the last row with acceleration >= {PULSE_FRACTION:.0%} of its "
+         "peak"),
+        ("Pulse start", s.pulse_start, "s", ""),
+        ("Pulse end", s.pulse_end, "s", ""),
+        ("Maximum crush", s.max_crush, "m", "largest mitigator deflection Y31 - Y1"),
+        ("Final mitigator length", s.final_length, "m", "E16 + E19 - maximum crush"),
+        ("Final M1", s.final_m1, "kg", "MEM with the uncrushed mitigator, as the macro ends"),
+        ("Final m31", s.final_m31, "kg", "OBR front plate with the crushed honeycomb"),
+        ("OBR exit velocity", s.obr_exit_velocity, "m/s",
+         "OBR front plate velocity at the end of the run"),
+        ("MEM final velocity", s.mem_final_velocity, "m/s", ""),
+    ]
+    for i in range(3):
+        value = s.spectrum.peaks[i] if i < len(s.spectrum.peaks) else None
+        rows.append((f"Dominant frequency {i + 1}", value, "Hz",
+                     f"local maxima of the amplitude spectrum above {PEAK_MIN_HZ:,.0f} Hz, "
+                     "most prominent first (log prominence)" if i == 0 else ""))
+    for label, freqs in (("initial", s.natural_initial), ("final", s.natural_final)):
+        for i, f in enumerate(freqs):
+            rows.append((f"OBR chain natural frequency {i + 1} ({label} masses)", f, "Hz",
+                         "sqrt of the eigenvalues of M^-1 K of the bird's springs / 2 pi"
+                         if i == 0 and label == "initial" else ""))
+    rows += [
+        ("Model", p.model, "", ""),
+        ("Integrator", result.integrator, "", ""),
+        ("Time step", p.delta, "s", "E2"),
+        ("Rows", result.rows, "", "time rows of the run"),
+        ("Rows on the sheets", timings.get("sheet_rows"), "", ""),
+        ("Every N-th row", timings.get("every"), "", "1: every row is on the sheets"),
+        ("Engine version", timings.get("version"), "", "airgun-xl"),
+        ("Input file", timings.get("input"), "", ""),
+        ("Input SHA-256", timings.get("sha256"), "", ""),
+    ]
+    if "kernel_seconds" in timings:
+        rows += [("Kernel run time", timings["kernel_seconds"], "s", "time stepping alone"),
+                 ("Run time", timings["run_seconds"], "s",
+                  "reading, stepping and post-processing, before writing")]
+    return rows
+
+
+def write_summary(wb, result, summary, timings):
+    """The Summary sheet: one labelled cell per figure (label A, value B, unit C, note D)."""
+    ws = wb.add_worksheet("Summary")
+    ws.set_column(0, 0, 44)
+    ws.set_column(1, 1, 24)
+    ws.set_column(2, 2, 8)
+    ws.set_column(3, 3, 70)
+    bold = wb.add_format({"bold": True})
+    for col, text in enumerate(("Quantity", "Value", "Unit", "Definition")):
+        ws.write_string(0, col, text, bold)
+    for row, (label, value, unit, note) in enumerate(_summary_rows(result, summary, timings), 1):
+        ws.write_string(row, 0, label)
+        if isinstance(value, (float, int, np.floating, np.integer)) and not isinstance(value,
+                                                                                         bool):
+            ws.write_number(row, 1, float(value))
+        elif isinstance(value, datetime.datetime):
+            ws.write_string(row, 1, value.isoformat())
+        elif value is not None:
+            ws.write_string(row, 1, str(value))
+        if unit:
+            ws.write_string(row, 2, unit)
+        if note:
+            ws.write_string(row, 3, note)
+    return ws
