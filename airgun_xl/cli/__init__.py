@@ -4,9 +4,9 @@ import sys
 
 from .. import __version__
 from ..errors import AirgunXlError, OptionError
-from . import fill, template
+from . import check, convergence, fill, template
 
-COMMANDS = (fill, template)
+COMMANDS = (fill, check, convergence, template)
 
 
 class _Parser(argparse.ArgumentParser):

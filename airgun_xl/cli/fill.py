@@ -4,7 +4,9 @@ import time
 from pathlib import Path
 
 from .. import __version__
+from ..checks import StabilityError, after_run, before_run
 from ..engine.filtered import HOSTS
+from ..engine.integrators import INTEGRATORS
 from ..engine.summary import PULSE_FRACTION, summarize
 from ..outputs import GROUPS, SIDECAR_MODES, from_sheet
 from ..shot import Shot
@@ -35,6 +37,12 @@ def add_parser(sub):
     p.add_argument("--sidecar", choices=SIDECAR_MODES,
                    help="full time history beside the output: auto (when rows are left out), "
                         "always or never")
+    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy",
+                   help="legacy: ArtSim's scheme (the default); newmark: average-acceleration "
+                        "Newmark, unconditionally stable for the OBR chain")
+    p.add_argument("--allow-unstable", action="store_true",
+                   help="run even when the time step is above the critical step (a diverging "
+                        "run still stops)")
     p.add_argument("--reproducible", action="store_true",
                    help="leave run times out of the Summary, so equal inputs give equal bytes")
     p.set_defaults(run=run)
@@ -83,12 +91,21 @@ def run(args):
     if sidecar is not None:
         check_output(sidecar, args.force, inputs=[args.shot])
     warn(shot.warnings)
-    result = shot.run(host=args.host, track=outputs.tracked_series(sidecar is not None))
+    crit, findings = before_run(shot.params, args.integrator)
+    if crit.ratio > 1 and not args.allow_unstable:
+        error = next(f for f in findings if f.level == "error")
+        raise StabilityError(f"{error}; expected a smaller E2, --integrator newmark, or "
+                             "--allow-unstable")
+    warn(str(f) for f in findings if f.level != "note")
+    result = shot.run(integrator=args.integrator, host=args.host,
+                      track=outputs.tracked_series(sidecar is not None))
     warn(result.warnings[len(shot.warnings):])
+    warn(str(f) for f in after_run(result))
     needs_summary = outputs.groups & {"summary", "spectrum", "charts"}
     summary = summarize(result) if needs_summary else None
     info = {"version": __version__, "input": str(args.shot), "sha256": shot.source.sha256,
-            "command": " ".join(["airgun-xl", *sys.argv[1:]])}
+            "command": " ".join(["airgun-xl", *sys.argv[1:]]),
+            "dt_crit": crit.dt_crit, "dt_ratio": crit.ratio}
     if not args.reproducible:
         info.update(kernel_seconds=result.history.kernel_seconds,
                     run_seconds=time.perf_counter() - started)

@@ -10,10 +10,14 @@
  *
  * Python interface (module airgun_xl.engine._artsim):
  *   legacy_kernel(params, rows, t, y1, y31, y32, y33, crush, m31, defl, xp, force, m1, v1, v31)
- *     params: a sequence of 21 floats in the order of the enum below;
+ *     params: a sequence of 22 floats in the order of the enum below;
  *     the other arguments: writable, C-contiguous float64 buffers of length >= rows. The
  *     tracked columns from crush on may be None: they are then neither computed nor stored.
- *     Returns (final M1, final m31). The GIL is released while stepping.
+ *     Returns (final M1, final m31, first diverged row or -1, final x_plastic, max and min
+ *     relative velocity while loading, largest crushed mass). The GIL is released while
+ *     stepping, which stops at the first row whose displacement is not finite or passes
+ *     params[21], the bound no physical run exceeds.
+ *   newmark_kernel(...): the same, with the average-acceleration Newmark scheme.
  *   render_cells(column, first_row, values) -> list of str
  *     '<c r="I5"><v>...</v></c>' for each value (finite float64), rows counted from
  *     first_row (1-based), numbers with 17 significant digits (exact round trip).
@@ -26,7 +30,8 @@
 #define PI_MACRO 3.141592653
 
 enum { P_M1, P_M31, P_M32, P_M33, P_K2, P_K3, P_DELTA, P_RHO, P_RCONE, P_HCONE, P_HCYL,
-       P_MMIT, P_VCONE, P_E, P_EC, P_SIGMAY, P_ZETA, P_V1, P_V31, P_V32, P_V33, P_COUNT };
+       P_MMIT, P_VCONE, P_E, P_EC, P_SIGMAY, P_ZETA, P_V1, P_V31, P_V32, P_V33, P_BOUND,
+       P_COUNT };
 
 typedef struct {
     double *t, *y1, *y31, *y32, *y33, *crush, *m31, *defl, *xp, *force, *m1, *v1, *v31;
@@ -41,24 +46,88 @@ static double crush_factor_poly(double Vobr)
            - (0.0001897436) * (V * V) + (0.008340218) * (V) + 1.257647;
 }
 
-static void legacy_steps(const double *p, Py_ssize_t rows, Columns c, double *finals)
+/* The mitigator's state between steps (the macro's variables of the same names). */
+typedef struct {
+    double M1, m31, vcone, xPlastic, maxmitdef, mitigatordeflection, forceCounter, dforce;
+    double Force, crushFactor;
+    /* statistics for the checks (not in the macro) */
+    double max_Vobr, min_Vobr, max_temp;
+} Mitigator;
+
+static void mitigator_start(Mitigator *s, const double *p)
 {
-    const double m32 = p[P_M32], m33 = p[P_M33], k2 = p[P_K2], k3 = p[P_K3];
+    s->M1 = p[P_M1] + p[P_MMIT];
+    s->m31 = p[P_M31];
+    s->vcone = p[P_VCONE]; /* E28 is the starting "vcone"; a wedge step overwrites it */
+    s->xPlastic = s->maxmitdef = s->mitigatordeflection = s->forceCounter = 0;
+    s->dforce = s->Force = 0;
+    s->crushFactor = NAN; /* Variant Empty until the first loading step */
+    s->max_Vobr = -INFINITY;
+    s->min_Vobr = INFINITY;
+    s->max_temp = 0;
+}
+
+/* One step of the mitigator force law, from the MEM and OBR front plate positions now (y1,
+ * y31) and one step before (yn1, yn31); returns the force, clamped at >= 0, and updates the
+ * masses. This is the macro's loop body down to "If (Force < 0)", in the macro's order. */
+static double mitigator_force(Mitigator *s, const double *p, double y1, double yn1, double y31,
+                              double yn31)
+{
     const double delta = p[P_DELTA], rho = p[P_RHO], rcone = p[P_RCONE], hcone = p[P_HCONE];
     const double hcylinder = p[P_HCYL], E = p[P_E], ec = p[P_EC], sigmay = p[P_SIGMAY];
-    const double zeta = p[P_ZETA];
-    /* Start: masses; damping from the initial masses, once. */
-    double M1 = p[P_M1] + p[P_MMIT];
-    double m31 = p[P_M31];
-    const double c2 = 2 * zeta * sqrt(-k2 * (m31 + m32));
-    const double c3 = 2 * zeta * sqrt(-k3 * (m32 + m33));
-    double vcone = p[P_VCONE]; /* E28 is the starting "vcone"; a wedge step overwrites it */
-    double xPlastic = 0, maxmitdef = 0, mitigatordeflection = 0, forceCounter = 0;
-    double dforce = 0, Force = 0;
-    double crushFactor = NAN; /* Variant Empty until the first loading step */
+    double L = hcone + hcylinder - s->mitigatordeflection; /* previous step's deflection */
+    double cPlastic, Area, k1;
+    /* Plastic front: advances only when the relative increment is >= 0. */
+    cPlastic = (y31 - yn31 - y1 + yn1) / (ec * delta);
+    if (cPlastic >= 0)
+        s->xPlastic = s->xPlastic + (cPlastic * delta);
+    s->mitigatordeflection = y31 - y1;
+    if (s->mitigatordeflection < s->maxmitdef) {
+        /* Unloading: elastic over the full area; the masses stay frozen. */
+        Area = PI_MACRO * rcone * rcone;
+        k1 = -((Area * E) / (L));
+        if (s->forceCounter == 0) {
+            s->Force = -k1 * (s->mitigatordeflection - hcone);
+            s->dforce = s->Force - s->dforce; /* offset that keeps F continuous at the turn */
+            s->forceCounter = 0 + 1;          /* macro: fourcecounter + 1, a typo: Empty + 1 */
+        }
+        s->Force = -k1 * (s->mitigatordeflection - hcone) - s->dforce;
+    } else {
+        /* Loading: plastic crush with mass transfer. */
+        double h, temp, Vobr;
+        s->maxmitdef = s->mitigatordeflection;
+        if (s->xPlastic <= hcone) {
+            h = s->xPlastic;
+            Area = (PI_MACRO * rcone * rcone) * (h / hcone);
+            temp = ((rho * Area * h) / 3.0);
+            s->vcone = temp; /* the wedge's crushed mass replaces the E28 "volume" */
+        } else {
+            Area = PI_MACRO * rcone * rcone;
+            h = s->xPlastic - hcone;
+            temp = s->vcone + (rho * Area * h);
+        }
+        s->M1 = p[P_M1] + p[P_MMIT] - temp; /* Range("A2") + Range("E25") - temp */
+        s->m31 = p[P_M31] + temp;
+        Vobr = (((y31 - yn31) - (y1 - yn1)) / delta);
+        s->crushFactor = crush_factor_poly(Vobr);
+        if (s->crushFactor < 1)
+            s->crushFactor = 1;
+        s->Force = sigmay * Area * s->crushFactor;
+        s->dforce = s->Force;
+        if (Area > 0 && Vobr > s->max_Vobr) s->max_Vobr = Vobr; /* while the law acts */
+        if (Area > 0 && Vobr < s->min_Vobr) s->min_Vobr = Vobr;
+        if (temp > s->max_temp) s->max_temp = temp;
+    }
+    if (s->Force < 0)
+        s->Force = 0;
+    return s->Force;
+}
+
+static void start_rows(const double *p, Py_ssize_t rows, Columns c)
+{
+    const double delta = p[P_DELTA];
     double currentTime = -delta;
     Py_ssize_t k;
-
     /* Time starts at -delta and accumulates by repeated addition. */
     for (k = 0; k < rows; k++) {
         c.t[k] = currentTime;
@@ -73,56 +142,61 @@ static void legacy_steps(const double *p, Py_ssize_t rows, Columns c, double *fi
     }
     if (rows > 1)
         c.y1[1] = c.y31[1] = c.y32[1] = c.y33[1] = 0;
+}
 
+/* Record row k's tracked values; return 0, or 1 when a displacement left the bound. */
+static int finish_row(const double *p, Columns c, Py_ssize_t k, const Mitigator *s)
+{
+    const double delta = p[P_DELTA], bound = p[P_BOUND];
+    /* Tracked values (not in the macro): NULL columns are skipped. */
+    if (c.crush) c.crush[k] = s->crushFactor;
+    if (c.m31) c.m31[k] = s->m31;
+    if (c.defl) c.defl[k] = s->mitigatordeflection;
+    if (c.xp) c.xp[k] = s->xPlastic;
+    if (c.force) c.force[k] = s->Force;
+    if (c.m1) c.m1[k] = s->M1;
+    /* central-difference velocities of MEM and OBR front plate, at the row before */
+    if (c.v1) c.v1[k - 1] = (c.y1[k] - c.y1[k - 2]) / (2 * delta);
+    if (c.v31) c.v31[k - 1] = (c.y31[k] - c.y31[k - 2]) / (2 * delta);
+    /* divergence: a non-finite value, or growth no physical bound allows (not in the macro) */
+    return !(fabs(c.y1[k]) <= bound && fabs(c.y31[k]) <= bound && fabs(c.y32[k]) <= bound
+             && fabs(c.y33[k]) <= bound);
+}
+
+static void finish_run(const Mitigator *s, Py_ssize_t bad, double *out)
+{
+    out[0] = s->M1;
+    out[1] = s->m31;
+    out[2] = (double)bad;
+    out[3] = s->xPlastic;
+    out[4] = s->max_Vobr;
+    out[5] = s->min_Vobr;
+    out[6] = s->max_temp;
+}
+
+/* ArtSim's scheme: central differences with backward-difference damping velocities. */
+static void legacy_steps(const double *p, Py_ssize_t rows, Columns c, double *out)
+{
+    const double m32 = p[P_M32], m33 = p[P_M33], k2 = p[P_K2], k3 = p[P_K3];
+    const double delta = p[P_DELTA], zeta = p[P_ZETA];
+    Mitigator s;
+    double c2, c3;
+    Py_ssize_t k, bad = -1;
+
+    mitigator_start(&s, p);
+    /* Damping from the initial masses, once. */
+    c2 = 2 * zeta * sqrt(-k2 * (s.m31 + m32));
+    c3 = 2 * zeta * sqrt(-k3 * (m32 + m33));
+    start_rows(p, rows, c);
     for (k = 2; k < rows; k++) {
-        double L = hcone + hcylinder - mitigatordeflection; /* previous step's deflection */
         double y1 = c.y1[k - 1], yn1 = c.y1[k - 2];
         double y31 = c.y31[k - 1], yn31 = c.y31[k - 2];
         double y32 = c.y32[k - 1], y33 = c.y33[k - 1];
         /* Backward-difference relative velocities, from the two previous rows. */
         double yPrime2 = ((y32 - c.y32[k - 2]) - (y31 - c.y31[k - 2])) / delta;
         double yPrime3 = ((y33 - c.y33[k - 2]) - (y32 - c.y32[k - 2])) / delta;
-        double cPlastic, springValue, Area, k1;
-        /* Plastic front: advances only when the relative increment is >= 0. */
-        cPlastic = (c.y31[k - 1] - c.y31[k - 2] - c.y1[k - 1] + c.y1[k - 2]) / (ec * delta);
-        if (cPlastic >= 0)
-            xPlastic = xPlastic + (cPlastic * delta);
-        mitigatordeflection = y31 - y1;
-        if (mitigatordeflection < maxmitdef) {
-            /* Unloading: elastic over the full area; the masses stay frozen. */
-            Area = PI_MACRO * rcone * rcone;
-            k1 = -((Area * E) / (L));
-            if (forceCounter == 0) {
-                Force = -k1 * (mitigatordeflection - hcone);
-                dforce = Force - dforce;    /* offset that keeps F continuous at the turn */
-                forceCounter = 0 + 1;       /* macro: fourcecounter + 1, a typo: Empty + 1 */
-            }
-            Force = -k1 * (mitigatordeflection - hcone) - dforce;
-        } else {
-            /* Loading: plastic crush with mass transfer. */
-            double h, temp, Vobr;
-            maxmitdef = mitigatordeflection;
-            if (xPlastic <= hcone) {
-                h = xPlastic;
-                Area = (PI_MACRO * rcone * rcone) * (h / hcone);
-                temp = ((rho * Area * h) / 3.0);
-                vcone = temp; /* the wedge's crushed mass replaces the E28 "volume" */
-            } else {
-                Area = PI_MACRO * rcone * rcone;
-                h = xPlastic - hcone;
-                temp = vcone + (rho * Area * h);
-            }
-            M1 = p[P_M1] + p[P_MMIT] - temp; /* Range("A2") + Range("E25") - temp */
-            m31 = p[P_M31] + temp;
-            Vobr = (((y31 - yn31) - (y1 - yn1)) / delta);
-            crushFactor = crush_factor_poly(Vobr);
-            if (crushFactor < 1)
-                crushFactor = 1;
-            Force = sigmay * Area * crushFactor;
-            dforce = Force;
-        }
-        if (Force < 0)
-            Force = 0;
+        double springValue, Force = mitigator_force(&s, p, y1, yn1, y31, yn31);
+        double M1 = s.M1, m31 = s.m31;
         /* Central-difference updates, the four lines of the macro. */
         springValue = ((delta * delta) / M1) * (Force);
         c.y1[k] = 2 * y1 - yn1 + springValue;
@@ -133,29 +207,94 @@ static void legacy_steps(const double *p, Py_ssize_t rows, Columns c, double *fi
         c.y32[k] = 2 * y32 - c.y32[k - 2] + springValue;
         springValue = ((delta * delta) / m33) * ((k3 * y33) - (k3 * y32) - (c3 * yPrime3));
         c.y33[k] = 2 * y33 - c.y33[k - 2] + springValue;
-        /* Tracked values (not in the macro): NULL columns are skipped. */
-        if (c.crush) c.crush[k] = crushFactor;
-        if (c.m31) c.m31[k] = m31;
-        if (c.defl) c.defl[k] = mitigatordeflection;
-        if (c.xp) c.xp[k] = xPlastic;
-        if (c.force) c.force[k] = Force;
-        if (c.m1) c.m1[k] = M1;
-        /* central-difference velocities of MEM and OBR front plate, at the row before */
-        if (c.v1) c.v1[k - 1] = (c.y1[k] - c.y1[k - 2]) / (2 * delta);
-        if (c.v31) c.v31[k - 1] = (c.y31[k] - c.y31[k - 2]) / (2 * delta);
+        if (finish_row(p, c, k, &s)) {
+            bad = k;
+            break;
+        }
     }
-    finals[0] = M1;
-    finals[1] = m31;
+    finish_run(&s, bad, out);
+}
+
+/* Average-acceleration Newmark (beta = 1/4, gamma = 1/2) for the OBR chain, implicit in the
+ * springs and dampers, so unconditionally stable for them; the mitigator force law is the
+ * macro's, evaluated explicitly at the Newmark predictor. The MEM is coupled to the chain
+ * only through that force. Not in the macro. */
+static void newmark_steps(const double *p, Py_ssize_t rows, Columns c, double *out)
+{
+    const double m32 = p[P_M32], m33 = p[P_M33], kk2 = -p[P_K2], kk3 = -p[P_K3];
+    const double dt = p[P_DELTA], zeta = p[P_ZETA];
+    const double beta = 0.25, gamma = 0.5;
+    Mitigator s;
+    double c2, c3, y[4], v[4], a[4];
+    Py_ssize_t k, bad = -1;
+    int i;
+
+    mitigator_start(&s, p);
+    c2 = 2 * zeta * sqrt(kk2 * (s.m31 + m32));
+    c3 = 2 * zeta * sqrt(kk3 * (m32 + m33));
+    start_rows(p, rows, c);
+    for (i = 0; i < 4; i++) y[i] = 0;
+    v[0] = p[P_V1]; v[1] = p[P_V31]; v[2] = p[P_V32]; v[3] = p[P_V33];
+    /* a(0): no force yet; the chain's dampers act on the initial relative velocities */
+    a[0] = 0;
+    a[1] = (c2 * (v[2] - v[1])) / s.m31;
+    a[2] = (-c2 * (v[2] - v[1]) + c3 * (v[3] - v[2])) / m32;
+    a[3] = (-c3 * (v[3] - v[2])) / m33;
+    for (k = 2; k < rows; k++) {
+        double yp[4], vp[4], F, m31, r[3], d[3], lo[3], up[3];
+        for (i = 0; i < 4; i++) {
+            yp[i] = y[i] + dt * v[i] + (0.5 - beta) * dt * dt * a[i];
+            vp[i] = v[i] + (1 - gamma) * dt * a[i];
+        }
+        F = mitigator_force(&s, p, yp[0], y[0], yp[1], y[1]);
+        m31 = s.m31;
+        /* MEM: only the mitigator force */
+        a[0] = F / s.M1;
+        /* chain: (M + gamma dt C + beta dt^2 K) a = f - C vp - K yp, tridiagonal */
+        d[0] = m31 + gamma * dt * c2 + beta * dt * dt * kk2;
+        d[1] = m32 + gamma * dt * (c2 + c3) + beta * dt * dt * (kk2 + kk3);
+        d[2] = m33 + gamma * dt * c3 + beta * dt * dt * kk3;
+        up[0] = lo[1] = -(gamma * dt * c2 + beta * dt * dt * kk2);
+        up[1] = lo[2] = -(gamma * dt * c3 + beta * dt * dt * kk3);
+        r[0] = -F - (c2 * (vp[1] - vp[2])) - (kk2 * (yp[1] - yp[2]));
+        r[1] = -(c2 * (vp[2] - vp[1]) + c3 * (vp[2] - vp[3]))
+               - (kk2 * (yp[2] - yp[1]) + kk3 * (yp[2] - yp[3]));
+        r[2] = -(c3 * (vp[3] - vp[2])) - (kk3 * (yp[3] - yp[2]));
+        /* Thomas algorithm */
+        for (i = 1; i < 3; i++) {
+            double w = lo[i] / d[i - 1];
+            d[i] -= w * up[i - 1];
+            r[i] -= w * r[i - 1];
+        }
+        a[3] = r[2] / d[2];
+        a[2] = (r[1] - up[1] * a[3]) / d[1];
+        a[1] = (r[0] - up[0] * a[2]) / d[0];
+        for (i = 0; i < 4; i++) {
+            y[i] = yp[i] + beta * dt * dt * a[i];
+            v[i] = vp[i] + gamma * dt * a[i];
+        }
+        c.y1[k] = y[0];
+        c.y31[k] = y[1];
+        c.y32[k] = y[2];
+        c.y33[k] = y[3];
+        if (finish_row(p, c, k, &s)) {
+            bad = k;
+            break;
+        }
+    }
+    finish_run(&s, bad, out);
 }
 
 #define N_COLUMNS 13
 #define N_REQUIRED 5
 
-static PyObject *py_legacy_kernel(PyObject *self, PyObject *args)
+typedef void (*Stepper)(const double *, Py_ssize_t, Columns, double *);
+
+static PyObject *run_kernel(PyObject *args, Stepper steps)
 {
     PyObject *params, *seq, *objs[N_COLUMNS];
     Py_buffer views[N_COLUMNS];
-    double p[P_COUNT], finals[2];
+    double p[P_COUNT], finals[7];
     double *ptrs[N_COLUMNS];
     Py_ssize_t rows, i;
     int got = 0;
@@ -203,17 +342,28 @@ static PyObject *py_legacy_kernel(PyObject *self, PyObject *args)
     c.crush = ptrs[5]; c.m31 = ptrs[6]; c.defl = ptrs[7]; c.xp = ptrs[8]; c.force = ptrs[9];
     c.m1 = ptrs[10]; c.v1 = ptrs[11]; c.v31 = ptrs[12];
     Py_BEGIN_ALLOW_THREADS
-    legacy_steps(p, rows, c, finals);
+    steps(p, rows, c, finals);
     Py_END_ALLOW_THREADS
     for (i = 0; i < N_COLUMNS; i++)
         if (views[i].obj != NULL)
             PyBuffer_Release(&views[i]);
-    return Py_BuildValue("dd", finals[0], finals[1]);
+    return Py_BuildValue("ddndddd", finals[0], finals[1], (Py_ssize_t)finals[2], finals[3],
+                         finals[4], finals[5], finals[6]);
 fail:
     for (i = 0; i < got; i++)
         if (views[i].obj != NULL)
             PyBuffer_Release(&views[i]);
     return NULL;
+}
+
+static PyObject *py_legacy_kernel(PyObject *self, PyObject *args)
+{
+    return run_kernel(args, legacy_steps);
+}
+
+static PyObject *py_newmark_kernel(PyObject *self, PyObject *args)
+{
+    return run_kernel(args, newmark_steps);
 }
 
 /* Sheet XML for a run of numeric cells: the writer's fast path (columns_sheet.py). The text
@@ -289,6 +439,8 @@ static PyMethodDef methods[] = {
     {"legacy_kernel", py_legacy_kernel, METH_VARARGS,
      "legacy_kernel(params, rows, t, y1, y31, y32, y33, crush, m31, defl, xp, force, m1, v1, "
      "v31)\nRun ArtSim's position loop into the given float64 buffers; return (M1, m31)."},
+    {"newmark_kernel", py_newmark_kernel, METH_VARARGS,
+     "newmark_kernel(...): as legacy_kernel, with the average-acceleration Newmark scheme."},
     {"render_cells", py_render_cells, METH_VARARGS,
      "render_cells(column, first_row, values) -> list of '<c r=...><v>...</v></c>' strings"},
     {NULL, NULL, 0, NULL}};

@@ -63,6 +63,9 @@ def filtered_acceleration(y33, delta, samplerate, host="excel"):
     iterations = max(0, math.floor(last) - 3 + 1)
     period = math.floor(samplerate) + 1  # innercounter > samplerate, innercounter an Integer
     up, both = _offset(-samplerate, host), _offset(2 * samplerate, host)
+    if samplerate < 1:  # a sample every row from a stencil inside one row: no filter at all
+        return Filtered(np.zeros(0, dtype=np.int64), np.zeros(0), [
+            f"samplerate 1/(E2*E34) = {samplerate:.3g} is below one row: no filtered column"])
     if not float(samplerate).is_integer():
         warnings.append(
             f"samplerate 1/(E2*E34) = {samplerate:.6g} is not a whole number of rows: the legacy "

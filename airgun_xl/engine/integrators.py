@@ -10,13 +10,40 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import OptionError
-from ._artsim import legacy_kernel
+from ..errors import AirgunXlError, OptionError
+from ._artsim import legacy_kernel, newmark_kernel
 
 #: Order of the parameters the compiled kernel takes (``_artsim.c``, enum at its top).
 KERNEL_PARAMS = ("m1", "m31", "m32", "m33", "k2", "k3", "delta", "rho", "rcone", "hcone",
                  "hcylinder", "mmitigator", "vcone", "E", "ec", "sigmay", "zeta", "v1", "v31",
                  "v32", "v33")
+
+
+@dataclass
+class KernelStats:
+    """What the kernel saw, for the checks: final plastic front [m], largest and smallest
+    relative velocity while loading [m/s], largest crushed mass [kg]."""
+
+    x_plastic: float
+    max_relative_velocity: float
+    min_relative_velocity: float
+    max_crushed_mass: float
+
+
+class DivergenceError(AirgunXlError):
+    """The scheme diverged: a displacement became non-finite or passed the physical bound."""
+
+    def __init__(self, integrator, p, row, arrays):
+        names = ("Y1", "Y31", "Y32", "Y33")
+        values = [a[row] for a in arrays[1:5]]
+        worst = max(range(4), key=lambda i: abs(values[i]) if values[i] == values[i] else
+                    float("inf"))
+        time_at = arrays[0][row]
+        super().__init__(
+            f"the {integrator} scheme diverged at step {row - 1:,} (t = {time_at:.6g} s): "
+            f"{names[worst]} = {values[worst]:.3g} m, beyond the {displacement_bound(p):.3g} m "
+            "no physical run reaches; expected a smaller E2 (Timestep) or --integrator newmark")
+        self.row, self.time = row, time_at
 
 
 @dataclass
@@ -63,10 +90,34 @@ class History:
     final_m1: float
     final_m31: float
     kernel_seconds: float
+    stats: KernelStats = None
 
 
 #: The step values an integrator can record, in :class:`History` order.
 TRACKED = ("crush_factor", "m31", "deflection", "x_plastic", "force", "m1", "v1", "v31")
+
+
+def displacement_bound(p):
+    """Largest |displacement| a physical run can reach [m]: ten times the free flight at the
+    fastest initial speed plus the mitigator length, plus 1 m. Beyond it the scheme diverged."""
+    v = max(abs(p.v1), abs(p.v31), abs(p.v32), abs(p.v33))
+    return 10 * (v * p.max_time + p.hcone + p.hcylinder) + 1.0
+
+
+def _run(kernel, name, p, track):
+    rows = p.rows
+    arrays = [np.zeros(rows) for _ in range(5)] + [
+        np.full(rows, np.nan) if key in track else None for key in TRACKED]
+    values = kernel_params(p) + [displacement_bound(p)]
+    started = time.perf_counter()
+    final_m1, final_m31, bad, x_plastic, max_v, min_v, max_crushed = kernel(values, rows,
+                                                                            *arrays)
+    elapsed = time.perf_counter() - started
+    if bad >= 0:
+        raise DivergenceError(name, p, bad, arrays)
+    history = History(*arrays, final_m1, final_m31, elapsed)
+    history.stats = KernelStats(x_plastic, max_v, min_v, max_crushed)
+    return blank_left_out(history, p)
 
 
 def run_legacy(p, track=TRACKED):
@@ -82,16 +133,23 @@ def run_legacy(p, track=TRACKED):
     Returns
     -------
     History
+
+    Raises
+    ------
+    DivergenceError
+        When a displacement stops being finite or passes :func:`displacement_bound`.
     """
-    rows = p.rows
-    arrays = [np.zeros(rows) for _ in range(5)] + [
-        np.full(rows, np.nan) if name in track else None for name in TRACKED]
-    values = kernel_params(p)
-    started = time.perf_counter()
-    final_m1, final_m31 = legacy_kernel(values, rows, *arrays)
-    elapsed = time.perf_counter() - started
-    history = History(*arrays, final_m1, final_m31, elapsed)
-    return blank_left_out(history, p)
+    return _run(legacy_kernel, "legacy", p, track)
+
+
+def run_newmark(p, track=TRACKED):
+    """Time-step with the average-acceleration Newmark scheme (beta = 1/4, gamma = 1/2).
+
+    Implicit, so unconditionally stable, for the OBR chain's springs and dampers; the
+    mitigator force law is the macro's, evaluated at the Newmark predictor. Same interface as
+    :func:`run_legacy`.
+    """
+    return _run(newmark_kernel, "newmark", p, track)
 
 
 def kernel_params(p):
@@ -116,7 +174,7 @@ def blank_left_out(history, p):
     return history
 
 
-INTEGRATORS = {"legacy": run_legacy}
+INTEGRATORS = {"legacy": run_legacy, "newmark": run_newmark}
 
 
 def get_integrator(name):

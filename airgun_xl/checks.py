@@ -1,0 +1,129 @@
+"""Checks of a shot before and after its run: stability, and cases where the model is
+stretched past what it was built for. Each finding names the cell that causes it."""
+import math
+from dataclasses import dataclass
+
+from .cells import BY_ADDRESS
+from .engine.legacy_law import CRUSH_FIT_RANGE, crush_factor
+from .engine.stability import WARN_RATIO, critical_time_step
+from .errors import AirgunXlError
+
+#: Bird masses differing by this factor or more make a stiff, badly scaled system.
+MASS_RATIO_WARNING = 1e6
+
+
+class StabilityError(AirgunXlError):
+    """The time step is above the scheme's critical step: the run would diverge."""
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One result of a check: ``level`` is "error", "warning" or "note"."""
+
+    level: str
+    cell: str
+    message: str
+
+    def __str__(self):
+        label = BY_ADDRESS[self.cell].label if self.cell in BY_ADDRESS else ""
+        where = f"{self.cell} ({label})" if label else self.cell
+        return f"{where}: {self.message}"
+
+
+def _fmt(dt):
+    return f"{dt:.3g} s"
+
+
+def stability(p, integrator="legacy"):
+    """The critical step of the chosen scheme and its finding (None when comfortably stable).
+
+    Newmark is implicit in the OBR chain; only the mitigator's unloading stiffness, which it
+    treats explicitly, bounds its step.
+    """
+    crit = critical_time_step(p, chain=integrator == "legacy")
+    safe = f"the largest safe time step is {_fmt(crit.dt_crit)}"
+    if crit.ratio > 1:
+        return crit, Finding("error", "E2", f"{_fmt(p.delta)} is {crit.ratio:.3g} x the "
+                                            f"critical time step of the {integrator} scheme, "
+                                            f"set by {crit.limiting}; {safe}")
+    if crit.ratio > WARN_RATIO:
+        return crit, Finding("warning", "E2", f"{_fmt(p.delta)} is {crit.ratio:.2f} x the "
+                                              f"critical time step ({_fmt(crit.dt_crit)}) of "
+                                              f"the {integrator} scheme: close to unstable")
+    return crit, None
+
+
+def before_run(p, integrator="legacy"):
+    """Findings that need no run. Returns (CriticalStep, list of Finding)."""
+    crit, finding = stability(p, integrator)
+    found = [finding] if finding else []
+    lo, hi = CRUSH_FIT_RANGE
+    v_rel = p.v31 - p.v1
+    if v_rel > hi:  # (a bird slower than the MEM crushes nothing at first: no warning)
+        found.append(Finding("warning", "A28", f"the bird meets the MEM at {v_rel:.4g} m/s, "
+                             f"outside {lo:g}..{hi:g} m/s where the crush-factor polynomial "
+                             f"(Eq. 8) holds: it is extrapolated there (crush factor "
+                             f"{crush_factor(v_rel):.3g})"))
+    if p.v1 == p.v31 == p.v32 == p.v33:
+        found.append(Finding("note", "A28", f"all masses start at {p.v31:g} m/s: nothing "
+                             "crushes the mitigator, the response is free flight"))
+    steps = p.max_time / p.delta
+    if abs(steps - round(steps)) > 1e-9 * steps:
+        found.append(Finding("warning", "E6", f"E6/E2 = {steps!r} is not a whole number of "
+                             f"steps; the macro's row count floor(E6/E2 + 2) gives {p.rows:,} "
+                             "rows, ending before E6"))
+    elif steps != round(steps):
+        found.append(Finding("note", "E6", f"E6/E2 = {steps!r} rounds below {round(steps)}: "
+                             f"the macro's row count gives {p.rows:,} rows, not "
+                             f"{round(steps) + 2:,}"))
+    s = p.samplerate
+    if s < 1:
+        found.append(Finding("warning", "E34", f"1/(E2*E34) = {s:.3g}: less than a row between "
+                             "filter samples, so there is no filtered column"))
+    elif 2 * s >= p.rows - 2:
+        found.append(Finding("warning", "E34", f"1/(E2*E34) = {s:.6g} rows: the filter needs "
+                             f"2 x that within the run's {p.rows:,} rows, so there is no "
+                             "filtered column"))
+    elif not float(s).is_integer():
+        found.append(Finding("warning", "E34", f"1/(E2*E34) = {s:.6g} is not a whole number "
+                             "of rows: the legacy filtered column is ill-defined (Excel "
+                             "drifts a row per sample, LibreOffice writes zeros)"))
+    masses = {c: m for c, m in (("B2", p.m31), ("C2", p.m32), ("D2", p.m33)) if m > 0}
+    light = min(masses, key=masses.get)
+    heavy = max(list(masses.values()) + [p.m1 + p.mmitigator])
+    if heavy / masses[light] >= MASS_RATIO_WARNING:
+        found.append(Finding("warning", light, f"{masses[light]:.3g} kg is "
+                             f"{heavy / masses[light]:.2g} times lighter than the heaviest "
+                             "mass: a stiff, badly scaled system (see the critical time step)"))
+    if p.zeta == 0:
+        found.append(Finding("note", "E43", "zeta = 0: the OBR chain is undamped"))
+    return crit, found
+
+
+def after_run(result):
+    """Findings from what the kernel saw during the run."""
+    p, stats = result.params, result.history.stats
+    found = []
+    if stats is None:
+        return found
+    lo, hi = CRUSH_FIT_RANGE
+    said = p.v31 - p.v1 > hi  # before_run already warned about the impact speed
+    if not said and (stats.max_relative_velocity > hi or stats.min_relative_velocity < lo):
+        worst = (stats.max_relative_velocity if stats.max_relative_velocity > hi
+                 else stats.min_relative_velocity)
+        found.append(Finding("warning", "A28", f"while crushing, the relative velocity reached "
+                             f"{worst:.4g} m/s, outside {lo:g}..{hi:g} m/s where the "
+                             "crush-factor polynomial (Eq. 8) holds (crush factor "
+                             f"{crush_factor(worst):.3g} there)"))
+    length = p.hcone + p.hcylinder
+    if stats.x_plastic > length:
+        found.append(Finding("warning", "E19", f"the plastic front reached {stats.x_plastic:.4g}"
+                             f" m, past the end of the mitigator (E16 + E19 = {length:.4g} m): "
+                             "it bottoms out, where the model no longer holds"))
+    if stats.max_crushed_mass > p.mmitigator:
+        found.append(Finding("warning", "E25", f"the crushed honeycomb joining m31 reached "
+                             f"{stats.max_crushed_mass:.4g} kg, more than the mitigator's "
+                             f"{p.mmitigator:.4g} kg: more mass than the MEM can give"))
+    if not math.isfinite(result.peak_kg):
+        found.append(Finding("warning", "E6", "no acceleration rows: the run is too short"))
+    return found

@@ -1,0 +1,30 @@
+"""``airgun-xl check SHOT.xlsx``: can this shot's run be trusted? (No run, no output.)"""
+from ..checks import before_run
+from ..engine.integrators import INTEGRATORS
+from ..shot import Shot
+
+
+def add_parser(sub):
+    p = sub.add_parser("check", help="predict stability and list the model's limits for a shot",
+                       description="Predict the critical time step of the chosen scheme and "
+                                   "list what the shot stretches (crush-factor range, filter, "
+                                   "row count, masses). Exit 0 when it can run, 2 when the "
+                                   "time step is unstable.")
+    p.add_argument("shot", metavar="SHOT.xlsx", help="workbook in the report's layout")
+    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
+    p.set_defaults(run=run)
+
+
+def run(args):
+    shot = Shot.from_workbook(args.shot)
+    p = shot.params
+    crit, findings = before_run(p, args.integrator)
+    print(f"{args.shot}: {p.model}, {args.integrator} integrator")
+    print(f"  time step E2 = {p.delta:.4g} s, critical {crit.dt_crit:.4g} s, ratio "
+          f"{crit.ratio:.3g}: {crit.verdict}")
+    print(f"  set by {crit.limiting}")
+    for message in shot.warnings:
+        print(f"  warning: {message}")
+    for f in findings:
+        print(f"  {f.level}: {f}")
+    return 2 if crit.ratio > 1 else 0

@@ -1,0 +1,88 @@
+"""``airgun-xl convergence SHOT.xlsx``: error against time step and run time."""
+import math
+from pathlib import Path
+
+from ..engine.convergence import default_ladder, ladder, parse_duration
+from ..engine.integrators import INTEGRATORS
+from ..errors import OptionError
+from ..shot import Shot
+from ..workbook.atomic import check_output
+from ..workbook.convergence import write_convergence, write_png
+
+
+def add_parser(sub):
+    p = sub.add_parser("convergence", help="run a shot over a ladder of time steps",
+                       description="Run the shot at each time step of a ladder, report each "
+                                   "figure's error against the finest level (with Richardson "
+                                   "extrapolation and the observed order), recommend the "
+                                   "coarsest time step that meets --rtol on the peak, and "
+                                   "write a workbook and a PNG of error against run time.")
+    p.add_argument("shot", metavar="SHOT.xlsx")
+    p.add_argument("--levels", help="comma-separated time steps, e.g. 5us,2us,1us,500ns "
+                                    "(default: the sheet's E2, then 1-2-5 steps down to 5ns)")
+    p.add_argument("--integrator", default="legacy",
+                   help=f"one or more of {', '.join(sorted(INTEGRATORS))}, comma-separated")
+    p.add_argument("--rtol", default="1e-3", help="tolerance on the peak (default 0.1%%)")
+    p.add_argument("-o", "--output", metavar="OUT.xlsx",
+                   help="workbook (default: SHOT.convergence.xlsx); the PNG goes beside it")
+    p.add_argument("--force", action="store_true")
+    p.set_defaults(run=run)
+
+
+def run(args):
+    from . import warn
+
+    shot = Shot.from_workbook(args.shot)
+    integrators = [n.strip() for n in args.integrator.split(",") if n.strip()]
+    unknown = [n for n in integrators if n not in INTEGRATORS]
+    if unknown or not integrators:
+        raise OptionError(f"--integrator: found {args.integrator!r}, expected one or more of "
+                          f"{', '.join(sorted(INTEGRATORS))}")
+    try:
+        rtol = float(args.rtol)
+    except ValueError:
+        rtol = math.nan
+    if not 0 < rtol < 1:
+        raise OptionError(f"--rtol: found {args.rtol!r}, expected a number between 0 and 1")
+    if args.levels:
+        deltas = [parse_duration(t) for t in args.levels.split(",") if t.strip()]
+    else:
+        deltas = default_ladder(shot.params.delta)
+    if len(deltas) < 2:
+        raise OptionError(f"--levels: found {args.levels!r}, expected at least two time steps")
+    for d in deltas:
+        shot.params.replace(delta=d)  # each level is a valid shot (raises on the cell)
+    shot_path = Path(args.shot)
+    output = Path(args.output) if args.output else shot_path.with_name(
+        shot_path.stem + ".convergence.xlsx")
+    png = output.with_suffix(".png")
+    check_output(output, args.force, inputs=[args.shot])
+    check_output(png, args.force, inputs=[args.shot])
+    warn(shot.warnings)
+    ladders = [ladder(shot, deltas, name, rtol) for name in integrators]
+    write_convergence(ladders, output, args.force, shot)
+    warn([] if write_png(ladders, png) else ["matplotlib is not installed: no PNG"])
+    print_table(ladders)
+    print(f"wrote {output} and {png}")
+    return 0
+
+
+def print_table(ladders):
+    for lad in ladders:
+        print(f"{lad.integrator} integrator:")
+        print(f"  {'dt':>9} {'rows':>10} {'kernel s':>9} {'total s':>8} {'peak kG':>10} "
+              f"{'rel.err':>9} {'order':>6} {'crush m':>8} {'rel.err':>9}")
+        for lv in lad.levels:
+            order = lv.order.get("peak_kg")
+            print(f"  {lv.delta:9.3g} {lv.rows:10,} {lv.kernel_seconds:9.4f} "
+                  f"{lv.total_seconds:8.3f} {lv.figures['peak_kg']:10.5f} "
+                  f"{lv.errors['peak_kg']:9.2e} {'' if order is None else f'{order:6.2f}':>6} "
+                  f"{lv.figures['max_crush']:8.5f} {lv.errors['max_crush']:9.2e}")
+        extrapolated = lad.richardson["peak_kg"]
+        finest = lad.levels[-1].figures["peak_kg"]
+        print(f"  Richardson: peak {extrapolated:.5f} kG (finest level off by "
+              f"{abs(finest - extrapolated) / abs(extrapolated):.1e})")
+        rec = lad.recommended
+        print(f"  coarsest dt with peak within {lad.rtol:.1%} of the finest: "
+              + (f"{rec:.3g} s" if rec == rec else "none of the coarser levels"))
+

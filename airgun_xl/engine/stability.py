@@ -1,0 +1,138 @@
+"""Critical time step of the legacy scheme, predicted before a run.
+
+ArtSim's update, for the linear part of the model, is
+
+    M (y[n+1] - 2 y[n] + y[n-1]) / dt^2 = -K y[n] - C (y[n] - y[n-1]) / dt
+
+(central differences, with the macro's backward-difference velocities in the dampers). Over
+one step it maps (y[n], y[n-1]) to (y[n+1], y[n]) by the matrix
+
+    G(dt) = [[2I - dt^2 M^-1 K - dt M^-1 C,  -I + dt M^-1 C],
+             [I,                              0            ]]
+
+and the run stays bounded while the spectral radius of G is at most 1. The critical step is
+found by bisection on that radius. For one undamped mode it is 2/omega; with the macro's
+dampers it is (2 sqrt(1 + zeta^2) - 2 zeta)/omega.
+
+The matrices are the model's:
+- the OBR chain's springs k2, k3 and dampers c2, c3 (from the initial masses, as the macro
+  computes them once);
+- the elastic unloading stiffness A E / L between MEM and front plate, at its stiffest, when
+  the remaining length L is the mitigator fully compacted, (E16 + E19)(1 - E37);
+- the masses over the range the run passes through: m31 grows from B2 as crushed honeycomb
+  joins it (at most E25 more), M1 shrinks by as much. The smallest critical step over that
+  range is the prediction.
+"""
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Spectral radius above 1 by more than this is growth; below, the rigid-body modes' double
+#: eigenvalue 1, which floating-point eigenvalues split by about 1e-8.
+RADIUS_TOLERANCE = 1e-6
+
+#: Warn when dt / dt_crit passes this; refuse above 1.
+WARN_RATIO = 0.5
+
+
+@dataclass(frozen=True)
+class CriticalStep:
+    """The prediction for a shot.
+
+    Attributes
+    ----------
+    dt_crit : float
+        Largest stable time step of the legacy scheme [s].
+    ratio : float
+        The shot's dt / dt_crit.
+    limiting : str
+        What sets it, in words (the stiffest mode's frequency and the cells behind it).
+    """
+
+    dt_crit: float
+    ratio: float
+    limiting: str
+
+    @property
+    def verdict(self):
+        if self.ratio > 1:
+            return "unstable"
+        return "marginal" if self.ratio > WARN_RATIO else "stable"
+
+
+def _matrices(p, m31, m1, chain=True):
+    """M, C, K of the 4-DOF linear model (MEM, m31, m32, m33) with unloading stiffness; with
+    ``chain=False``, without the OBR springs and dampers (what Newmark treats explicitly)."""
+    kk2, kk3 = (-p.k2, -p.k3) if chain else (0.0, 0.0)
+    c2 = 2 * p.zeta * math.sqrt(kk2 * (p.m31 + p.m32))
+    c3 = 2 * p.zeta * math.sqrt(kk3 * (p.m32 + p.m33))
+    area = math.pi * p.rcone ** 2
+    k_mit = area * p.E / ((p.hcone + p.hcylinder) * (1 - p.ec) or p.hcone)
+    masses = [m1, m31, p.m32 or 1.0, p.m33 or 1.0]  # a left-out mass: its stand-in
+    K = np.zeros((4, 4))
+    C = np.zeros((4, 4))
+    for (i, j), k, c in (((0, 1), k_mit, 0.0), ((1, 2), kk2, c2), ((2, 3), kk3, c3)):
+        block = np.array([[1.0, -1.0], [-1.0, 1.0]])
+        K[np.ix_((i, j), (i, j))] += k * block
+        C[np.ix_((i, j), (i, j))] += c * block
+    return np.diag(masses), C, K
+
+
+def spectral_radius(dt, M, C, K):
+    """Spectral radius of the legacy scheme's step matrix G(dt)."""
+    n = len(M)
+    Minv = np.diag(1 / np.diag(M))
+    eye = np.eye(n)
+    G = np.block([[2 * eye - dt * dt * Minv @ K - dt * Minv @ C, -eye + dt * Minv @ C],
+                  [eye, np.zeros((n, n))]])
+    return float(np.max(np.abs(np.linalg.eigvals(G))))
+
+
+def _critical(M, C, K):
+    omega_max = math.sqrt(max(np.max(np.real(np.linalg.eigvals(np.linalg.solve(M, K)))),
+                              1e-300))
+    lo, hi = 0.0, 4.0 / omega_max  # the damped bound is below 2/omega, so hi is unstable
+    while spectral_radius(hi, M, C, K) <= 1 + RADIUS_TOLERANCE:
+        hi *= 2
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if spectral_radius(mid, M, C, K) <= 1 + RADIUS_TOLERANCE:
+            lo = mid
+        else:
+            hi = mid
+    return lo, omega_max
+
+
+def critical_time_step(p, samples=5, chain=True):
+    """Predict the legacy scheme's critical time step for a shot.
+
+    Parameters
+    ----------
+    p : airgun_xl.params.ShotParams
+    samples : int
+        Points over the range of m31 (from B2 to B2 + E25) where it is evaluated.
+    chain : bool
+        Include the OBR chain (the legacy scheme); False for Newmark, which is implicit in it.
+
+    Returns
+    -------
+    CriticalStep
+    """
+    best = None
+    for m31 in np.linspace(p.m31, p.m31 + p.mmitigator, samples):
+        m1 = p.m1 + p.mmitigator - (m31 - p.m31)
+        M, C, K = _matrices(p, float(m31), max(float(m1), 1e-9), chain)
+        dt, omega = _critical(M, C, K)
+        if best is None or dt < best[0]:
+            best = (dt, omega, float(m31))
+    dt, omega, m31 = best
+    f = omega / (2 * math.pi)
+    if chain:
+        limiting = (f"the stiffest mode, {f:,.0f} Hz (springs B6, C6, masses B2..D2, and the "
+                    f"unloading stiffness from E13, E31, E16, E19, E37), with m31 = "
+                    f"{m31:.4g} kg")
+    else:
+        limiting = (f"the mitigator's unloading stiffness (E13, E31, E16, E19, E37), "
+                    f"{f:,.0f} Hz with m31 = {m31:.4g} kg")
+    return CriticalStep(dt, p.delta / dt, limiting)
