@@ -42,7 +42,8 @@ class ChartSpec:
 CHARTS = (
     ChartSpec("accel", "Test-item acceleration (Fig. 12)", "Time (s)", "Acceleration (kG's)",
               (Series("accel_kg", "Acceleration"),
-               Series("filtered_kg", "Filtered samples", markers=True))),
+               Series("filtered_kg", "Filtered samples", markers=True),
+               Series("compared_kg", "Other model (--compare-models)"))),
     ChartSpec("spectrum", "FFT of the test-item acceleration (Figs. 14-15)", "Frequency (Hz)",
               "Amplitude (kG)", (Series("spectrum", "Amplitude"),), (0.0, SPECTRUM_MAX_HZ)),
     ChartSpec("force", "Mitigator force (Fig. 16)", "Time (s)", "Force (N)",
@@ -58,7 +59,7 @@ CHARTS = (
 )
 
 
-def series_data(result, spectrum):
+def series_data(result, spectrum, compared=None):
     """Full-resolution ``(x, y)`` arrays of every chart series key."""
     h = result.history
     t = h.time
@@ -70,6 +71,8 @@ def series_data(result, spectrum):
         "spectrum": (spectrum.frequency, spectrum.amplitude),
         "y1": (t, h.y1), "y31": (t, h.y31), "y32": (t, h.y32), "y33": (t, h.y33),
     }
+    if compared is not None:
+        data["compared_kg"] = (compared.history.time, compared.accel_kg)
     for key in ("force", "deflection", "x_plastic", "v31", "v1"):
         values = getattr(h, key)
         if values is not None:
@@ -96,7 +99,7 @@ def nice_range(values, include_zero=False):
     return math.floor(lo / step) * step, math.ceil(hi / step) * step
 
 
-def add_charts(workbook, sheet, refs, data, max_time):
+def add_charts(workbook, sheet, refs, data, max_time, labels=None):
     """Insert the charts on ``sheet``, two a row.
 
     Parameters
@@ -109,6 +112,8 @@ def add_charts(workbook, sheet, refs, data, max_time):
         Series key -> full-resolution (x, y), for the axis ranges.
     max_time : float
         End of the time axis [s].
+    labels : dict, optional
+        Series key -> legend name, overriding the chart's own.
     """
     sheet.write_string(0, 0, "Charts of this shot; the figure numbers are those of ARL-TR-3559.")
     sheet.set_landscape()
@@ -122,7 +127,8 @@ def add_charts(workbook, sheet, refs, data, max_time):
         decimated = []
         for i, s in enumerate(present):
             ref = refs[s.key]
-            options = {"name": s.name, "categories": ref.x_range(), "values": ref.y_range()}
+            name = (labels or {}).get(s.key, s.name)
+            options = {"name": name, "categories": ref.x_range(), "values": ref.y_range()}
             color = COLORS[i % len(COLORS)]
             if s.markers:
                 options["marker"] = {"type": "circle", "size": 5,

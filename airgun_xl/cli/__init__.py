@@ -4,9 +4,9 @@ import sys
 
 from .. import __version__
 from ..errors import AirgunXlError, OptionError
-from . import check, convergence, fill, template
+from . import check, convergence, design, fill, sweep, template
 
-COMMANDS = (fill, check, convergence, template)
+COMMANDS = (fill, check, convergence, design, sweep, template)
 
 
 class _Parser(argparse.ArgumentParser):

@@ -1,17 +1,14 @@
 """``airgun-xl fill SHOT.xlsx [-o OUT.xlsx] [--force] [...]``: run a shot into a new workbook."""
-import sys
 import time
 from pathlib import Path
 
-from .. import __version__
-from ..checks import StabilityError, after_run, before_run
 from ..engine.filtered import HOSTS
 from ..engine.integrators import INTEGRATORS
-from ..engine.summary import PULSE_FRACTION, summarize
+from ..engine.summary import PULSE_FRACTION
+from ..models import MODELS
 from ..outputs import GROUPS, SIDECAR_MODES, from_sheet
+from ..pipeline import Options, fill_workbook
 from ..shot import Shot
-from ..workbook.atomic import check_output
-from ..workbook.sidecar import sidecar_path, write_history
 
 
 def add_parser(sub):
@@ -43,6 +40,11 @@ def add_parser(sub):
     p.add_argument("--allow-unstable", action="store_true",
                    help="run even when the time step is above the critical step (a diverging "
                         "run still stops)")
+    p.add_argument("--model", choices=MODELS, default="4-mass",
+                   help="4-mass: ArtSim (default); rigid: the previous rigid-body model")
+    p.add_argument("--compare-models", action="store_true",
+                   help="also run the other model; both curves in the acceleration chart and "
+                        "both peaks in the Summary")
     p.add_argument("--reproducible", action="store_true",
                    help="leave run times out of the Summary, so equal inputs give equal bytes")
     p.set_defaults(run=run)
@@ -57,11 +59,13 @@ def _ms(seconds):
     return f"{seconds * 1e3:.4f} ms"
 
 
-def print_summary(output, result, summary, stride, sidecar):
-    s = summary
+def print_summary(output, filled):
+    result, s, stride, sidecar = filled.result, filled.summary, filled.stride, filled.sidecar
     lines = [f"wrote {output}: {result.rows:,} rows"
              + (f", 1 in {stride} on the sheets" if stride > 1 else "")
-             + f"; {result.params.model.split(' (')[0]} model, {result.integrator} integrator"]
+             + f"; {result.params.model.split(' (')[0]} model"
+             + (" (rigid)" if getattr(result, "model", "") == "rigid" else "")
+             + f", {result.integrator} integrator"]
     if s is not None:
         lines.append(f"  peak {s.peak_kg:.5f} kG at {_ms(s.time_of_peak)}; filtered "
                      f"{s.filtered_peak_kg:.5f} kG at {_ms(s.time_of_filtered_peak)}")
@@ -72,6 +76,9 @@ def print_summary(output, result, summary, stride, sidecar):
                          + ", ".join(f"{f / 1e3:.2f}" for f in s.spectrum.peaks) + " kHz")
     else:
         lines.append(f"  peak {result.peak_kg:.5f} kG at {_ms(result.time_of_peak)}")
+    if filled.compared is not None:
+        c = filled.compared
+        lines.append(f"  {c.model} model: peak {c.peak_kg:.5f} kG at {_ms(c.time_of_peak)}")
     if sidecar is not None:
         lines.append(f"  full history in {sidecar}")
     print("\n".join(lines))
@@ -85,32 +92,8 @@ def run(args):
     shot = Shot.from_workbook(args.shot)
     outputs = from_sheet(shot.source.outputs_block).with_flags(
         args.only, args.no_charts, args.every, args.max_sheet_rows, args.sidecar)
-    rows = shot.params.rows
-    sidecar = sidecar_path(output) if outputs.writes_sidecar(rows) else None
-    check_output(output, args.force, inputs=[args.shot])  # before the run, not after
-    if sidecar is not None:
-        check_output(sidecar, args.force, inputs=[args.shot])
-    warn(shot.warnings)
-    crit, findings = before_run(shot.params, args.integrator)
-    if crit.ratio > 1 and not args.allow_unstable:
-        error = next(f for f in findings if f.level == "error")
-        raise StabilityError(f"{error}; expected a smaller E2, --integrator newmark, or "
-                             "--allow-unstable")
-    warn(str(f) for f in findings if f.level != "note")
-    result = shot.run(integrator=args.integrator, host=args.host,
-                      track=outputs.tracked_series(sidecar is not None))
-    warn(result.warnings[len(shot.warnings):])
-    warn(str(f) for f in after_run(result))
-    needs_summary = outputs.groups & {"summary", "spectrum", "charts"}
-    summary = summarize(result) if needs_summary else None
-    info = {"version": __version__, "input": str(args.shot), "sha256": shot.source.sha256,
-            "command": " ".join(["airgun-xl", *sys.argv[1:]]),
-            "dt_crit": crit.dt_crit, "dt_ratio": crit.ratio}
-    if not args.reproducible:
-        info.update(kernel_seconds=result.history.kernel_seconds,
-                    run_seconds=time.perf_counter() - started)
-    warn(result.write(output, force=args.force, outputs=outputs, summary=summary, info=info))
-    if sidecar is not None:
-        write_history(result, sidecar)
-    print_summary(output, result, summary, outputs.stride(rows), sidecar)
+    options = Options(args.integrator, args.host, args.model, args.compare_models, args.force,
+                      args.allow_unstable, args.reproducible)
+    filled = fill_workbook(shot, output, outputs, options, warn, started)
+    print_summary(output, filled)
     return 0

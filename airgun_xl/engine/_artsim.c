@@ -172,7 +172,10 @@ static void finish_run(const Mitigator *s, Py_ssize_t bad, double *out)
     out[4] = s->max_Vobr;
     out[5] = s->min_Vobr;
     out[6] = s->max_temp;
+    out[7] = s->maxmitdef; /* the largest deflection: the maximum crush */
 }
+
+#define N_FINALS 8
 
 /* ArtSim's scheme: central differences with backward-difference damping velocities. */
 static void legacy_steps(const double *p, Py_ssize_t rows, Columns c, double *out)
@@ -294,7 +297,7 @@ static PyObject *run_kernel(PyObject *args, Stepper steps)
 {
     PyObject *params, *seq, *objs[N_COLUMNS];
     Py_buffer views[N_COLUMNS];
-    double p[P_COUNT], finals[7];
+    double p[P_COUNT], finals[N_FINALS];
     double *ptrs[N_COLUMNS];
     Py_ssize_t rows, i;
     int got = 0;
@@ -347,8 +350,8 @@ static PyObject *run_kernel(PyObject *args, Stepper steps)
     for (i = 0; i < N_COLUMNS; i++)
         if (views[i].obj != NULL)
             PyBuffer_Release(&views[i]);
-    return Py_BuildValue("ddndddd", finals[0], finals[1], (Py_ssize_t)finals[2], finals[3],
-                         finals[4], finals[5], finals[6]);
+    return Py_BuildValue("ddnddddd", finals[0], finals[1], (Py_ssize_t)finals[2], finals[3],
+                         finals[4], finals[5], finals[6], finals[7]);
 fail:
     for (i = 0; i < got; i++)
         if (views[i].obj != NULL)
@@ -364,6 +367,75 @@ static PyObject *py_legacy_kernel(PyObject *self, PyObject *args)
 static PyObject *py_newmark_kernel(PyObject *self, PyObject *args)
 {
     return run_kernel(args, newmark_steps);
+}
+
+/* Many shots of equal row count, for sweeps: params (n x P_COUNT), and for each shot its Y33
+ * row (n x rows) and its finals (n x N_FINALS, as the single-shot kernel returns them). The
+ * same stepping code as one shot, so the results are the same to the last bit. ``last``
+ * picks the displacement returned (the bird's last mass, Y33 or Y32/Y31). The GIL is
+ * released: two threads on two halves use both cores. */
+static PyObject *py_batch_kernel(PyObject *self, PyObject *args)
+{
+    PyObject *objs[4];
+    Py_buffer views[4];
+    Py_ssize_t rows, n, i, k;
+    int integrator, last, got;
+    double *scratch = NULL;
+
+    if (!PyArg_ParseTuple(args, "OniiOOO", &objs[0], &rows, &integrator, &last, &objs[1],
+                          &objs[2], &objs[3]))
+        return NULL;
+    if (last < 1 || last > 3)
+        return PyErr_Format(PyExc_ValueError, "last must be 1 (Y31), 2 (Y32) or 3 (Y33)");
+    for (got = 0; got < 4; got++) {
+        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (got ? PyBUF_WRITABLE : 0);
+        if (PyObject_GetBuffer(objs[got], &views[got], flags) < 0)
+            goto fail;
+        if (views[got].itemsize != sizeof(double) || strcmp(views[got].format, "d")) {
+            PyErr_SetString(PyExc_ValueError, "buffers must be float64");
+            got++;
+            goto fail;
+        }
+    }
+    n = views[0].len / (Py_ssize_t)(P_COUNT * sizeof(double));
+    if (rows < 0 || views[0].len != n * P_COUNT * (Py_ssize_t)sizeof(double)
+        || views[1].len < rows * (Py_ssize_t)sizeof(double)
+        || views[2].len < n * rows * (Py_ssize_t)sizeof(double)
+        || views[3].len < n * N_FINALS * (Py_ssize_t)sizeof(double)) {
+        PyErr_SetString(PyExc_ValueError, "buffer sizes do not match (n x 22, rows, n x rows, "
+                                          "n x 8)");
+        goto fail;
+    }
+    scratch = PyMem_RawMalloc((size_t)(rows > 0 ? rows : 1) * 4 * sizeof(double));
+    if (scratch == NULL) {
+        PyErr_NoMemory();
+        goto fail;
+    }
+    Py_BEGIN_ALLOW_THREADS
+    for (i = 0; i < n; i++) {
+        Columns c = {0};
+        double *row = (double *)views[2].buf + i * rows, **mine;
+        c.t = (double *)views[1].buf;
+        c.y1 = scratch;
+        c.y31 = scratch + rows;
+        c.y32 = scratch + 2 * rows;
+        c.y33 = scratch + 3 * rows;
+        mine = last == 1 ? &c.y31 : last == 2 ? &c.y32 : &c.y33;
+        *mine = row; /* the bird's last mass goes to the output */
+        for (k = 0; k < rows; k++)
+            row[k] = 0;
+        (integrator ? newmark_steps : legacy_steps)((double *)views[0].buf + i * P_COUNT, rows,
+                                                    c, (double *)views[3].buf + i * N_FINALS);
+    }
+    Py_END_ALLOW_THREADS
+    PyMem_RawFree(scratch);
+    for (i = 0; i < 4; i++)
+        PyBuffer_Release(&views[i]);
+    Py_RETURN_NONE;
+fail:
+    for (i = 0; i < got && i < 4; i++)
+        PyBuffer_Release(&views[i]);
+    return NULL;
 }
 
 /* Sheet XML for a run of numeric cells: the writer's fast path (columns_sheet.py). The text
@@ -441,6 +513,9 @@ static PyMethodDef methods[] = {
      "v31)\nRun ArtSim's position loop into the given float64 buffers; return (M1, m31)."},
     {"newmark_kernel", py_newmark_kernel, METH_VARARGS,
      "newmark_kernel(...): as legacy_kernel, with the average-acceleration Newmark scheme."},
+    {"batch_kernel", py_batch_kernel, METH_VARARGS,
+     "batch_kernel(params, rows, integrator, last, t, y, finals): many shots of equal rows "
+     "(integrator 0 legacy, 1 newmark; last 1..3: which of Y31..Y33 goes to y)."},
     {"render_cells", py_render_cells, METH_VARARGS,
      "render_cells(column, first_row, values) -> list of '<c r=...><v>...</v></c>' strings"},
     {NULL, NULL, 0, NULL}};

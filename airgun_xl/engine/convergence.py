@@ -5,13 +5,12 @@ times. Errors are taken against the finest level, and the finest level's own err
 estimated by Richardson extrapolation with the observed order.
 """
 import math
-import re
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import OptionError
+from ..units import parse_duration as _parse
 from .summary import summarize
 
 #: Figures compared across levels: (attribute of the level, label, unit).
@@ -28,22 +27,9 @@ QUANTITIES = (
 #: Default finest time step [s].
 FINEST = 5e-9
 
-_EXPONENTS = {"s": 0, "ms": -3, "us": -6, "µs": -6, "ns": -9}
-
-
 def parse_duration(text, option="--levels"):
-    """``"500ns"`` -> 5e-7 [s]; accepts s, ms, us, µs, ns, or a bare number of seconds."""
-    match = re.fullmatch(r"\s*([0-9.eE+-]+)\s*(s|ms|us|µs|ns)?\s*", str(text))
-    try:  # "500ns" -> float("500e-9"): the same double as typing 5e-7 in a cell
-        if match and match.group(2) not in (None, "s"):
-            value = float(f"{match.group(1)}e{_EXPONENTS[match.group(2)]}")
-        else:
-            value = float(match.group(1)) if match else None
-    except ValueError:
-        value = None
-    if value is None or not value > 0 or not math.isfinite(value):
-        raise OptionError(f"{option}: found {text!r}, expected durations such as 5us, 500ns")
-    return value
+    """A time step such as ``500ns`` [s] (see :func:`airgun_xl.units.parse_duration`)."""
+    return _parse(text, option)
 
 
 def default_ladder(dt, finest=FINEST):

@@ -35,6 +35,90 @@ def _offset(n, host):
     return round(n)  # Excel: nearest integer, halves to even (Python's round does the same)
 
 
+@dataclass
+class Stencils:
+    """Where the macro's filter reads and writes, for a run of ``n`` rows.
+
+    ``write[i]`` is the row a sample lands on, computed from Y33 at rows ``centre[i]``,
+    ``before[i]`` and ``after[i]`` (rows at or past ``n`` read as 0, empty cells).
+    """
+
+    centre: np.ndarray
+    before: np.ndarray
+    after: np.ndarray
+    write: np.ndarray
+    warnings: list
+
+
+def filter_stencils(n, samplerate, host="excel"):
+    """Follow the macro's cursor over ``n`` rows; see the module docstring.
+
+    Returns
+    -------
+    Stencils
+    """
+    if host not in HOSTS:
+        raise ValueError(f"host must be one of {HOSTS}")
+    empty = np.zeros(0, dtype=np.int64)
+    if samplerate < 1:  # a sample every row from a stencil inside one row: no filter at all
+        return Stencils(empty, empty, empty, empty, [
+            f"samplerate 1/(E2*E34) = {samplerate:.3g} is below one row: no filtered column"])
+    warnings = []
+    if not float(samplerate).is_integer():
+        warnings.append(
+            f"samplerate 1/(E2*E34) = {samplerate:.6g} is not a whole number of rows: the legacy "
+            f"filtered column is ill-defined (Excel rounds the offsets and drifts a row per "
+            f"sample; LibreOffice writes zeros); reproducing {host}")
+    # The loop visits `iterations` rows from index 0 (sheet row 2).
+    last = n - (2 * samplerate)  # `introwcount - (2 * samplerate)`, a double
+    iterations = max(0, math.floor(last) - 3 + 1)
+    period = math.floor(samplerate) + 1  # innercounter > samplerate, innercounter an Integer
+    up, both = _offset(-samplerate, host), _offset(2 * samplerate, host)
+    written = {}  # row written -> (centre, before, after); a later "" write empties it again
+    cursor = 0  # array index of the cursor
+    done = 0
+    top = -1  # highest row holding a sample
+    while done + period <= iterations:
+        if written and top >= cursor:  # rows written "" before the sample
+            for blank in range(cursor, cursor + period - 1):
+                written.pop(blank, None)
+        cursor += period - 1
+        done += period
+        r0 = cursor
+        r1 = r0 + up
+        r2 = r1 + both
+        r3 = r2 + up
+        if min(r1, r2, r3) < 0:  # index -1 is the header row: a type mismatch in the macro
+            warnings.append("the filter stencil reaches the header row, where the legacy macro "
+                            "stops with an error; later samples are left out")
+            break
+        written[r3] = (r0, r1, r2)
+        top = max(top, r3)
+        cursor = r3 + 1
+    rows = sorted(written)
+    parts = np.array([written[r] for r in rows], dtype=np.int64).reshape(-1, 3)
+    return Stencils(parts[:, 0], parts[:, 1], parts[:, 2], np.array(rows, dtype=np.int64),
+                    warnings)
+
+
+def filtered_values(y, delta, samplerate, stencils):
+    """The samples' values [m/s^2] for displacement rows ``y`` (1-D, or 2-D: one run a row).
+
+    ``scale * (un2 + un - 2 * un1)`` in the macro's order, so a 2-D batch gives each run's
+    values to the last bit.
+    """
+    scale = 1.0 / (delta * delta * samplerate * samplerate)
+    y = np.asarray(y)
+    n = y.shape[-1]
+    padded = np.concatenate((y, np.zeros(y.shape[:-1] + (1,))), axis=-1)  # row n reads 0
+
+    def at(rows):
+        return padded[..., np.minimum(rows, n)]
+
+    un1, un2, un = at(stencils.centre), at(stencils.before), at(stencils.after)
+    return scale * (un2 + un - 2 * un1)
+
+
 def filtered_acceleration(y33, delta, samplerate, host="excel"):
     """Resample the test-item acceleration as ArtSim's last loop does.
 
@@ -54,46 +138,6 @@ def filtered_acceleration(y33, delta, samplerate, host="excel"):
     Filtered
         The sample rows and values; ``warnings`` says when the column is ill-defined.
     """
-    if host not in HOSTS:
-        raise ValueError(f"host must be one of {HOSTS}")
-    n = len(y33)
-    warnings = []
-    # The loop visits `iterations` rows from index 0 (sheet row 2).
-    last = n - (2 * samplerate)  # `introwcount - (2 * samplerate)`, a double
-    iterations = max(0, math.floor(last) - 3 + 1)
-    period = math.floor(samplerate) + 1  # innercounter > samplerate, innercounter an Integer
-    up, both = _offset(-samplerate, host), _offset(2 * samplerate, host)
-    if samplerate < 1:  # a sample every row from a stencil inside one row: no filter at all
-        return Filtered(np.zeros(0, dtype=np.int64), np.zeros(0), [
-            f"samplerate 1/(E2*E34) = {samplerate:.3g} is below one row: no filtered column"])
-    if not float(samplerate).is_integer():
-        warnings.append(
-            f"samplerate 1/(E2*E34) = {samplerate:.6g} is not a whole number of rows: the legacy "
-            f"filtered column is ill-defined (Excel rounds the offsets and drifts a row per "
-            f"sample; LibreOffice writes zeros); reproducing {host}")
-    scale = 1.0 / (delta * delta * samplerate * samplerate)
-    written = {}  # array index -> value; a later "" write empties a cell again
-    cursor = 0  # array index of the cursor
-    done = 0
-    top = -1  # highest row holding a sample
-    while done + period <= iterations:
-        if written and top >= cursor:  # rows written "" before the sample
-            for blank in range(cursor, cursor + period - 1):
-                written.pop(blank, None)
-        cursor += period - 1
-        done += period
-        r0 = cursor
-        r1 = r0 + up
-        r2 = r1 + both
-        r3 = r2 + up
-        if min(r1, r2, r3) < 0:  # index -1 is the header row: a type mismatch in the macro
-            warnings.append("the filter stencil reaches the header row, where the legacy macro "
-                            "stops with an error; later samples are left out")
-            break
-        un1, un2, un = (y33[r] if r < n else 0.0 for r in (r0, r1, r2))  # below the data: 0
-        written[r3] = scale * (un2 + un - 2 * un1)
-        top = max(top, r3)
-        cursor = r3 + 1
-    rows = sorted(written)
-    values = [written[r] for r in rows]
-    return Filtered(np.array(rows, dtype=np.int64), np.array(values, dtype=float), warnings)
+    stencils = filter_stencils(len(y33), samplerate, host)
+    values = filtered_values(y33, delta, samplerate, stencils)
+    return Filtered(stencils.write, np.asarray(values, dtype=float), stencils.warnings)

@@ -22,12 +22,14 @@ KERNEL_PARAMS = ("m1", "m31", "m32", "m33", "k2", "k3", "delta", "rho", "rcone",
 @dataclass
 class KernelStats:
     """What the kernel saw, for the checks: final plastic front [m], largest and smallest
-    relative velocity while loading [m/s], largest crushed mass [kg]."""
+    relative velocity while loading [m/s], largest crushed mass [kg], largest mitigator
+    deflection (the maximum crush) [m]."""
 
     x_plastic: float
     max_relative_velocity: float
     min_relative_velocity: float
     max_crushed_mass: float
+    max_crush: float
 
 
 class DivergenceError(AirgunXlError):
@@ -110,13 +112,13 @@ def _run(kernel, name, p, track):
         np.full(rows, np.nan) if key in track else None for key in TRACKED]
     values = kernel_params(p) + [displacement_bound(p)]
     started = time.perf_counter()
-    final_m1, final_m31, bad, x_plastic, max_v, min_v, max_crushed = kernel(values, rows,
-                                                                            *arrays)
+    final_m1, final_m31, bad, x_plastic, max_v, min_v, max_crushed, max_crush = kernel(
+        values, rows, *arrays)
     elapsed = time.perf_counter() - started
     if bad >= 0:
         raise DivergenceError(name, p, bad, arrays)
     history = History(*arrays, final_m1, final_m31, elapsed)
-    history.stats = KernelStats(x_plastic, max_v, min_v, max_crushed)
+    history.stats = KernelStats(x_plastic, max_v, min_v, max_crushed, max_crush)
     return blank_left_out(history, p)
 
 

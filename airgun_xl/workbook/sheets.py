@@ -146,8 +146,14 @@ def _summary_rows(result, summary, timings):
             rows.append((f"OBR chain natural frequency {i + 1} ({label} masses)", f, "Hz",
                          "sqrt of the eigenvalues of M^-1 K of the bird's springs / 2 pi"
                          if i == 0 and label == "initial" else ""))
+    compared = timings.get("compared")
+    if compared is not None:
+        rows += [(f"Peak acceleration, {compared.model} model", compared.peak_kg, "kG",
+                  "the same shot with the other model (--compare-models)"),
+                 (f"Time of peak, {compared.model} model", compared.time_of_peak, "s", "")]
     rows += [
-        ("Model", p.model, "", ""),
+        ("Model", p.model + (" - the rigid-body model" if getattr(result, "model", "")
+                             == "rigid" else ""), "", ""),
         ("Integrator", result.integrator, "", ""),
         ("Time step", p.delta, "s", "E2"),
         ("Critical time step", timings.get("dt_crit"), "s",

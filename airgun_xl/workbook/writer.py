@@ -250,9 +250,11 @@ def write_workbook(result, path, force=False, outputs=Outputs(), summary=None, i
         if "spectrum" in outputs:
             refs.update(write_spectrum(wb, summary.spectrum, ColumnsWorksheet))
         if charts_ws is not None:
-            data = series_data(result, summary.spectrum)
+            data = series_data(result, summary.spectrum, info.get("compared"))
             placed = write_chart_data(wb, data, refs, ColumnsWorksheet)
-            add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]))
+            compared = info.get("compared")
+            labels = {"compared_kg": f"{compared.model} model"} if compared is not None else None
+            add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]), labels)
         if source is not None and source.outputs_block:
             write_cells(wb.add_worksheet(SHEET_NAME, worksheet_class=ColumnsWorksheet),
                         source.outputs_block)

@@ -1,0 +1,103 @@
+"""``airgun-xl design SHOT.xlsx --target-peak 12kG``: solve for the pulse a client asks for."""
+import dataclasses
+import time
+from pathlib import Path
+
+from ..design import VARIABLES, solve_peak, solve_peak_and_duration, variable
+from ..engine.integrators import INTEGRATORS
+from ..errors import OptionError
+from ..models import MODELS
+from ..outputs import from_sheet
+from ..pipeline import Options, fill_workbook
+from ..shot import Shot
+from ..units import parse_duration, parse_peak
+from .fill import print_summary
+
+
+def add_parser(sub):
+    p = sub.add_parser("design", help="find the v0 or geometry that gives a requested peak",
+                       description="Solve for the value of one parameter (two with "
+                                   "--target-duration) that gives the requested peak "
+                                   "acceleration of the test item, and write the designed "
+                                   "shot as a filled workbook.")
+    p.add_argument("shot", metavar="SHOT.xlsx")
+    p.add_argument("--target-peak", required=True, metavar="PEAK",
+                   help="requested peak: 12kG, 11750g or 1.2e5m/s2")
+    p.add_argument("--target-duration", metavar="DURATION",
+                   help="requested pulse duration (>= 10%% of peak): 5ms, 4500us; needs two "
+                        "--vary")
+    p.add_argument("--vary", action="append", metavar="CELL",
+                   help=f"parameter to solve for: {', '.join(VARIABLES)} (A28: A28..A30 "
+                        "together, the default)")
+    p.add_argument("--range", metavar="LO:HI",
+                   help="search range of the (first) varied parameter, in its unit")
+    p.add_argument("--filtered", action="store_true", help="match the filtered peak")
+    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
+    p.add_argument("--model", choices=MODELS, default="4-mass")
+    p.add_argument("-o", "--output", metavar="OUT.xlsx",
+                   help="designed shot, filled (default: SHOT.design.xlsx)")
+    p.add_argument("--force", action="store_true")
+    p.set_defaults(run=run)
+
+
+def _range(text):
+    try:
+        lo, hi = (float(v) for v in text.split(":"))
+    except (ValueError, AttributeError):
+        lo = hi = float("nan")
+    if not lo < hi:
+        raise OptionError(f"--range: found {text!r}, expected LO:HI with LO < HI")
+    return lo, hi
+
+
+def run(args):
+    from . import warn
+
+    target = parse_peak(args.target_peak)
+    duration = parse_duration(args.target_duration) if args.target_duration else None
+    names = args.vary or ["A28"]
+    variables = [variable(n) for n in names]
+    if duration is not None and len(variables) != 2:
+        raise OptionError("--target-duration: found one --vary, expected two (the first meets "
+                          "the peak, the second the duration)")
+    if duration is None and len(variables) != 1:
+        raise OptionError("--vary: found two parameters, expected one (or add "
+                          "--target-duration)")
+    bounds = _range(args.range) if args.range else None
+    shot = Shot.from_workbook(args.shot)
+    shot_path = Path(args.shot)
+    output = Path(args.output) if args.output else shot_path.with_name(
+        shot_path.stem + ".design.xlsx")
+    started = time.perf_counter()
+    if duration is None:
+        design = solve_peak(shot.params, target, variables[0], args.filtered, args.integrator,
+                            args.model, bounds)
+    else:
+        design = solve_peak_and_duration(shot.params, target, duration, *variables,
+                                         args.filtered, args.integrator, args.model)
+    solve_seconds = time.perf_counter() - started
+    for var, value in zip(design.variables, design.values):
+        print(f"{var.cell}{'..A30' if var.cell == 'A28' else ''} = {value:.6g} {var.unit}")
+    print(f"  achieved peak {design.peak_kg:.5f} kG (target {target:.5f} kG), pulse "
+          f"{design.duration * 1e3:.4f} ms"
+          + (f" (target {duration * 1e3:.4f} ms)" if duration is not None else ""))
+    print(f"  {design.evaluations} simulations in {solve_seconds:.2f} s")
+    warn(design.warnings)
+    designed = with_cells(shot, design)
+    outputs = from_sheet(shot.source.outputs_block)
+    options = Options(args.integrator, "excel", args.model, False, args.force)
+    filled = fill_workbook(designed, output, outputs, options, warn)
+    print_summary(output, filled)
+    return 0
+
+
+def with_cells(shot, design):
+    """The shot with the solved values in their cells (as constants) and in its parameters."""
+    block = dict(shot.source.block)
+    for var, value in zip(design.variables, design.values):
+        for address in var.cells:
+            from openpyxl.utils.cell import coordinate_to_tuple
+
+            block[coordinate_to_tuple(address)] = (float(value), None)
+    source = dataclasses.replace(shot.source, block=block)
+    return dataclasses.replace(shot, params=design.params, source=source)

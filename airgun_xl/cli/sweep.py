@@ -1,0 +1,89 @@
+"""``airgun-xl sweep SHOT.xlsx --vary A28=100:260:161``: many shots at once."""
+import sys
+import time
+from pathlib import Path
+
+from ..engine.integrators import INTEGRATORS
+from ..errors import OptionError
+from ..models import MODELS
+from ..shot import Shot
+from ..sweeps import grid, monte_carlo, parse_sd, parse_vary, spread
+from ..workbook.atomic import check_output
+from ..workbook.sweep import write_sweep
+
+
+def add_parser(sub):
+    p = sub.add_parser("sweep", help="run a grid of shots, or a Monte Carlo over uncertain "
+                                     "inputs",
+                       description="Evaluate a grid of shots (--vary, several make a grid) or "
+                                   "a Monte Carlo (--mc N with --sd) with the batch kernel on "
+                                   "both cores; write the headline figures per shot and charts.")
+    p.add_argument("shot", metavar="SHOT.xlsx")
+    p.add_argument("--vary", action="append", metavar="CELL=LO:HI:N", default=[],
+                   help="a parameter cell and its values, e.g. A28=100:260:161")
+    p.add_argument("--mc", metavar="N", help="Monte Carlo: this many shots")
+    p.add_argument("--sd", action="append", metavar="CELL=SD[%]", default=[],
+                   help="spread of an uncertain input, e.g. E40=3%% (Monte Carlo)")
+    p.add_argument("--seed", type=int, default=None, help="random seed (Monte Carlo)")
+    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
+    p.add_argument("--model", choices=MODELS, default="4-mass")
+    p.add_argument("-o", "--output", metavar="OUT.xlsx",
+                   help="table and charts (default: SHOT.sweep.xlsx)")
+    p.add_argument("--force", action="store_true")
+    p.set_defaults(run=run)
+
+
+def _progress_bar(total):
+    """A tqdm bar on a terminal; nothing when stderr is not a TTY (logs, CI)."""
+    if not sys.stderr.isatty():
+        return None, None
+    from tqdm import tqdm
+
+    bar = tqdm(total=total, unit="shot", file=sys.stderr)
+    return bar, bar.update
+
+
+def run(args):
+    shot = Shot.from_workbook(args.shot)
+    varies = [parse_vary(v) for v in args.vary]
+    sds = [parse_sd(s) for s in args.sd]
+    if args.mc is not None:
+        try:
+            n = int(args.mc)
+        except ValueError:
+            n = 0
+        if n < 2 or not sds:
+            raise OptionError(f"--mc: found {args.mc!r}{'' if sds else ' without --sd'}, "
+                              "expected a number of shots of at least 2, with --sd")
+        if varies:
+            raise OptionError("--vary: found a grid with --mc, expected one or the other")
+    elif not varies:
+        raise OptionError("--vary: found none, expected CELL=LO:HI:N (or --mc N with --sd)")
+    shot_path = Path(args.shot)
+    output = Path(args.output) if args.output else shot_path.with_name(
+        shot_path.stem + ".sweep.xlsx")
+    check_output(output, args.force, inputs=[args.shot])
+    total = n if args.mc is not None else 1
+    for _, _, values in varies:
+        total *= len(values)
+    bar, progress = _progress_bar(total)
+    started = time.perf_counter()
+    try:
+        if args.mc is not None:
+            result = monte_carlo(shot.params, sds, n, args.seed, args.integrator, args.model,
+                                 progress)
+        else:
+            result = grid(shot.params, varies, args.integrator, args.model, progress)
+    finally:
+        if bar is not None:
+            bar.close()
+    seconds = time.perf_counter() - started
+    stats = spread(result.figures[:, 0])
+    write_sweep(result, output, args.force, stats if args.mc is not None else None)
+    steps = total * (shot.params.rows - 2)
+    print(f"wrote {output}: {total:,} shots in {seconds:.2f} s ({steps / seconds:.3g} "
+          f"shot-steps/s); {int(result.diverged.sum())} diverged, "
+          f"{int(result.invalid.sum())} invalid")
+    print(f"  peak {stats['mean']:.4f} kG mean, sd {stats['sd']:.4f}, 5-95% "
+          f"{stats['p5']:.4f}-{stats['p95']:.4f} kG")
+    return 0

@@ -1,0 +1,211 @@
+"""Test design: find the parameter value that gives a client's requested pulse.
+
+The peak of the test item's acceleration is a piecewise-smooth function of a parameter (the
+OBR's ringing shifts which oscillation is highest), so the solver first scans the parameter's
+range in one batch run, then refines the first bracket where the peak crosses the target
+with scipy's brentq, which needs only a sign change, not smoothness.
+"""
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .engine.batch import run_batch
+from .engine.legacy_law import CRUSH_FIT_RANGE
+from .errors import AirgunXlError, OptionError
+from .models import apply_model
+
+
+class DesignError(AirgunXlError):
+    """The target cannot be met: it lies outside what the varied parameter can reach."""
+
+
+@dataclass(frozen=True)
+class Variable:
+    """A parameter the design may vary: its cells, the fields they fill, and a search range
+    (absolute, or relative to the sheet's value when ``relative``)."""
+
+    cell: str
+    label: str
+    unit: str
+    fields: tuple
+    cells: tuple
+    range: tuple
+    relative: bool = False
+
+    def value(self, p):
+        return getattr(p, self.fields[0])
+
+    def bounds(self, p):
+        lo, hi = self.range
+        return (lo * self.value(p), hi * self.value(p)) if self.relative else (lo, hi)
+
+    def apply(self, p, x):
+        return p.replace(**{f: float(x) for f in self.fields})
+
+
+VARIABLES = {
+    "A28": Variable("A28", "v0", "m/s", ("v31", "v32", "v33"), ("A28", "A29", "A30"),
+                    (10.0, 260.0)),
+    "E13": Variable("E13", "E13", "m", ("rcone",), ("E13",), (0.5, 2.0), True),
+    "E16": Variable("E16", "E16", "m", ("hcone",), ("E16",), (0.2, 3.0), True),
+    "E40": Variable("E40", "E40", "Pa", ("sigmay",), ("E40",), (0.5, 2.0), True),
+    "A2": Variable("A2", "A2", "kg", ("m1",), ("A2",), (0.25, 4.0), True),
+}
+
+#: Points of the first scan over a parameter's range.
+SCAN_POINTS = 25
+
+
+def variable(name):
+    key = name.strip().upper()
+    if key in ("A29", "A30", "V0"):
+        key = "A28"
+    if key not in VARIABLES:
+        raise OptionError(f"--vary: found {name!r}, expected one of {', '.join(VARIABLES)}")
+    return VARIABLES[key]
+
+
+@dataclass
+class Design:
+    """A solved design."""
+
+    variables: list
+    values: list
+    params: object
+    peak_kg: float
+    duration: float
+    evaluations: int
+    warnings: list = field(default_factory=list)
+
+
+class _Objective:
+    """Figures of the shot at parameter values, counting simulations."""
+
+    def __init__(self, p, integrator, model, filtered):
+        self.p, self.integrator, self.model = p, integrator, model
+        self.column = 2 if filtered else 0
+        self.evaluations = 0
+
+    def figures(self, params_list):
+        self.evaluations += len(params_list)
+        batch = run_batch([apply_model(q, self.model) for q in params_list], self.integrator)
+        return batch.figures
+
+    def peak(self, params):
+        return float(self.figures([params])[0, self.column])
+
+
+def _bracket(xs, ys, target):
+    """First consecutive pair of scan points whose values straddle the target."""
+    for i in range(len(xs) - 1):
+        a, b = ys[i] - target, ys[i + 1] - target
+        if np.isfinite(a) and np.isfinite(b) and (a == 0 or a * b < 0):
+            return xs[i], xs[i + 1]
+    return None
+
+
+def _span_message(var, p, xs, ys, what):
+    finite = ys[np.isfinite(ys)]
+    lo, hi = var.bounds(p)
+    held = "" if var.cell == "E13" else f"with E13 = {p.rcone:.3g} m "
+    if not len(finite):
+        return f"{held}every shot diverged for {var.label} in {lo:.4g}-{hi:.4g} {var.unit}"
+    return (f"{held}the {what} spans {finite.min():.3g}-{finite.max():.3g} kG for {var.label} "
+            f"in {lo:.4g}-{hi:.4g} {var.unit}")
+
+
+def solve_peak(p, target_kg, var, filtered=False, integrator="legacy", model="4-mass",
+               bounds=None, objective=None):
+    """The value of ``var`` that gives a peak of ``target_kg``.
+
+    Parameters
+    ----------
+    p : airgun_xl.params.ShotParams
+    target_kg : float
+        Requested peak [kG].
+    var : Variable
+    filtered : bool
+        Match the filtered peak instead of the raw one.
+    bounds : (float, float), optional
+        Search range; :attr:`Variable.range` by default.
+
+    Returns
+    -------
+    Design
+
+    Raises
+    ------
+    DesignError
+        When the peak never reaches the target over the range; the message gives the span.
+    """
+    from scipy.optimize import brentq
+
+    obj = objective or _Objective(p, integrator, model, filtered)
+    lo, hi = bounds or var.bounds(p)
+    xs = np.linspace(lo, hi, SCAN_POINTS)
+    ys = obj.figures([var.apply(p, x) for x in xs])[:, obj.column]
+    bracket = _bracket(xs, ys, target_kg)
+    if bracket is None:
+        what = "filtered peak" if filtered else "peak"
+        raise DesignError(f"a {'filtered ' if filtered else ''}peak of {target_kg:.5g} kG is "
+                          f"out of reach: {_span_message(var, p, xs, ys, what)}")
+    x = brentq(lambda v: obj.peak(var.apply(p, v)) - target_kg, *bracket, xtol=1e-12,
+               rtol=1e-12, maxiter=200)
+    solved = var.apply(p, x)
+    figs = obj.figures([solved])[0]
+    design = Design([var], [x], solved, float(figs[obj.column]), float(figs[3]),
+                    obj.evaluations)
+    design.warnings = design_warnings(solved, target_kg, design.peak_kg)
+    return design
+
+
+def solve_peak_and_duration(p, target_kg, target_s, var1, var2, filtered=False,
+                            integrator="legacy", model="4-mass"):
+    """Two parameters for a peak and a pulse duration: ``var1`` meets the peak for each
+    value of ``var2``, and brentq on ``var2`` meets the duration."""
+    from scipy.optimize import brentq
+
+    obj = _Objective(p, integrator, model, filtered)
+
+    def duration_at(v2):
+        design = solve_peak(var2.apply(p, v2), target_kg, var1, filtered, integrator, model,
+                            objective=obj)
+        return design.duration, design
+
+    lo, hi = var2.bounds(p)
+    xs = np.linspace(lo, hi, 9)
+    ds = []
+    for x in xs:
+        try:
+            ds.append(duration_at(x)[0])
+        except DesignError:
+            ds.append(math.nan)
+    ds = np.array(ds)
+    bracket = _bracket(xs, ds, target_s)
+    if bracket is None:
+        finite = ds[np.isfinite(ds)]
+        span = (f"{finite.min() * 1e3:.3g}-{finite.max() * 1e3:.3g} ms" if len(finite)
+                else "nothing")
+        raise DesignError(f"a pulse of {target_s * 1e3:.4g} ms at {target_kg:.5g} kG is out "
+                          f"of reach: varying {var2.label} over {lo:.4g}-{hi:.4g} {var2.unit}"
+                          f" gives {span}")
+    x2 = brentq(lambda v: duration_at(v)[0] - target_s, *bracket, xtol=1e-12, rtol=1e-9,
+                maxiter=100)
+    _, inner = duration_at(x2)
+    inner.variables, inner.values = [var1, var2], [inner.values[0], x2]
+    inner.evaluations = obj.evaluations
+    return inner
+
+
+def design_warnings(p, target_kg, achieved):
+    """Where the solution stretches the model."""
+    out = []
+    if abs(achieved - target_kg) > 1e-3 * abs(target_kg):
+        out.append(f"the peak jumps across the target here: {achieved:.5g} kG is the closest "
+                   "this parameter reaches")
+    if p.v31 - p.v1 > CRUSH_FIT_RANGE[1]:
+        out.append(f"A28: the solution's impact speed {p.v31 - p.v1:.4g} m/s is beyond "
+                   f"{CRUSH_FIT_RANGE[1]:g} m/s, where the crush-factor polynomial is "
+                   "extrapolated")
+    return out

@@ -1,0 +1,117 @@
+"""Many shots at once: the headline figures of each, for sweeps, Monte Carlo and design.
+
+Shots with the same time grid run in the compiled batch kernel (the single-shot stepping code
+in a loop, the GIL released) on two threads; the derived figures are computed for a whole
+block of shots with the same numpy expressions as one shot's. Each figure therefore equals
+the single-shot figure (:func:`airgun_xl.engine.summary.summarize`) to the last bit.
+"""
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._artsim import batch_kernel
+from .derived import KG_DIVISOR
+from .filtered import filter_stencils, filtered_values
+from .integrators import displacement_bound, kernel_params
+from .summary import KG, PULSE_FRACTION
+
+#: The figures of each shot, in column order of :attr:`Batch.figures`.
+FIGURES = ("peak_kg", "time_of_peak", "filtered_peak_kg", "pulse_duration", "max_crush")
+
+_INTEGRATOR_ID = {"legacy": 0, "newmark": 1}
+BLOCK = 64  # shots post-processed at a time: bounds memory at rows x 64 doubles a block
+
+
+@dataclass
+class Batch:
+    """Figures of many shots: ``figures[i, j]`` is shot i's ``FIGURES[j]`` (NaN when the shot
+    diverged); ``diverged[i]`` says so."""
+
+    figures: np.ndarray
+    diverged: np.ndarray
+
+    def column(self, name):
+        return self.figures[:, FIGURES.index(name)]
+
+
+def _grid_key(p):
+    return p.delta, p.max_time, p.filter_frequency, p.bird_masses
+
+
+def run_batch(params, integrator="legacy", host="excel", threads=2, progress=None):
+    """Headline figures of each of ``params`` (a list of :class:`ShotParams`).
+
+    Parameters
+    ----------
+    progress : callable, optional
+        Called with the number of shots finished after each block.
+
+    Returns
+    -------
+    Batch
+    """
+    n = len(params)
+    figures = np.full((n, len(FIGURES)), np.nan)
+    diverged = np.zeros(n, dtype=bool)
+    groups = {}
+    for i, p in enumerate(params):
+        groups.setdefault(_grid_key(p), []).append(i)
+    pool = ThreadPoolExecutor(threads) if threads > 1 else None
+    try:
+        for indices in groups.values():
+            first = params[indices[0]]
+            stencils = filter_stencils(first.rows, first.samplerate, host)
+            for start in range(0, len(indices), BLOCK):
+                block = indices[start:start + BLOCK]
+                figs, bad = _run_block([params[i] for i in block], integrator, stencils, pool)
+                figures[block] = figs
+                diverged[block] = bad
+                if progress is not None:
+                    progress(len(block))
+    finally:
+        if pool is not None:
+            pool.shutdown()
+    return Batch(figures, diverged)
+
+
+def _run_block(block, integrator, stencils, pool):
+    p0 = block[0]
+    rows, m = p0.rows, len(block)
+    matrix = np.array([kernel_params(p) + [displacement_bound(p)] for p in block])
+    y = np.empty((m, rows))
+    finals = np.empty((m, 8))
+    halves = [(0, m // 2), (m // 2, m)] if pool is not None and m > 1 else [(0, m)]
+    times = [np.empty(rows) for _ in halves]
+
+    def work(half, t):
+        a, b = half
+        batch_kernel(matrix[a:b], rows, _INTEGRATOR_ID[integrator], p0.bird_masses, t, y[a:b],
+                     finals[a:b])
+
+    if pool is not None and len(halves) > 1:
+        list(pool.map(work, halves, times))
+    else:
+        work(halves[0], times[0])
+    t = times[0]
+    bad = finals[:, 2] >= 0
+    out = np.full((m, len(FIGURES)), np.nan)
+    if rows >= 3:
+        # as derived.test_item_derivatives, one shot a row
+        accel = (1.0 / (p0.delta * p0.delta)) * (y[:, 2:] + y[:, :-2] - 2 * y[:, 1:-1])
+        kg = accel / KG_DIVISOR
+        i_peak = np.argmax(kg, axis=1)
+        peak = kg[np.arange(m), i_peak]
+        out[:, 0] = peak
+        out[:, 1] = t[1 + i_peak]
+        above = kg >= (PULSE_FRACTION * peak)[:, None]
+        first = np.argmax(above, axis=1)
+        last = kg.shape[1] - 1 - np.argmax(above[:, ::-1], axis=1)
+        out[:, 3] = np.where(peak > 0, t[1 + last] - t[1 + first], 0.0)
+    inside = stencils.write < rows
+    if inside.any():
+        values = filtered_values(y, p0.delta, p0.samplerate, stencils)[:, inside]
+        out[:, 2] = np.max(values / KG, axis=1)
+    out[:, 4] = finals[:, 7]
+    out[bad] = np.nan
+    return out, bad

@@ -1,0 +1,113 @@
+"""Grids and Monte Carlo over a shot's parameters, run with the batch kernel."""
+import itertools
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from .cells import BY_ADDRESS, CELLS
+from .engine.batch import FIGURES, run_batch
+from .errors import AirgunXlError, OptionError
+from .models import apply_model
+
+#: Cells whose value moves several fields: the bird's velocity goes to A28..A30 together.
+GROUPED = {"A28": ("v31", "v32", "v33")}
+
+
+def fields_of(cell, option):
+    cell = cell.strip().upper()
+    if cell in GROUPED:
+        return cell, GROUPED[cell]
+    if cell not in BY_ADDRESS:
+        raise OptionError(f"{option}: found {cell!r}, expected a parameter cell such as A28, "
+                          f"E40 ({', '.join(c.address for c in CELLS)})")
+    return cell, (BY_ADDRESS[cell].name,)
+
+
+def parse_vary(text):
+    """``A28=100:260:161`` -> (cell, fields, values)."""
+    match = re.fullmatch(r"\s*([A-Za-z]+[0-9]+)\s*=\s*([^:]+):([^:]+):(\d+)\s*", text)
+    try:
+        lo, hi, n = float(match.group(2)), float(match.group(3)), int(match.group(4))
+    except (AttributeError, ValueError):
+        n = 0
+    if n < 1:
+        raise OptionError(f"--vary: found {text!r}, expected CELL=LO:HI:N such as "
+                          "A28=100:260:161")
+    cell, fields = fields_of(match.group(1), "--vary")
+    return cell, fields, np.linspace(lo, hi, n)
+
+
+def parse_sd(text):
+    """``E40=3%`` (relative) or ``E40=8e5`` (absolute) -> (cell, fields, sd, relative)."""
+    match = re.fullmatch(r"\s*([A-Za-z]+[0-9]+)\s*=\s*([0-9.eE+-]+)\s*(%?)\s*", text)
+    try:
+        sd = float(match.group(2))
+    except (AttributeError, ValueError):
+        sd = -1.0
+    if not sd >= 0:
+        raise OptionError(f"--sd: found {text!r}, expected CELL=SD or CELL=SD% such as E40=3%")
+    cell, fields = fields_of(match.group(1), "--sd")
+    return cell, fields, sd / 100 if match.group(3) else sd, bool(match.group(3))
+
+
+@dataclass
+class SweepResult:
+    cells: list  # the varied cells
+    values: np.ndarray  # shots x cells
+    figures: np.ndarray  # shots x FIGURES
+    diverged: np.ndarray
+    invalid: np.ndarray  # shots whose sampled values were not a valid shot
+
+
+def _set(p, fields, value):
+    return p.replace(**{f: float(value) for f in fields})
+
+
+def _evaluate(p, varied, rows_values, integrator, model, progress):
+    params, invalid = [], np.zeros(len(rows_values), dtype=bool)
+    for i, row in enumerate(rows_values):
+        q = p
+        try:
+            for (cell, fields), value in zip(varied, row):
+                q = _set(q, fields, value)
+            params.append(apply_model(q, model))
+        except AirgunXlError:
+            invalid[i] = True
+    batch = run_batch(params, integrator, progress=progress)
+    figures = np.full((len(rows_values), len(FIGURES)), np.nan)
+    diverged = np.zeros(len(rows_values), dtype=bool)
+    figures[~invalid] = batch.figures
+    diverged[~invalid] = batch.diverged
+    return figures, diverged, invalid
+
+
+def grid(p, varies, integrator="legacy", model="4-mass", progress=None):
+    """Every combination of the ``varies`` values (from :func:`parse_vary`)."""
+    varied = [(cell, fields) for cell, fields, _ in varies]
+    combos = np.array(list(itertools.product(*(v for _, _, v in varies))))
+    figures, diverged, invalid = _evaluate(p, varied, combos, integrator, model, progress)
+    return SweepResult([c for c, _ in varied], combos, figures, diverged, invalid)
+
+
+def monte_carlo(p, sds, n, seed=None, integrator="legacy", model="4-mass", progress=None):
+    """``n`` shots with the ``sds`` cells drawn from normal distributions around the sheet's
+    values (a draw that is not a valid shot, e.g. a negative mass, is counted as invalid)."""
+    rng = np.random.default_rng(seed)
+    columns = []
+    for cell, fields, sd, relative in sds:
+        mean = getattr(p, fields[0])
+        columns.append(rng.normal(mean, sd * abs(mean) if relative else sd, n))
+    samples = np.column_stack(columns) if columns else np.zeros((n, 0))
+    varied = [(cell, fields) for cell, fields, _, _ in sds]
+    figures, diverged, invalid = _evaluate(p, varied, samples, integrator, model, progress)
+    return SweepResult([c for c, _ in varied], samples, figures, diverged, invalid)
+
+
+def spread(values):
+    """Mean, standard deviation, 5th and 95th percentiles of the finite values."""
+    v = values[np.isfinite(values)]
+    if not len(v):
+        return dict(mean=np.nan, sd=np.nan, p5=np.nan, p95=np.nan, n=0)
+    return dict(mean=float(v.mean()), sd=float(v.std(ddof=1)) if len(v) > 1 else 0.0,
+                p5=float(np.percentile(v, 5)), p95=float(np.percentile(v, 95)), n=len(v))
