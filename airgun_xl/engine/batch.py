@@ -20,7 +20,7 @@ from .summary import KG, PULSE_FRACTION
 FIGURES = ("peak_kg", "time_of_peak", "filtered_peak_kg", "pulse_duration", "max_crush")
 
 _INTEGRATOR_ID = {"legacy": 0, "newmark": 1}
-BLOCK = 64  # shots post-processed at a time: bounds memory at rows x 64 doubles a block
+BLOCK = 128  # shots a block: bounds memory at rows x 128 doubles (12 MB for shot A)
 
 
 @dataclass
@@ -79,21 +79,24 @@ def _run_block(block, integrator, stencils, pool):
     p0 = block[0]
     rows, m = p0.rows, len(block)
     matrix = np.array([kernel_params(p) + [displacement_bound(p)] for p in block])
-    y = np.empty((m, rows))
-    finals = np.empty((m, 8))
     halves = [(0, m // 2), (m // 2, m)] if pool is not None and m > 1 else [(0, m)]
-    times = [np.empty(rows) for _ in halves]
 
-    def work(half, t):
+    def work(half):  # kernel and figures of half the block, on one thread
         a, b = half
-        batch_kernel(matrix[a:b], rows, _INTEGRATOR_ID[integrator], p0.bird_masses, t, y[a:b],
-                     finals[a:b])
+        y = np.empty((b - a, rows))
+        finals = np.empty((b - a, 8))
+        t = np.empty(rows)
+        batch_kernel(matrix[a:b], rows, _INTEGRATOR_ID[integrator], p0.bird_masses, t, y,
+                     finals)
+        return _figures(y, t, finals, p0, stencils)
 
-    if pool is not None and len(halves) > 1:
-        list(pool.map(work, halves, times))
-    else:
-        work(halves[0], times[0])
-    t = times[0]
+    parts = list(pool.map(work, halves)) if len(halves) > 1 else [work(halves[0])]
+    return (np.concatenate([f for f, _ in parts]), np.concatenate([b for _, b in parts]))
+
+
+def _figures(y, t, finals, p0, stencils):
+    """FIGURES of each row of ``y`` (the bird's last mass), as one shot's are computed."""
+    m, rows = y.shape
     bad = finals[:, 2] >= 0
     out = np.full((m, len(FIGURES)), np.nan)
     if rows >= 3:
