@@ -1,7 +1,6 @@
 """A fill from start to finish, shared by ``fill`` and ``design``: check, run, summarize,
 write the workbook and the sidecar. Reports go through a ``warn`` callback."""
 import dataclasses
-import sys
 import time
 
 from . import __version__
@@ -21,6 +20,8 @@ class Options:
     force: bool = False
     allow_unstable: bool = False
     reproducible: bool = False
+    track_all: bool = False  # record every step value (an archived run keeps them all)
+    command: tuple = ()  # the command line, for provenance
 
 
 @dataclasses.dataclass
@@ -56,7 +57,8 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
                              "--allow-unstable")
     warn(str(f) for f in findings if f.level != "note")
     result = model_shot.run(integrator=options.integrator, host=options.host,
-                            track=outputs.tracked_series(sidecar is not None))
+                            track=outputs.tracked_series(sidecar is not None
+                                                         or options.track_all))
     warn(result.warnings[len(shot.warnings):])
     warn(str(f) for f in after_run(result))
     compared = None
@@ -68,7 +70,7 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
     result.model = options.model
     needs_summary = outputs.groups & {"summary", "spectrum", "charts"}
     summary = summarize(result) if needs_summary else None
-    info = {"version": __version__, "command": " ".join(["airgun-xl", *sys.argv[1:]]),
+    info = {"version": __version__, "command": " ".join(options.command),
             "dt_crit": crit.dt_crit, "dt_ratio": crit.ratio, "compared": compared}
     if shot.source is not None:
         info.update(input=str(shot.source.path), sha256=shot.source.sha256)

@@ -9,7 +9,6 @@ Medians over N runs after a warm-up, with the machine they came from:
 """
 import argparse
 import statistics
-import subprocess
 import sys
 import tempfile
 import time

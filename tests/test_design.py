@@ -4,6 +4,7 @@ import math
 import numpy as np
 import openpyxl
 import pytest
+from conftest import TEMPLATE
 
 import airgun_xl
 from airgun_xl import Shot
@@ -13,10 +14,13 @@ from airgun_xl.engine.batch import FIGURES, run_batch
 from airgun_xl.engine.summary import summarize
 from airgun_xl.errors import OptionError
 from airgun_xl.models import apply_model
-from airgun_xl.stiffness import (LB_PER_IN, axial_stiffness_inch, damping_coefficient,
-                                 stiffness_from_frequency)
+from airgun_xl.stiffness import (
+    LB_PER_IN,
+    axial_stiffness_inch,
+    damping_coefficient,
+    stiffness_from_frequency,
+)
 from airgun_xl.units import parse_duration, parse_peak
-from conftest import TEMPLATE
 
 SHOT_A = airgun_xl.load(TEMPLATE).params  # dt = 0.5 us, as the acceptance asks
 

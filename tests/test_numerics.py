@@ -6,6 +6,7 @@ import shutil
 import numpy as np
 import openpyxl
 import pytest
+from conftest import TEMPLATE
 
 import airgun_xl
 from airgun_xl import Shot, ShotParams
@@ -14,7 +15,6 @@ from airgun_xl.engine.convergence import default_ladder, ladder, parse_duration
 from airgun_xl.engine.integrators import DivergenceError, run_legacy
 from airgun_xl.engine.stability import critical_time_step
 from airgun_xl.errors import OptionError
-from conftest import TEMPLATE
 
 SHOT_A = airgun_xl.load(TEMPLATE).params
 

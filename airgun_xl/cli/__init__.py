@@ -1,12 +1,13 @@
 """The ``airgun-xl`` command: parses arguments and hands off to one module per subcommand."""
 import argparse
+import os
 import sys
 
 from .. import __version__
 from ..errors import AirgunXlError, OptionError
-from . import check, convergence, design, fill, sweep, template
+from . import archive, check, convergence, design, diff, fill, sweep, template
 
-COMMANDS = (fill, check, convergence, design, sweep, template)
+COMMANDS = (fill, diff, archive, check, convergence, design, sweep, template)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -32,6 +33,7 @@ def main(argv=None):
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
+        args.argv = ["airgun-xl", *(sys.argv[1:] if argv is None else argv)]
         if args.command is None:
             parser.print_help()
             return 2
@@ -42,6 +44,9 @@ def main(argv=None):
     except KeyboardInterrupt:
         print("airgun-xl: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # e.g. `airgun-xl history | head`
+        sys.stdout = open(os.devnull, "w")
+        return 0
 
 
 def warn(messages):

@@ -85,7 +85,8 @@ def run(args):
     warn(design.warnings)
     designed = with_cells(shot, design)
     outputs = from_sheet(shot.source.outputs_block)
-    options = Options(args.integrator, "excel", args.model, False, args.force)
+    options = Options(args.integrator, "excel", args.model, False, args.force,
+                      command=tuple(args.argv))
     filled = fill_workbook(designed, output, outputs, options, warn)
     print_summary(output, filled)
     return 0

@@ -1,7 +1,10 @@
 """``airgun-xl fill SHOT.xlsx [-o OUT.xlsx] [--force] [...]``: run a shot into a new workbook."""
+import dataclasses
 import time
 from pathlib import Path
 
+from ..archive import ENV, archive_dir
+from ..archiving import archive_fill, now
 from ..engine.filtered import HOSTS
 from ..engine.integrators import INTEGRATORS
 from ..engine.summary import PULSE_FRACTION
@@ -45,6 +48,10 @@ def add_parser(sub):
     p.add_argument("--compare-models", action="store_true",
                    help="also run the other model; both curves in the acceleration chart and "
                         "both peaks in the Summary")
+    p.add_argument("--archive", metavar="DIR",
+                   help=f"also store the run as a new entry of this archive (default: "
+                        f"${ENV} when set)")
+    p.add_argument("--name", help="shot name in the archive (default: SHOT's file name)")
     p.add_argument("--reproducible", action="store_true",
                    help="leave run times out of the Summary, so equal inputs give equal bytes")
     p.set_defaults(run=run)
@@ -93,7 +100,16 @@ def run(args):
     outputs = from_sheet(shot.source.outputs_block).with_flags(
         args.only, args.no_charts, args.every, args.max_sheet_rows, args.sidecar)
     options = Options(args.integrator, args.host, args.model, args.compare_models, args.force,
-                      args.allow_unstable, args.reproducible)
+                      args.allow_unstable, args.reproducible, command=tuple(args.argv))
+    root = archive_dir(args.archive, required=False)
+    if root is not None:
+        outputs = dataclasses.replace(outputs, sidecar="never")  # the entry holds the history
+        options.track_all = True
+    started_at = now()
     filled = fill_workbook(shot, output, outputs, options, warn, started)
     print_summary(output, filled)
+    if root is not None:
+        entry = archive_fill(root, args.name or Path(args.shot).stem, shot, output, filled,
+                             options, started_at, time.perf_counter() - started)
+        print(f"  archived as {entry.ref} in {root}")
     return 0

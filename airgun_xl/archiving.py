@@ -1,0 +1,68 @@
+"""What a fill puts in the archive: inputs, outputs, history, figures and provenance."""
+import dataclasses
+import datetime
+import platform
+from importlib import metadata
+
+import numpy as np
+
+from . import __version__
+from .archive import Archive, safe_name
+from .cells import CELLS
+from .workbook.sidecar import have_parquet, write_history
+
+LIBRARIES = ("numpy", "pandas", "openpyxl", "xlsxwriter", "formulas", "python-calamine",
+             "scipy", "pyarrow", "matplotlib")
+
+
+def _versions():
+    out = {"python": platform.python_version(), "airgun-xl": __version__}
+    for name in LIBRARIES:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = None
+    return out
+
+
+def _plain(value):
+    if isinstance(value, (np.floating, np.integer)):
+        return value.item()
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    return value
+
+
+def archive_fill(root, name, shot, output, filled, options, started_at, seconds):
+    """Store a finished fill as one archive entry; return the Entry."""
+    p, result, s = shot.params, filled.result, filled.summary
+    params = [{"cell": c.address, "label": c.label, "value": getattr(p, c.name),
+               "unit": c.unit, "meaning": c.meaning} for c in CELLS]
+    summary = {}
+    if s is not None:
+        summary = {k: _plain(v) for k, v in dataclasses.asdict(s).items() if k != "spectrum"}
+        summary["dominant_frequencies_hz"] = list(s.spectrum.peaks)
+    summary.update(rows=result.rows, peak_kg=_plain(result.peak_kg),
+                   time_of_peak=_plain(result.time_of_peak))
+    provenance = {"engine": __version__, "versions": _versions(),
+                  "input": str(shot.source.path) if shot.source else None,
+                  "input_sha256": shot.source.sha256 if shot.source else None,
+                  "started": started_at, "run_seconds": seconds,
+                  "command": list(options.command), "integrator": options.integrator,
+                  "model": options.model, "host": options.host, "stride": filled.stride}
+    files = {"output.xlsx": output}
+    if shot.source is not None:
+        files["input" + shot.source.path.suffix.lower()] = shot.source.path
+    history = "history.parquet" if have_parquet() else "history.csv"
+    index = {"input_sha256": provenance["input_sha256"], "v0": p.v31, "delta": p.delta,
+             "max_time": p.max_time, "sigmay": p.sigmay, "rcone": p.rcone,
+             "peak_kg": summary["peak_kg"], "integrator": options.integrator,
+             "model": options.model, "engine": __version__}
+    return Archive(root).add(
+        safe_name(name), files,
+        {"params.json": params, "summary.json": summary, "provenance.json": provenance},
+        index, {history: lambda path: write_history(result, path)})
+
+
+def now():
+    return datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")

@@ -1,0 +1,125 @@
+"""``history``, ``show``, ``compare`` and ``archive verify``: find archived shots again."""
+import json
+
+from ..archive import ENV, Archive, archive_dir
+from ..diff import diff_histories, format_report
+
+
+def add_parser(sub):
+    h = sub.add_parser("history", help="list the shots of an archive",
+                       description=f"List archived runs with key inputs and peak (DIR defaults "
+                                   f"to ${ENV}).")
+    h.add_argument("dir", nargs="?", metavar="DIR")
+    h.add_argument("--shot", metavar="NAME")
+    h.add_argument("--since", metavar="DATE", help="ISO date, e.g. 2026-11-01")
+    h.add_argument("--json", action="store_true")
+    h.set_defaults(run=run_history)
+    s = sub.add_parser("show", help="print one archived run")
+    s.add_argument("entry", metavar="ENTRY", help="SHOT, SHOT@VERSION or #ID")
+    s.add_argument("--archive", metavar="DIR")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(run=run_show)
+    c = sub.add_parser("compare", help="diff two archived runs: inputs, then outputs")
+    c.add_argument("entry1", metavar="ENTRY1")
+    c.add_argument("entry2", metavar="ENTRY2")
+    c.add_argument("--archive", metavar="DIR")
+    c.add_argument("--rtol", type=float, default=1e-12)
+    c.set_defaults(run=run_compare)
+    a = sub.add_parser("archive", help="archive maintenance: verify")
+    a.add_argument("action", choices=["verify"])
+    a.add_argument("dir", nargs="?", metavar="DIR")
+    a.set_defaults(run=run_verify)
+
+
+def _archive(given):
+    root = archive_dir(given)
+    return Archive(root)
+
+
+def run_history(args):
+
+
+    if args.since:
+        import datetime
+
+        try:
+            datetime.date.fromisoformat(args.since[:10])
+        except ValueError:
+            from ..errors import OptionError
+
+            raise OptionError(f"--since: found {args.since!r}, expected a date such as "
+                              "2026-11-01") from None
+    entries = _archive(args.dir).entries(args.shot, args.since)
+    if args.json:
+        print(json.dumps([dict(e.row, ref=e.ref) for e in entries], indent=1))
+        return 0
+    print(f"{'entry':<24} {'created':<26} {'v0 m/s':>8} {'dt s':>9} {'E40 Pa':>10} "
+          f"{'peak kG':>9}  integrator")
+    for e in entries:
+        r = e.row
+        print(f"{e.ref:<24} {e.created:<26} {r['v0']:>8.4g} {r['delta']:>9.3g} "
+              f"{r['sigmay']:>10.4g} {r['peak_kg']:>9.5f}  {r['integrator']}/{r['model']}")
+    print(f"{len(entries)} entr{'y' if len(entries) == 1 else 'ies'}")
+    return 0
+
+
+def run_show(args):
+    e = _archive(args.archive).get(args.entry)
+    doc = {"entry": e.ref, "id": e.id, "path": str(e.path), "created": e.created,
+           "params": e.load("params.json"), "summary": e.load("summary.json"),
+           "provenance": e.load("provenance.json"), "files": e.manifest()["files"]}
+    if args.json:
+        print(json.dumps(doc, indent=1))
+        return 0
+    print(f"{e.ref} (#{e.id}), created {e.created}, in {e.path}")
+    print("inputs:")
+    for p in doc["params"]:
+        print(f"  {p['cell']:<4} {p['label']:<32} {p['value']!r:>22} {p['unit']}")
+    print("figures:")
+    for k, v in doc["summary"].items():
+        print(f"  {k:<24} {v}")
+    prov = doc["provenance"]
+    print(f"provenance: airgun-xl {prov['engine']}, {prov['integrator']} integrator, "
+          f"{prov['model']} model, started {prov['started']}, {prov['run_seconds']:.2f} s")
+    print(f"  input SHA-256 {prov['input_sha256']}")
+    print(f"  command: {' '.join(prov['command'])}")
+    print("files: " + ", ".join(doc["files"]))
+    return 0
+
+
+def run_compare(args):
+    archive = _archive(args.archive)
+    a, b = archive.get(args.entry1), archive.get(args.entry2)
+    print(f"{a.ref} vs {b.ref}")
+    pa = {p["cell"]: p for p in a.load("params.json")}
+    pb = {p["cell"]: p for p in b.load("params.json")}
+    differing = [(c, pa[c]["label"], pa[c]["value"], pb[c]["value"]) for c in pa
+                 if pa[c]["value"] != pb[c]["value"]]
+    for cell, label, x, y in differing:
+        print(f"  input {cell} {label}: {x!r} vs {y!r}")
+    if not differing:
+        print("  inputs: the same")
+    report = diff_histories(a.ref, _history(a), b.ref, _history(b), args.rtol)
+    print(format_report(report))
+    return 0 if report.same and not differing else 1
+
+
+def _history(entry):
+    """The entry's full time history, column -> array."""
+    import pandas as pd
+
+    path = next(p for p in (entry.path / "history.parquet", entry.path / "history.csv")
+                if p.exists())
+    frame = pd.read_parquet(path) if path.suffix == ".parquet" else pd.read_csv(path)
+    frame.columns = [c.split(" [")[0] for c in frame.columns]
+    return {c: frame[c].to_numpy() for c in frame.columns}
+
+
+def run_verify(args):
+    archive = _archive(args.dir)
+    problems = archive.verify()
+    entries = archive.entries()
+    for p in problems:
+        print(f"problem: {p}")
+    print(f"{len(entries)} entries, {len(problems)} problems in {archive.root}")
+    return 0 if not problems else 1

@@ -1,0 +1,47 @@
+"""``airgun-xl diff LEGACY NEW``: does the new engine give the legacy numbers?"""
+import json
+
+from ..diff import DEFAULT_RTOL, diff_workbooks, format_report
+from ..errors import OptionError
+from ..workbook.diff_report import write_diff_report
+
+
+def add_parser(sub):
+    p = sub.add_parser("diff", help="compare a legacy workbook with a new one",
+                       description="Compare the parameter cells, then every result column of "
+                                   "two filled workbooks (.xlsx, .xlsm or .xls). Exit 0 within "
+                                   "tolerance, 1 when they differ, 2 for bad input.")
+    p.add_argument("legacy", metavar="LEGACY")
+    p.add_argument("new", metavar="NEW")
+    p.add_argument("--rtol", default=str(DEFAULT_RTOL),
+                   help="relative to each column's largest magnitude (default 1e-12: Calc and "
+                        "Excel keep 15 digits)")
+    p.add_argument("--atol", default="0", help="absolute tolerance (default 0)")
+    p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.add_argument("--report", metavar="REPORT.xlsx",
+                   help="also write a workbook: error table and the worst column's curves")
+    p.add_argument("--force", action="store_true", help="overwrite REPORT.xlsx")
+    p.set_defaults(run=run)
+
+
+def _tolerance(option, text):
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not value >= 0:
+        raise OptionError(f"{option}: found {text!r}, expected a number >= 0")
+    return value
+
+
+def run(args):
+    rtol, atol = _tolerance("--rtol", args.rtol), _tolerance("--atol", args.atol)
+    if args.report:
+        from ..workbook.atomic import check_output
+
+        check_output(args.report, args.force, inputs=[args.legacy, args.new])
+    report = diff_workbooks(args.legacy, args.new, rtol, atol)
+    print(json.dumps(report.as_dict(), indent=1) if args.json else format_report(report))
+    if args.report:
+        write_diff_report(report, args.report, args.force)
+    return 0 if report.same else 1

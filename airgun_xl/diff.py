@@ -1,0 +1,294 @@
+"""Compare two workbooks in the macro's layout: parameters first, then every result column.
+
+Workbooks are read with python-calamine (cached values; .xlsx, .xlsm and .xls). Columns are
+matched by the macro's position and header; rows by time. A column is compared where both
+files hold numbers in it: the legacy macro writes only the header of column O, so O is "only
+in new" rather than a column of differences.
+"""
+import math
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .cells import CELLS
+from .errors import WorkbookError
+from .workbook.reader import _sniff
+
+#: Default tolerance: Calc and Excel keep 15 significant digits.
+DEFAULT_RTOL = 1e-12
+
+FIRST_RESULT_COL = 7  # column H, 0-based
+
+
+def _letter(col):
+    from xlsxwriter.utility import xl_col_to_name
+
+    return xl_col_to_name(col)
+
+
+@dataclass
+class ResultSheet:
+    """The first sheet of a workbook in the macro's layout, as numbers."""
+
+    path: Path
+    params: dict  # address -> raw value
+    headers: dict  # 0-based col -> header text
+    data: dict  # 0-based col -> float array over the data rows (NaN where empty)
+    time: np.ndarray
+    finals: tuple  # (final M1, final m31) below column I, NaN when absent
+
+
+def _number(v):
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return math.nan
+    return float(v)
+
+
+def read_results(path):
+    """Read a filled workbook.
+
+    Raises
+    ------
+    WorkbookError
+        When the file cannot be read, or is not in the macro's layout (no "Time" in H1 and
+        time values below it).
+    """
+    path = Path(path)
+    _sniff(path)  # missing, folder, not a workbook, password-protected
+    try:
+        from python_calamine import CalamineWorkbook
+
+        rows = CalamineWorkbook.from_path(str(path)).get_sheet_by_index(0).to_python(
+            skip_empty_area=False)
+    except Exception as exc:  # noqa: BLE001 - calamine raises its own types
+        raise WorkbookError(f"{path}: is not a readable workbook ({exc})") from None
+    width = max((len(r) for r in rows), default=0)
+    grid = [list(r) + [""] * (width - len(r)) for r in rows]
+
+    def cell(r, c):
+        return grid[r][c] if r < len(grid) and c < width else ""
+
+    if str(cell(0, FIRST_RESULT_COL)).strip() != "Time":
+        raise WorkbookError(f"{path}: H1 holds {cell(0, FIRST_RESULT_COL)!r}, expected 'Time' "
+                            "(not a workbook in the macro's layout)")
+    time_values = []
+    for r in range(1, len(grid)):
+        v = _number(cell(r, FIRST_RESULT_COL))
+        if math.isnan(v):
+            break
+        time_values.append(v)
+    if not time_values:
+        raise WorkbookError(f"{path}: no time values below H1, expected the macro's result "
+                            "columns (fill the workbook first)")
+    n = len(time_values)
+    params = {}
+    for c in CELLS:
+        from openpyxl.utils.cell import coordinate_to_tuple
+
+        r, col = coordinate_to_tuple(c.address)
+        params[c.address] = cell(r - 1, col - 1)
+    headers, data = {}, {}
+    for col in range(FIRST_RESULT_COL, width):
+        header = cell(0, col)
+        last = len(grid) if col == 27 else n + 1  # AB may run past the last time row
+        values = np.array([_number(cell(r, col)) for r in range(1, last)])
+        if col == 8:
+            values = values[:n]
+        if header != "" or np.isfinite(values).any():
+            headers[col] = str(header)
+            data[col] = values
+    finals = (_number(cell(n + 2, 8)), _number(cell(n + 3, 8)))
+    return ResultSheet(path, params, headers, data, np.array(time_values), finals)
+
+
+@dataclass
+class ColumnDiff:
+    """How one column of NEW differs from LEGACY."""
+
+    column: str
+    header: str
+    rows_legacy: int
+    rows_new: int
+    max_abs: float
+    max_rel: float
+    outside: int
+    first_outside: dict = None  # row (sheet), time, legacy, new
+
+
+@dataclass
+class DiffReport:
+    legacy: str
+    new: str
+    rows: tuple
+    inputs: list  # (cell, label, legacy, new) of differing parameter cells
+    columns: list
+    only_legacy: list
+    only_new: list
+    rtol: float
+    atol: float
+    notes: list = field(default_factory=list)
+
+    @property
+    def same(self):
+        return (not self.inputs and self.rows[0] == self.rows[1]
+                and all(c.outside == 0 for c in self.columns))
+
+    def as_dict(self):
+        out = asdict(self)
+        out["same"] = self.same
+        return out
+
+
+def _same_param(a, b):
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
+        return a == b or abs(a - b) <= 1e-12 * max(abs(a), abs(b))
+    return a == b
+
+
+def _align(a, b):
+    """Indices into a and b of rows with equal time (the grids may differ in length)."""
+    if len(a.time) == len(b.time) and np.allclose(a.time, b.time, rtol=0,
+                                                  atol=1e-9 * np.ptp(a.time) + 1e-300):
+        idx = np.arange(len(a.time))
+        return idx, idx
+    step = np.median(np.diff(a.time)) if len(a.time) > 1 else 1.0
+    j = np.clip(np.searchsorted(b.time, a.time), 0, len(b.time) - 1)
+    j_prev = np.clip(j - 1, 0, len(b.time) - 1)
+    best = np.where(np.abs(b.time[j_prev] - a.time) < np.abs(b.time[j] - a.time), j_prev, j)
+    ok = np.abs(b.time[best] - a.time) <= 1e-6 * step
+    return np.flatnonzero(ok), best[ok]
+
+
+def _compare(col, header, x, y, times, rtol, atol):
+    """Column diff of aligned arrays x (legacy) and y (new)."""
+    scale = float(np.nanmax(np.abs(x))) if np.isfinite(x).any() else 0.0
+    both = np.isfinite(x) & np.isfinite(y)
+    diff = np.where(both, np.abs(x - y), 0.0)
+    one_empty = np.isfinite(x) != np.isfinite(y)
+    bad = (diff > atol + rtol * scale) | one_empty
+    max_abs = float(diff.max()) if len(diff) else 0.0
+    first = None
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        first = {"row": i + 2, "time": float(times[i]) if i < len(times) else None,
+                 "legacy": None if math.isnan(x[i]) else float(x[i]),
+                 "new": None if math.isnan(y[i]) else float(y[i])}
+    return ColumnDiff(_letter(col), header, int(np.isfinite(x).sum()),
+                      int(np.isfinite(y).sum()), max_abs, max_abs / scale if scale else max_abs,
+                      int(bad.sum()), first)
+
+
+def diff_workbooks(legacy_path, new_path, rtol=DEFAULT_RTOL, atol=0.0):
+    """Compare two filled workbooks; see the module docstring.
+
+    Returns
+    -------
+    DiffReport
+    """
+    a, b = read_results(legacy_path), read_results(new_path)
+    labels = {c.address: c.label for c in CELLS}
+    inputs = [(addr, labels[addr], a.params[addr], b.params[addr]) for addr in a.params
+              if not _same_param(a.params[addr], b.params[addr])]
+    ia, ib = _align(a, b)
+    columns, only_legacy, only_new = [], [], []
+    for col in sorted(set(a.data) | set(b.data)):
+        xa, xb = a.data.get(col), b.data.get(col)
+        ha, hb = a.headers.get(col, ""), b.headers.get(col, "")
+        has_a = xa is not None and np.isfinite(xa).any()
+        has_b = xb is not None and np.isfinite(xb).any()
+        name = f"{_letter(col)} {ha or hb}"
+        if has_a and has_b and ha == hb:
+            if col == 27:  # AB: rows may run past the time grid, compare by row
+                m = max(len(xa), len(xb))
+                xa2 = np.concatenate((xa, np.full(m - len(xa), np.nan)))
+                xb2 = np.concatenate((xb, np.full(m - len(xb), np.nan)))
+                columns.append(_compare(col, ha, xa2, xb2, a.time, rtol, atol))
+            else:
+                columns.append(_compare(col, ha, xa[ia], xb[ib], a.time[ia], rtol, atol))
+        elif has_a and not has_b:
+            only_legacy.append(name + (" (new: header only)" if hb else ""))
+        elif has_b and not has_a:
+            only_new.append(name + (" (legacy: header only)" if ha else ""))
+        elif has_a and has_b:
+            only_legacy.append(f"{_letter(col)} {ha}")
+            only_new.append(f"{_letter(col)} {hb}")
+    for k, label in enumerate(("Final M1", "Final m31")):
+        x, y = np.array([a.finals[k]]), np.array([b.finals[k]])
+        if np.isfinite(x).any() or np.isfinite(y).any():
+            d = _compare(8, label, x, y, [math.nan], rtol, atol)
+            d.column = f"I{len(a.time) + 3 + k}"
+            d.first_outside = ({**d.first_outside, "row": len(a.time) + 3 + k}
+                               if d.first_outside else None)
+            columns.append(d)
+    notes = []
+    worst = None
+    for col in sorted(set(a.data) & set(b.data)):
+        x, y = a.data[col], b.data[col]
+        if col == 27 or not (np.isfinite(x).any() and np.isfinite(y).any()):
+            continue
+        x, y = x[ia], y[ib]
+        scale = np.nanmax(np.abs(x)) or 1.0
+        err = np.nanmax(np.abs(x - y)) / scale if (np.isfinite(x) & np.isfinite(y)).any() else 0
+        if worst is None or err > worst[0]:
+            worst = (err, f"{_letter(col)} {a.headers[col]}", a.time[ia], x, y)
+    if len(ia) < max(len(a.time), len(b.time)):
+        notes.append(f"only {len(ia):,} rows share a time; legacy has {len(a.time):,}, new "
+                     f"{len(b.time):,}")
+    report = DiffReport(str(legacy_path), str(new_path), (len(a.time), len(b.time)), inputs,
+                        columns, only_legacy, only_new, rtol, atol, notes)
+    report.worst = worst[1:] if worst else None  # (name, time, legacy, new), for --report
+    return report
+
+
+def diff_histories(name_a, a, name_b, b, rtol=DEFAULT_RTOL, atol=0.0):
+    """Compare two full time histories (``{column: array}`` with a ``time`` column), as
+    :func:`diff_workbooks` compares sheet columns; for archived runs."""
+    ta, tb = np.asarray(a["time"]), np.asarray(b["time"])
+    sa = ResultSheet(Path(name_a), {}, {}, {}, ta, (np.nan, np.nan))
+    sb = ResultSheet(Path(name_b), {}, {}, {}, tb, (np.nan, np.nan))
+    ia, ib = _align(sa, sb)
+    columns = []
+    for name in [k for k in a if k in b and k != "time"]:
+        columns.append(_compare(0, name, np.asarray(a[name])[ia], np.asarray(b[name])[ib],
+                                ta[ia], rtol, atol))
+        columns[-1].column = name
+        columns[-1].header = ""
+    only_a = [k for k in a if k not in b]
+    only_b = [k for k in b if k not in a]
+    report = DiffReport(name_a, name_b, (len(ta), len(tb)), [], columns, only_a, only_b, rtol,
+                        atol)
+    report.worst = None
+    return report
+
+
+def format_report(report):
+    """The report as a readable table."""
+    lines = [f"LEGACY {report.legacy} ({report.rows[0]:,} rows)",
+             f"NEW    {report.new} ({report.rows[1]:,} rows)"]
+    if report.inputs:
+        lines.append("inputs differ (so the numbers may differ for that reason):")
+        for addr, label, x, y in report.inputs:
+            lines.append(f"  {addr} {label}: {x!r} vs {y!r}")
+    else:
+        lines.append(f"inputs: the {len(CELLS)} parameter cells agree")
+    lines.append(f"  {'column':<30} {'rows':>13} {'max abs':>10} {'max rel':>10} "
+                 f"{'outside':>8}  first outside")
+    for c in report.columns:
+        first = ""
+        if c.first_outside:
+            f = c.first_outside
+            when = "" if f["time"] is None else f" t={f['time']:.6g}"
+            first = f"row {f['row']}{when}: {f['legacy']!r} vs {f['new']!r}"
+        lines.append(f"  {(c.column + ' ' + c.header)[:30]:<30} "
+                     f"{c.rows_legacy:>6,}/{c.rows_new:<6,} {c.max_abs:>10.2e} "
+                     f"{c.max_rel:>10.2e} {c.outside:>8,}  {first}")
+    for label, names in (("only in legacy", report.only_legacy),
+                         ("only in new", report.only_new)):
+        if names:
+            lines.append(f"{label}: {'; '.join(names)}")
+    lines += report.notes
+    verdict = "within tolerance" if report.same else "DIFFERENT"
+    lines.append(f"{verdict} (rtol {report.rtol:g} of each column's largest magnitude, "
+                 f"atol {report.atol:g})")
+    return "\n".join(lines)

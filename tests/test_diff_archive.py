@@ -1,0 +1,232 @@
+"""Issue 4: diff against legacy output, and the archive of shots."""
+import json
+import os
+import random
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+import openpyxl
+import pytest
+from conftest import CASES, REFERENCE, TEMPLATE
+
+from airgun_xl.archive import Archive, safe_name
+from airgun_xl.cli import main
+
+CALC_HOST_CASES = {"samplerate_non_integer"}
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_every_legacy_case_diffs_clean(tmp_path, capsys, name):
+    case = CASES[name]
+    new = tmp_path / "new.xlsx"
+    host = ["--host", "calc"] if name in CALC_HOST_CASES else []
+    assert main(["fill", str(REFERENCE / case["input"]), "-o", str(new), *host]) == 0
+    capsys.readouterr()
+    assert main(["diff", str(REFERENCE / case["legacy_output"]), str(new)]) == 0
+    out = capsys.readouterr().out
+    assert "within tolerance" in out and "inputs: the 23 parameter cells agree" in out
+    assert "only in new: O Mitigator Deflection (legacy: header only); P Plastic Wave Front" \
+        in out
+
+
+@pytest.fixture
+def appendix_pair(tmp_path):
+    new = tmp_path / "new.xlsx"
+    assert main(["fill", str(REFERENCE / "shot_a_appendix_5us_input.xlsx"), "-o",
+                 str(new)]) == 0
+    return REFERENCE / "shot_a_appendix_5us_legacy.xlsx", new
+
+
+def test_a_one_in_a_billion_change_is_caught_at_its_row(tmp_path, capsys, appendix_pair):
+    legacy, new = appendix_pair
+    perturbed = tmp_path / "perturbed.xlsx"
+    wb = openpyxl.load_workbook(legacy)
+    original = wb.active["L500"].value
+    wb.active["L500"] = original * (1 + 1e-9)
+    wb.save(perturbed)
+    capsys.readouterr()
+    assert main(["diff", str(perturbed), str(new), "--json"]) == 1
+    report = json.loads(capsys.readouterr().out)
+    bad = [c for c in report["columns"] if c["outside"]]
+    assert [c["column"] for c in bad] == ["L"]
+    assert bad[0]["outside"] == 1
+    first = bad[0]["first_outside"]
+    assert first["row"] == 500 and first["legacy"] == pytest.approx(original * (1 + 1e-9))
+    assert first["time"] == pytest.approx((500 - 3) * 5e-6, abs=1e-15)
+    assert report["same"] is False
+
+
+def test_differing_inputs_are_named_first(capsys, appendix_pair):
+    _, new = appendix_pair
+    capsys.readouterr()
+    assert main(["diff", str(REFERENCE / "shot_a_published_5us_legacy.xlsx"), str(new)]) == 1
+    out = capsys.readouterr().out
+    assert "E43 Damping Factor (Zeta): 0.05 vs 0.02" in out
+    assert out.index("inputs differ") < out.index("column")
+
+
+def test_another_layout_is_bad_input(tmp_path, capsys, appendix_pair):
+    legacy, _ = appendix_pair
+    other = tmp_path / "other.xlsx"
+    wb = openpyxl.Workbook()
+    wb.active["A1"] = "not the report's layout"
+    wb.save(other)
+    assert main(["diff", str(legacy), str(other)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "H1" in err[0] and "expected 'Time'" in err[0]
+    assert main(["diff", str(legacy), str(tmp_path / "missing.xlsx")]) == 2
+    assert main(["diff", str(legacy), str(TEMPLATE)]) == 2  # not filled yet
+    assert "no time values" in capsys.readouterr().err
+
+
+def test_report_workbook(tmp_path, capsys, appendix_pair):
+    legacy, new = appendix_pair
+    report = tmp_path / "report.xlsx"
+    assert main(["diff", str(legacy), str(new), "--report", str(report)]) == 0
+    wb = openpyxl.load_workbook(report)
+    assert wb.sheetnames == ["Diff", "Worst column"]
+    rows = list(wb["Diff"].iter_rows(values_only=True))
+    header = next(i for i, r in enumerate(rows) if r[0] == "Column")
+    assert {r[0] for r in rows[header + 1:] if r[0]} >= {"H", "L", "U", "AB", "I1205"}
+    assert wb["Worst column"]["D1"].value == "new - legacy"
+    import zipfile
+    with zipfile.ZipFile(report) as z:  # openpyxl drops charts on reading: look in the zip
+        assert any(n.startswith("xl/charts/chart") for n in z.namelist())
+
+
+# -- the archive ---------------------------------------------------------------------------
+
+def _short_shot(tmp_path):
+    shot = tmp_path / "shot.xlsx"
+    shutil.copy(TEMPLATE, shot)
+    wb = openpyxl.load_workbook(shot)
+    wb["Sheet1"]["E6"] = 1e-3
+    wb.save(shot)
+    return shot
+
+
+def test_fill_archives_a_complete_entry_and_never_overwrites(tmp_path, capsys):
+    shot, archive = _short_shot(tmp_path), tmp_path / "archive"
+    for _ in range(2):
+        assert main(["fill", str(shot), "-o", str(tmp_path / "o.xlsx"), "--force",
+                     "--archive", str(archive)]) == 0
+    entries = Archive(archive).entries()
+    assert [e.ref for e in entries] == ["shot@1", "shot@2"]
+    e = entries[1]
+    assert sorted(p.name for p in e.path.iterdir()) == [
+        "history.parquet", "input.xlsx", "manifest.json", "output.xlsx", "params.json",
+        "provenance.json", "summary.json"]
+    assert (e.path / "input.xlsx").read_bytes() == shot.read_bytes()
+    params = {p["cell"]: p for p in e.load("params.json")}
+    assert params["E6"]["value"] == 1e-3 and params["E6"]["unit"] == "s"
+    prov = e.load("provenance.json")
+    assert prov["versions"]["numpy"] and prov["input_sha256"] == e.row["input_sha256"]
+    assert "--archive" in prov["command"]
+    import pandas as pd
+    assert len(pd.read_parquet(e.path / "history.parquet")) == 2002
+    assert e.load("summary.json")["peak_kg"] == pytest.approx(e.row["peak_kg"])
+    assert "archived as shot@2" in capsys.readouterr().out
+
+
+def test_archive_from_the_environment_and_the_finding_commands(tmp_path, capsys,
+                                                               monkeypatch):
+    shot, archive = _short_shot(tmp_path), tmp_path / "env-archive"
+    monkeypatch.setenv("AIRGUN_XL_ARCHIVE", str(archive))
+    assert main(["fill", str(shot), "-o", str(tmp_path / "a.xlsx"), "--only", "summary"]) == 0
+    wb = openpyxl.load_workbook(shot)
+    wb["Sheet1"]["A28"] = 200
+    wb.save(shot)
+    assert main(["fill", str(shot), "-o", str(tmp_path / "b.xlsx"), "--only", "summary"]) == 0
+    capsys.readouterr()
+    assert main(["history", "--json"]) == 0
+    listed = json.loads(capsys.readouterr().out)
+    assert [e["ref"] for e in listed] == ["shot@1", "shot@2"]
+    assert listed[1]["v0"] == 200 and listed[0]["peak_kg"] > listed[1]["peak_kg"]
+    assert main(["history", "--shot", "shot", "--since", "2000-01-01"]) == 0
+    assert "2 entries" in capsys.readouterr().out
+    assert main(["show", "shot@2"]) == 0
+    assert "A28" in capsys.readouterr().out
+    assert main(["compare", "shot@1", "shot@2"]) == 1
+    out = capsys.readouterr().out
+    assert "input A28" in out and "DIFFERENT" in out
+    assert main(["show", "nothing@9"]) == 2
+    assert main(["archive", "verify"]) == 0
+
+
+def test_verify_finds_altered_and_missing_files(tmp_path, capsys):
+    shot, archive = _short_shot(tmp_path), tmp_path / "archive"
+    assert main(["fill", str(shot), "-o", str(tmp_path / "o.xlsx"), "--only", "summary",
+                 "--archive", str(archive)]) == 0
+    entry = Archive(archive).entries()[0]
+    with open(entry.path / "summary.json", "a") as fh:
+        fh.write(" ")
+    (entry.path / "params.json").unlink()
+    capsys.readouterr()
+    assert main(["archive", "verify", str(archive)]) == 1
+    out = capsys.readouterr().out
+    assert "shot@1: summary.json altered" in out and "shot@1: missing params.json" in out
+
+
+def test_a_traversing_name_stays_inside(tmp_path):
+    shot, archive = _short_shot(tmp_path), tmp_path / "archive"
+    assert main(["fill", str(shot), "-o", str(tmp_path / "o.xlsx"), "--only", "summary",
+                 "--archive", str(archive), "--name", "../../x"]) == 0
+    assert safe_name("../../x") == "x" and safe_name("/etc/passwd") == "etc_passwd"
+    entry = Archive(archive).entries()[0]
+    assert entry.path.resolve().is_relative_to(archive.resolve())
+    assert not (tmp_path / "x").exists() and not (tmp_path.parent / "x").exists()
+
+
+FILL_LOOP = """
+import sys
+from airgun_xl.cli import main
+shot, archive, out, n = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
+for i in range(n):
+    assert main(["fill", shot, "-o", out, "--force", "--only", "summary",
+                 "--archive", archive]) == 0
+"""
+
+
+def test_two_processes_filling_at_once_lose_nothing(tmp_path):
+    shot, archive = _short_shot(tmp_path), tmp_path / "archive"
+    procs = [subprocess.Popen([sys.executable, "-c", FILL_LOOP, str(shot), str(archive),
+                               str(tmp_path / f"o{k}.xlsx"), "20"],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+             for k in range(2)]
+    for p in procs:
+        assert p.wait(timeout=600) == 0, p.stderr.read()
+    a = Archive(archive)
+    assert sorted(e.version for e in a.entries(shot="shot")) == list(range(1, 41))
+    assert a.verify() == []
+
+
+def test_a_fill_killed_at_random_moments_leaves_the_archive_whole(tmp_path):
+    """SIGKILL a filling process 24 times at random moments; after each, verify is clean
+    (recovery first: a dead writer's private folder goes, a complete unindexed entry is
+    indexed), and at the end a fill still works."""
+    shot, archive = _short_shot(tmp_path), tmp_path / "archive"
+    cmd = [sys.executable, "-m", "airgun_xl", "fill", str(shot), "-o",
+           str(tmp_path / "o.xlsx"), "--force", "--only", "summary", "--archive",
+           str(archive)]
+    started = time.perf_counter()
+    subprocess.run(cmd, check=True, capture_output=True)
+    duration = time.perf_counter() - started
+    rng = random.Random(20261122)
+    killed_inside = 0
+    for _ in range(24):
+        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        time.sleep(rng.uniform(0.3, 1.1) * duration)
+        if proc.poll() is None:
+            os.kill(proc.pid, signal.SIGKILL)
+            killed_inside += 1
+        proc.wait()
+        assert Archive(archive).verify() == []
+    assert killed_inside >= 12  # most kills landed while the fill was running
+    before = len(Archive(archive).entries())
+    subprocess.run(cmd, check=True, capture_output=True)
+    a = Archive(archive)
+    assert len(a.entries()) == before + 1 and a.verify() == []
+    assert not list((archive / ".tmp").iterdir())
