@@ -57,17 +57,21 @@ def bench_kernel(repeat):
 
     params = airgun_xl.load(TEMPLATE).params.replace(delta=5e-9)
     run_legacy(params)
-    times = [run_legacy(params).kernel_seconds for _ in range(repeat)]
     steps = params.rows - 2
-    med = statistics.median(times)
-    return [("kernel, shot A at 5 ns", f"{steps:,} steps", f"{med * 1e3:.1f} ms",
-             f"{steps / med:.3g} steps/s")]
+    rows = []
+    for label, track in (("all step values tracked", None), ("positions only", ())):
+        kwargs = {} if track is None else {"track": track}
+        med = statistics.median(run_legacy(params, **kwargs).kernel_seconds
+                                for _ in range(repeat))
+        rows.append((f"kernel, shot A at 5 ns, {label}", f"{steps:,} steps",
+                     f"{med * 1e3:.1f} ms", f"{steps / med:.3g} steps/s"))
+    return rows
 
 
 def bench_fills(repeat, tmp):
     out = tmp / "o.xlsx"
     full, full_min = timed(fill_cmd(TEMPLATE, out), repeat)
-    only, only_min = timed(fill_cmd(TEMPLATE, out, "--only", "summary"), repeat)
+    only, _ = timed(fill_cmd(TEMPLATE, out, "--only", "summary"), repeat)
     return [("fill shot A 0.5 us, full output (process)", "12,002 rows", f"{full:.3f} s",
              f"min {full_min:.3f} s"),
             ("fill shot A 0.5 us, --only summary", "12,002 rows", f"{only:.3f} s",
