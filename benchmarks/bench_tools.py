@@ -14,7 +14,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from bench_fill import TEMPLATE, machine, timed
+from bench_fill import TEMPLATE, machine, timed, warm_bytecode
 
 
 def bench_convergence(repeat, tmp):
@@ -72,6 +72,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7)
     args = parser.parse_args()
+    warm_bytecode()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         rows = bench_convergence(args.repeat, tmp) + bench_design(args.repeat, tmp) + \

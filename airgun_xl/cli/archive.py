@@ -2,7 +2,6 @@
 import json
 
 from ..archive import ENV, Archive, archive_dir
-from ..diff import diff_histories, format_report
 
 
 def add_parser(sub):
@@ -99,6 +98,8 @@ def run_compare(args):
         print(f"  input {cell} {label}: {x!r} vs {y!r}")
     if not differing:
         print("  inputs: the same")
+    from ..diff import diff_histories, format_report
+
     report = diff_histories(a.ref, _history(a), b.ref, _history(b), args.rtol)
     print(format_report(report))
     return 0 if report.same and not differing else 1
