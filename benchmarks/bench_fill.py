@@ -138,20 +138,25 @@ def warm_bytecode():
                    check=True)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def run_table(doc, benches):
+    """Parse --repeat, warm the bytecode cache, run ``benches(repeat, tmp)`` and print its rows
+    as a table under the machine's name."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7)
     args = parser.parse_args()
     warm_bytecode()
     with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
-        rows = bench_kernel(args.repeat) + bench_fills(args.repeat, tmp) + \
-            bench_long(args.repeat, tmp) + bench_stages(args.repeat, tmp)
+        rows = benches(args.repeat, Path(tmp))
     print(f"machine: {machine()}")
     print(f"medians of {args.repeat} runs after a warm-up\n")
     widths = [max(len(r[i]) for r in rows) for i in range(4)]
     for r in rows:
         print("  ".join(cell.ljust(w) for cell, w in zip(r, widths)))
+
+
+def main():
+    run_table(__doc__, lambda repeat, tmp: bench_kernel(repeat) + bench_fills(repeat, tmp)
+              + bench_long(repeat, tmp) + bench_stages(repeat, tmp))
 
 
 if __name__ == "__main__":

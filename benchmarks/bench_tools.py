@@ -7,14 +7,11 @@ Medians over N runs after a warm-up, with the machine they came from:
 - a design solve for 8 kG at 0.5 us: the solve alone (scipy imported) and the process;
 - the batch kernel: 1,000 shots x 12,002 rows, shot-steps/s, beside one shot's kernel.
 """
-import argparse
 import statistics
 import sys
-import tempfile
 import time
-from pathlib import Path
 
-from bench_fill import TEMPLATE, machine, timed, warm_bytecode
+from bench_fill import TEMPLATE, run_table, timed
 
 
 def bench_convergence(repeat, tmp):
@@ -69,19 +66,8 @@ def bench_sweep(repeat):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=7)
-    args = parser.parse_args()
-    warm_bytecode()
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
-        rows = bench_convergence(args.repeat, tmp) + bench_design(args.repeat, tmp) + \
-            bench_sweep(args.repeat)
-    print(f"machine: {machine()}")
-    print(f"medians of {args.repeat} runs after a warm-up\n")
-    widths = [max(len(r[i]) for r in rows) for i in range(4)]
-    for r in rows:
-        print("  ".join(cell.ljust(w) for cell, w in zip(r, widths)))
+    run_table(__doc__, lambda repeat, tmp: bench_convergence(repeat, tmp)
+              + bench_design(repeat, tmp) + bench_sweep(repeat))
 
 
 if __name__ == "__main__":
