@@ -33,6 +33,21 @@ def _plain(value):
     return value
 
 
+def shot_name(shot, given=None):
+    """The archive name of a shot: ``given``, else the value beside a "Shot" label in the
+    parameter sheet, else the input file's name."""
+    if given:
+        return given
+    if shot.source is not None:
+        for (row, col), (value, _) in sorted(shot.source.block.items()):
+            if isinstance(value, str) and value.strip().lower() == "shot":
+                name = shot.source.block.get((row, col + 1), (None, None))[0]
+                if name not in (None, ""):
+                    return str(name)
+        return shot.source.path.stem
+    return "shot"
+
+
 def archive_fill(root, name, shot, output, filled, options, started_at, seconds):
     """Store a finished fill as one archive entry; return the Entry."""
     p, result, s = shot.params, filled.result, filled.summary

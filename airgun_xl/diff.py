@@ -82,12 +82,15 @@ def read_results(path):
         raise WorkbookError(f"{path}: no time values below H1, expected the macro's result "
                             "columns (fill the workbook first)")
     n = len(time_values)
+    from openpyxl.utils.cell import coordinate_to_tuple
+
     params = {}
     for c in CELLS:
-        from openpyxl.utils.cell import coordinate_to_tuple
-
         r, col = coordinate_to_tuple(c.address)
         params[c.address] = cell(r - 1, col - 1)
+    blank = [a for a, v in params.items() if v == ""]
+    if blank and path.suffix.lower() in (".xlsx", ".xlsm"):
+        params.update(_error_cells(path, blank))
     headers, data = {}, {}
     for col in range(FIRST_RESULT_COL, width):
         header = cell(0, col)
@@ -100,6 +103,24 @@ def read_results(path):
             data[col] = values
     finals = (_number(cell(n + 2, 8)), _number(cell(n + 3, 8)))
     return ResultSheet(path, params, headers, data, np.array(time_values), finals)
+
+
+def _error_cells(path, addresses):
+    """calamine reads an error cell as blank; openpyxl keeps its text (#DIV/0!, ...)."""
+    import openpyxl
+
+    try:
+        wb = openpyxl.load_workbook(path, read_only=True, data_only=True)
+        ws = wb.worksheets[0]
+        found = {}
+        for row in ws.iter_rows(min_row=1, max_row=43, max_col=5):
+            for c in row:
+                if getattr(c, "coordinate", None) in addresses and c.value is not None:
+                    found[c.coordinate] = c.value
+        wb.close()
+        return found
+    except Exception:  # noqa: BLE001 - the blank calamine gave stays
+        return {}
 
 
 @dataclass

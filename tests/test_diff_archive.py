@@ -170,6 +170,34 @@ def test_verify_finds_altered_and_missing_files(tmp_path, capsys):
     assert "shot@1: summary.json altered" in out and "shot@1: missing params.json" in out
 
 
+def test_the_shot_cell_names_the_entry(tmp_path):
+    shot, archive = _short_shot(tmp_path), tmp_path / "archive"
+    wb = openpyxl.load_workbook(shot)
+    wb["Sheet1"]["A44"], wb["Sheet1"]["B44"] = "Shot", "client 17/B"
+    wb.save(shot)
+    assert main(["fill", str(shot), "-o", str(tmp_path / "o.xlsx"), "--only", "summary",
+                 "--archive", str(archive)]) == 0
+    assert [e.ref for e in Archive(archive).entries()] == ["client_17_B@1"]
+
+
+def test_an_error_cell_in_the_parameters_is_read(tmp_path, capsys, appendix_pair):
+    """calamine reads #DIV/0! as blank; diff reads it with openpyxl and names it."""
+    legacy, new = appendix_pair
+    broken = tmp_path / "broken.xlsx"
+    wb = openpyxl.load_workbook(legacy)
+    wb.active["E43"] = "=1/0"
+    wb.save(broken)
+    subprocess.run(["soffice", f"-env:UserInstallation=file://{tmp_path}/lo", "--headless",
+                    "--convert-to", "xlsx", "--outdir", str(tmp_path / "lo-out"), str(broken)],
+                   capture_output=True, timeout=300, check=False)
+    converted = tmp_path / "lo-out" / "broken.xlsx"
+    if not converted.exists():
+        pytest.skip("LibreOffice is not installed")
+    capsys.readouterr()
+    assert main(["diff", str(converted), str(new)]) == 1
+    assert "E43 Damping Factor (Zeta): '#DIV/0!' vs 0.02" in capsys.readouterr().out
+
+
 def test_a_traversing_name_stays_inside(tmp_path):
     shot, archive = _short_shot(tmp_path), tmp_path / "archive"
     assert main(["fill", str(shot), "-o", str(tmp_path / "o.xlsx"), "--only", "summary",

@@ -4,7 +4,7 @@ import time
 from pathlib import Path
 
 from ..archive import ENV, archive_dir
-from ..archiving import archive_fill, now
+from ..archiving import archive_fill, now, shot_name
 from ..engine.filtered import HOSTS
 from ..engine.integrators import INTEGRATORS
 from ..engine.summary import PULSE_FRACTION
@@ -51,7 +51,8 @@ def add_parser(sub):
     p.add_argument("--archive", metavar="DIR",
                    help=f"also store the run as a new entry of this archive (default: "
                         f"${ENV} when set)")
-    p.add_argument("--name", help="shot name in the archive (default: SHOT's file name)")
+    p.add_argument("--name", help="shot name in the archive (default: the cell beside a 'Shot' "
+                                  "label in the sheet, else SHOT's file name)")
     p.add_argument("--reproducible", action="store_true",
                    help="leave run times out of the Summary, so equal inputs give equal bytes")
     p.set_defaults(run=run)
@@ -109,7 +110,7 @@ def run(args):
     filled = fill_workbook(shot, output, outputs, options, warn, started)
     print_summary(output, filled)
     if root is not None:
-        entry = archive_fill(root, args.name or Path(args.shot).stem, shot, output, filled,
-                             options, started_at, time.perf_counter() - started)
+        entry = archive_fill(root, shot_name(shot, args.name), shot, output, filled, options,
+                             started_at, time.perf_counter() - started)
         print(f"  archived as {entry.ref} in {root}")
     return 0
