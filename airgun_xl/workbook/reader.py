@@ -97,12 +97,17 @@ def _read_zip(path, data):
         raise WorkbookError(f"{path}: is not a readable .xlsx workbook ({exc})") from None
     try:
         sheets = {}
+        last = _block_extent(data)  # openpyxl need not parse an old workbook's result rows
+        wanted = None  # after the first sheet: the other sheets its formulas name, and Outputs
         for ws_f, ws_v in zip(wb_f.worksheets, wb_v.worksheets):
             first = not sheets
+            if not first and ws_f.title.upper() not in wanted:
+                continue  # e.g. the Tracked or ChartData sheets of a filled workbook
             cells = {}
             max_col = PARAMETER_COLUMNS if first else None
-            for row_f, row_v in zip(ws_f.iter_rows(max_col=max_col),
-                                    ws_v.iter_rows(max_col=max_col)):
+            max_row = last if first else None
+            for row_f, row_v in zip(ws_f.iter_rows(max_row=max_row, max_col=max_col),
+                                    ws_v.iter_rows(max_row=max_row, max_col=max_col)):
                 for cf, cv in zip(row_f, row_v):
                     if cf.value is None or not hasattr(cf, "column"):
                         continue
@@ -114,6 +119,10 @@ def _read_zip(path, data):
                 if h1 is not None:
                     cells[(1, 8)] = (h1, None)
             sheets[ws_f.title] = cells
+            if first:
+                text = " ".join(f for _, f in cells.values() if f).upper()
+                wanted = {t.upper() for t in wb_f.sheetnames[1:]
+                          if t.upper() in text or t.upper() == "OUTPUTS"}
     except (zipfile.BadZipFile, KeyError, OSError, ValueError) as exc:
         raise WorkbookError(f"{path}: is not a readable .xlsx workbook ({exc})") from None
     finally:
@@ -122,6 +131,24 @@ def _read_zip(path, data):
     if not sheets:
         raise WorkbookError(f"{path}: has no worksheet, expected the report's parameter sheet")
     return sheets
+
+
+def _block_extent(data):
+    """Last row to read in columns A..G of the first sheet: the last one with a value there,
+    found by python-calamine (fast), plus a margin of 200 rows for formulas whose cached
+    value is "" (calamine shows those as empty); None when it cannot tell: read every row."""
+    try:
+        from python_calamine import CalamineWorkbook
+
+        rows = CalamineWorkbook.from_filelike(io.BytesIO(data)).get_sheet_by_index(
+            0).to_python(skip_empty_area=False)
+    except Exception:  # noqa: BLE001 - openpyxl will report a broken file itself
+        return None
+    last = 1
+    for r, row in enumerate(rows, start=1):
+        if any(v not in ("", None) for v in row[:PARAMETER_COLUMNS]):
+            last = r
+    return last + 200
 
 
 def _formula_text(value):
