@@ -2,8 +2,9 @@
 
 An integrator is a function ``f(params, track=TRACKED) -> History`` that time-steps the shot
 and records the displacements and, for the names in ``track``, the step values; the others are
-None, neither computed nor stored. ``legacy`` is the faithful port of ArtSim's central-difference loop; a robust scheme
-registers itself in :data:`INTEGRATORS` under its own name and is then selectable everywhere.
+None, neither computed nor stored. ``legacy`` is the faithful port of ArtSim's
+central-difference loop; ``newmark`` is a robust scheme. An integrator registers itself in
+:data:`INTEGRATORS` under its own name and is then selectable everywhere.
 """
 import time
 from dataclasses import dataclass
