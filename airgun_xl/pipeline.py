@@ -66,8 +66,8 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
         other = "rigid" if options.model == "4-mass" else "4-mass"
         compared = dataclasses.replace(shot, params=apply_model(shot.params, other)).run(
             integrator=options.integrator, host=options.host, track=())
-        compared.model = other
-    result.model = options.model
+        compared = dataclasses.replace(compared, model=other)
+    result = dataclasses.replace(result, model=options.model)
     needs_summary = outputs.groups & {"summary", "spectrum", "charts"}
     summary = summarize(result) if needs_summary else None
     info = {"version": __version__, "command": " ".join(options.command),

@@ -29,6 +29,8 @@ class Result:
     warnings : list of str
     run_seconds : float
         Wall time of :meth:`Shot.run`: stepping and the derived columns [s].
+    model : str
+        The model variant that produced it (``4-mass`` or ``rigid``).
     """
 
     shot: object
@@ -40,6 +42,7 @@ class Result:
     filtered: object
     warnings: list
     run_seconds: float = float("nan")
+    model: str = "4-mass"  # which model variant produced it (airgun_xl.models)
 
     @property
     def params(self):

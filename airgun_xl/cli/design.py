@@ -94,11 +94,11 @@ def run(args):
 
 def with_cells(shot, design):
     """The shot with the solved values in their cells (as constants) and in its parameters."""
+    from openpyxl.utils.cell import coordinate_to_tuple
+
     block = dict(shot.source.block)
     for var, value in zip(design.variables, design.values):
         for address in var.cells:
-            from openpyxl.utils.cell import coordinate_to_tuple
-
             block[coordinate_to_tuple(address)] = (float(value), None)
     source = dataclasses.replace(shot.source, block=block)
     return dataclasses.replace(shot, params=design.params, source=source)

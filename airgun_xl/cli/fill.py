@@ -72,7 +72,7 @@ def print_summary(output, filled):
     lines = [f"wrote {output}: {result.rows:,} rows"
              + (f", 1 in {stride} on the sheets" if stride > 1 else "")
              + f"; {result.params.model.split(' (')[0]} model"
-             + (" (rigid)" if getattr(result, "model", "") == "rigid" else "")
+             + (" (rigid)" if result.model == "rigid" else "")
              + f", {result.integrator} integrator"]
     if s is not None:
         lines.append(f"  peak {s.peak_kg:.5f} kG at {_ms(s.time_of_peak)}; filtered "

@@ -152,8 +152,8 @@ def _summary_rows(result, summary, timings):
                   "the same shot with the other model (--compare-models)"),
                  (f"Time of peak, {compared.model} model", compared.time_of_peak, "s", "")]
     rows += [
-        ("Model", p.model + (" - the rigid-body model" if getattr(result, "model", "")
-                             == "rigid" else ""), "", ""),
+        ("Model", p.model + (" - the rigid-body model" if result.model == "rigid" else ""),
+         "", ""),
         ("Integrator", result.integrator, "", ""),
         ("Time step", p.delta, "s", "E2"),
         ("Critical time step", timings.get("dt_crit"), "s",
