@@ -13,7 +13,8 @@ import numpy as np
 
 from .cells import CELLS
 from .errors import WorkbookError
-from .workbook.reader import _sniff
+from . import limits
+from .workbook import guard
 
 #: Default tolerance: Calc and Excel keep 15 significant digits.
 DEFAULT_RTOL = 1e-12
@@ -45,43 +46,70 @@ def _number(v):
     return float(v)
 
 
+def _first_sheet(path):
+    """The first sheet's values as a float grid, its text cells, and the raw bytes; every cap
+    of :mod:`airgun_xl.workbook.guard` is checked before python-calamine runs."""
+    import io
+
+    from python_calamine import CalamineWorkbook
+
+    data, kind = guard.read_input(path)
+    if kind == "zip":
+        zf = guard.open_zip(path, data)
+        rows, columns = guard.sheet_extent(path, zf, guard.first_sheet_member(path, zf))
+    else:
+        extents = guard.xls_extents(path, data)
+        rows, columns = extents[0] if extents else (0, 0)
+    guard.check_extent(path, "its first sheet", rows, columns, limits.MAX_DIFF_CELLS)
+    grid = np.full((max(rows, 1), max(columns, 1)), np.nan)
+    text = {}  # (row, col) -> str, for headers, labels and parameter cells
+    try:
+        sheet = CalamineWorkbook.from_filelike(io.BytesIO(data)).get_sheet_by_index(0)
+        r0, c0 = sheet.start if sheet.start is not None else (0, 0)
+        for r, row in enumerate(sheet.iter_rows(), start=r0):
+            for c, v in enumerate(row, start=c0):
+                if isinstance(v, float) or (isinstance(v, int) and not isinstance(v, bool)):
+                    grid[r, c] = v
+                elif v != "" and v is not None:
+                    text[(r, c)] = v
+    except IndexError:
+        raise WorkbookError(f"{guard.display(path)}: holds cells outside the extent its XML "
+                            "declares, expected a consistent workbook") from None
+    except Exception as exc:  # noqa: BLE001 - calamine raises its own types
+        raise WorkbookError(f"{guard.display(path)}: is not a readable workbook "
+                            f"({type(exc).__name__}: {str(exc)[:120]})") from None
+    return grid, text, data
+
+
 def read_results(path):
     """Read a filled workbook.
 
     Raises
     ------
     WorkbookError
-        When the file cannot be read, or is not in the macro's layout (no "Time" in H1 and
-        time values below it).
+        When the file cannot be read, passes a cap of :mod:`airgun_xl.limits`, or is not in
+        the macro's layout (no "Time" in H1 and time values below it).
     """
     path = Path(path)
-    _sniff(path)  # missing, folder, not a workbook, password-protected
-    try:
-        from python_calamine import CalamineWorkbook
-
-        rows = CalamineWorkbook.from_path(str(path)).get_sheet_by_index(0).to_python(
-            skip_empty_area=False)
-    except Exception as exc:  # noqa: BLE001 - calamine raises its own types
-        raise WorkbookError(f"{path}: is not a readable workbook ({exc})") from None
-    width = max((len(r) for r in rows), default=0)
-    grid = [list(r) + [""] * (width - len(r)) for r in rows]
+    grid, text, data = _first_sheet(path)
+    height, width = grid.shape
 
     def cell(r, c):
-        return grid[r][c] if r < len(grid) and c < width else ""
+        if r >= height or c >= width:
+            return ""
+        v = grid[r, c]
+        return float(v) if not math.isnan(v) else text.get((r, c), "")
 
-    if str(cell(0, FIRST_RESULT_COL)).strip() != "Time":
-        raise WorkbookError(f"{path}: H1 holds {cell(0, FIRST_RESULT_COL)!r}, expected 'Time' "
-                            "(not a workbook in the macro's layout)")
-    time_values = []
-    for r in range(1, len(grid)):
-        v = _number(cell(r, FIRST_RESULT_COL))
-        if math.isnan(v):
-            break
-        time_values.append(v)
-    if not time_values:
-        raise WorkbookError(f"{path}: no time values below H1, expected the macro's result "
-                            "columns (fill the workbook first)")
-    n = len(time_values)
+    h1 = cell(0, FIRST_RESULT_COL)
+    if str(h1).strip() != "Time":
+        raise WorkbookError(f"{guard.display(path)}: H1 holds {h1!r}, expected 'Time' (not a "
+                            "workbook in the macro's layout)")
+    column = grid[1:, FIRST_RESULT_COL] if width > FIRST_RESULT_COL else np.array([])
+    gaps = np.flatnonzero(np.isnan(column))
+    n = int(gaps[0]) if len(gaps) else len(column)
+    if n == 0:
+        raise WorkbookError(f"{guard.display(path)}: no time values below H1, expected the "
+                            "macro's result columns (fill the workbook first)")
     from openpyxl.utils.cell import coordinate_to_tuple
 
     params = {}
@@ -89,28 +117,31 @@ def read_results(path):
         r, col = coordinate_to_tuple(c.address)
         params[c.address] = cell(r - 1, col - 1)
     blank = [a for a, v in params.items() if v == ""]
-    if blank and path.suffix.lower() in (".xlsx", ".xlsm"):
-        params.update(_error_cells(path, blank))
-    headers, data = {}, {}
+    if blank and data[:2] == b"PK":
+        params.update(_error_cells(data, blank))
+    headers, columns = {}, {}
     for col in range(FIRST_RESULT_COL, width):
-        header = cell(0, col)
-        last = len(grid) if col == 27 else n + 1  # AB may run past the last time row
-        values = np.array([_number(cell(r, col)) for r in range(1, last)])
+        header = text.get((0, col), "" if math.isnan(grid[0, col]) else grid[0, col])
+        last = height if col == 27 else n + 1  # AB may run past the last time row
+        values = grid[1:last, col].copy()
         if col == 8:
             values = values[:n]
         if header != "" or np.isfinite(values).any():
             headers[col] = str(header)
-            data[col] = values
+            columns[col] = values
     finals = (_number(cell(n + 2, 8)), _number(cell(n + 3, 8)))
-    return ResultSheet(path, params, headers, data, np.array(time_values), finals)
+    return ResultSheet(path, params, headers, columns, column[:n].copy(), finals)
 
 
-def _error_cells(path, addresses):
+def _error_cells(data, addresses):
     """calamine reads an error cell as blank; openpyxl keeps its text (#DIV/0!, ...)."""
+    import io
+
     import openpyxl
 
     try:
-        wb = openpyxl.load_workbook(path, read_only=True, data_only=True)
+        wb = openpyxl.load_workbook(io.BytesIO(data), read_only=True, data_only=True,
+                                    keep_links=False)
         ws = wb.worksheets[0]
         found = {}
         for row in ws.iter_rows(min_row=1, max_row=43, max_col=5):

@@ -19,9 +19,9 @@ from contextlib import contextmanager
 import numpy as np
 import xlsxwriter.workbook
 from xlsxwriter.utility import xl_col_to_name
-from xlsxwriter.worksheet import Worksheet
 
 from ..engine._artsim import render_cells
+from .safe_text import SafeWorksheet
 
 #: Rows in a worksheet (Excel's limit; xlsxwriter refuses beyond it).
 SHEET_ROWS = 1_048_576
@@ -30,7 +30,7 @@ SHEET_ROWS = 1_048_576
 CHUNK_ROWS = 8_192
 
 
-class ColumnsWorksheet(Worksheet):
+class ColumnsWorksheet(SafeWorksheet):
     """Worksheet with :meth:`write_number_column` for long numeric columns."""
 
     def __init__(self):

@@ -77,9 +77,12 @@ def _write_worst(wb, name, time, x, y):
     dlo, dhi = float(np.nanmin(diff)), float(np.nanmax(diff))
     pad = (hi - lo) * 0.05 or 1.0
     dpad = (dhi - dlo) * 0.05 or abs(dhi) * 0.05 or 1e-300
-    chart.set_title({"name": f"Worst column: {name}, both curves and their difference"})
+    # Titles that hold a workbook's own header text point at its cell: xlsxwriter would read
+    # a chart name such as "x!A1" or "=..." as a formula.
+    ws.write_string(n + 2, 0, f"Worst column: {name}, both curves and their difference")
+    chart.set_title({"name": ["Worst column", n + 2, 0]})
     chart.set_x_axis({"name": "Time (s)", "min": float(time[0]), "max": float(time[-1])})
-    chart.set_y_axis({"name": name, "min": lo - pad, "max": hi + pad})
+    chart.set_y_axis({"name": ["Worst column", 0, 1], "min": lo - pad, "max": hi + pad})
     chart.set_y2_axis({"name": "new - legacy", "min": dlo - dpad, "max": dhi + dpad,
                        "num_format": "0.0E+00"})
     chart.set_legend({"position": "bottom"})

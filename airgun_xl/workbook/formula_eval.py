@@ -30,8 +30,8 @@ class SheetView:
         ``{(sheet, col): sequence}`` of whole columns given as values for rows 1..n, e.g. the
         result columns of a run; they take precedence over ``sheets``.
     limits : dict, optional
-        ``{sheet: max_col}``: references beyond the columns that were read fail rather than
-        read as blank.
+        ``{sheet: (max_row, max_col)}``: references beyond the rows and columns that were read
+        fail rather than read as blank.
     """
 
     def __init__(self, sheets, default, columns=None, limits=None):
@@ -53,8 +53,13 @@ class SheetView:
         if column is not None:
             return (column[row - 1] if row <= len(column) else None), None
         limit = self.limits.get(sheet)
-        if limit is not None and col > limit and (row, col) not in self.sheets[sheet]:
-            raise FormulaFailure("refers to a cell outside the parameter block")
+        if limit is not None and (row > limit[0] or col > limit[1]) and (
+                (row, col) not in self.sheets.get(sheet, {})):
+            from openpyxl.utils.cell import get_column_letter
+
+            block = "the parameter block" if sheet == self.default else f"the cells read of {sheet}"
+            raise FormulaFailure(f"refers to a cell outside {block} (rows 1-{limit[0]}, columns "
+                                 f"A-{get_column_letter(min(limit[1], 16_384))})")
         return self.sheets.get(sheet, {}).get((row, col), (None, None))
 
 

@@ -7,21 +7,25 @@ are recomputed.
 
 .xlsx and .xlsm are read with openpyxl (formulas and cached values); .xls with python-calamine
 (cached values only, which Excel wrote and which are trusted).
+
+A workbook may come from anyone: :mod:`airgun_xl.workbook.guard` checks the file and the zip
+before a parser runs, only the first :data:`~airgun_xl.limits.BLOCK_ROWS` rows are read, and
+only real formula cells (``<f>``) are formulas: a text cell that starts with ``=`` is text.
 """
 import hashlib
 import io
-import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .. import limits
 from ..cells import CELLS, PARAMETER_COLUMNS, TIME_HEADER
-from ..errors import CellError, WorkbookError
+from ..errors import AirgunXlError, CellError, WorkbookError
 from ..params import Found, ShotParams, describe
+from . import guard
 from .formula_eval import Evaluator, FormulaFailure, SheetView
 
-ZIP_MAGIC = b"PK\x03\x04"
-CFB_MAGIC = bytes.fromhex("D0CF11E0A1B11AE1")  # OLE compound file: .xls, or an encrypted .xlsx
-ENCRYPTED_STREAM = "EncryptedPackage".encode("utf-16-le")
+#: Columns read from a sheet other than the parameter sheet (Outputs, or one a formula names).
+OTHER_COLUMNS = 26
 
 #: Relative difference above which a cached formula value "disagrees" with its evaluation.
 CACHE_RTOL = 1e-12
@@ -60,59 +64,41 @@ class Source:
         """A :class:`SheetView` over the parameter sheet and the other sheets."""
         sheets = dict(self.other_sheets)
         sheets[self.sheet_title.upper()] = self.block
+        bounds = {name: (limits.BLOCK_ROWS, OTHER_COLUMNS) for name in sheets}
         if extra_columns is None:  # only the block was read: references beyond it must fail
-            return SheetView(sheets, self.sheet_title.upper(), {},
-                             {self.sheet_title.upper(): PARAMETER_COLUMNS})
-        return SheetView(sheets, self.sheet_title.upper(), extra_columns)
-
-
-def _sniff(path):
-    path = Path(path)
-    if not path.exists():
-        raise WorkbookError(f"{path}: no such file, expected a workbook (.xlsx, .xlsm or .xls)")
-    if path.is_dir():
-        raise WorkbookError(f"{path}: is a folder, expected a workbook (.xlsx, .xlsm or .xls)")
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise WorkbookError(f"{path}: cannot be read ({exc.strerror})") from None
-    if data.startswith(ZIP_MAGIC):
-        return data, "zip"
-    if data.startswith(CFB_MAGIC):
-        if ENCRYPTED_STREAM in data:
-            raise WorkbookError(f"{path}: is password-protected, expected an unprotected workbook "
-                                "(save a copy without a password)")
-        return data, "xls"
-    raise WorkbookError(f"{path}: is not a workbook, expected an .xlsx, .xlsm or .xls file")
+            bounds[self.sheet_title.upper()] = (limits.BLOCK_ROWS, PARAMETER_COLUMNS)
+            return SheetView(sheets, self.sheet_title.upper(), {}, bounds)
+        # the run's result columns extend the first sheet to the right, not down its block
+        bounds[self.sheet_title.upper()] = (limits.BLOCK_ROWS, 16_384)
+        return SheetView(sheets, self.sheet_title.upper(), extra_columns, bounds)
 
 
 def _read_zip(path, data):
     import openpyxl
-    from openpyxl.utils.exceptions import InvalidFileException
 
+    zf = guard.open_zip(path, data)  # before any parser: sizes, ratios, DTDs and entities
+    zf.close()
+    shown = guard.display(path)
+    wb_f = wb_v = None
     try:
-        wb_f = openpyxl.load_workbook(io.BytesIO(data), read_only=True, data_only=False)
-        wb_v = openpyxl.load_workbook(io.BytesIO(data), read_only=True, data_only=True)
-    except (zipfile.BadZipFile, InvalidFileException, KeyError, OSError, ValueError) as exc:
-        raise WorkbookError(f"{path}: is not a readable .xlsx workbook ({exc})") from None
-    try:
+        wb_f = openpyxl.load_workbook(io.BytesIO(data), read_only=True, data_only=False,
+                                      keep_links=False)
+        wb_v = openpyxl.load_workbook(io.BytesIO(data), read_only=True, data_only=True,
+                                      keep_links=False)
         sheets = {}
-        last = _block_extent(data)  # openpyxl need not parse an old workbook's result rows
         wanted = None  # after the first sheet: the other sheets its formulas name, and Outputs
         for ws_f, ws_v in zip(wb_f.worksheets, wb_v.worksheets):
             first = not sheets
             if not first and ws_f.title.upper() not in wanted:
                 continue  # e.g. the Tracked or ChartData sheets of a filled workbook
             cells = {}
-            max_col = PARAMETER_COLUMNS if first else None
-            max_row = last if first else None
-            for row_f, row_v in zip(ws_f.iter_rows(max_row=max_row, max_col=max_col),
-                                    ws_v.iter_rows(max_row=max_row, max_col=max_col)):
+            max_col = PARAMETER_COLUMNS if first else OTHER_COLUMNS
+            for row_f, row_v in zip(ws_f.iter_rows(max_row=limits.BLOCK_ROWS, max_col=max_col),
+                                    ws_v.iter_rows(max_row=limits.BLOCK_ROWS, max_col=max_col)):
                 for cf, cv in zip(row_f, row_v):
                     if cf.value is None or not hasattr(cf, "column"):
                         continue
-                    formula = _formula_text(cf.value)
-                    cells[(cf.row, cf.column)] = (cv.value, formula)
+                    cells[(cf.row, cf.column)] = (cv.value, _formula_text(cf))
             if first:
                 h1 = next(ws_v.iter_rows(min_row=1, max_row=1, min_col=8, max_col=8,
                                          values_only=True), (None,))[0]
@@ -123,35 +109,31 @@ def _read_zip(path, data):
                 text = " ".join(f for _, f in cells.values() if f).upper()
                 wanted = {t.upper() for t in wb_f.sheetnames[1:]
                           if t.upper() in text or t.upper() == "OUTPUTS"}
-    except (zipfile.BadZipFile, KeyError, OSError, ValueError) as exc:
-        raise WorkbookError(f"{path}: is not a readable .xlsx workbook ({exc})") from None
+    except AirgunXlError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - any parser failure on untrusted bytes is one line
+        raise WorkbookError(f"{shown}: is not a readable .xlsx workbook "
+                            f"({_reason(exc)})") from None
     finally:
-        wb_f.close()
-        wb_v.close()
+        for wb in (wb_f, wb_v):
+            if wb is not None:
+                wb.close()
     if not sheets:
-        raise WorkbookError(f"{path}: has no worksheet, expected the report's parameter sheet")
+        raise WorkbookError(f"{shown}: has no worksheet, expected the report's parameter sheet")
     return sheets
 
 
-def _block_extent(data):
-    """Last row to read in columns A..G of the first sheet: the last one with a value there,
-    found by python-calamine (fast), plus a margin of 200 rows for formulas whose cached
-    value is "" (calamine shows those as empty); None when it cannot tell: read every row."""
-    try:
-        from python_calamine import CalamineWorkbook
+def _reason(exc):
+    """A parser's exception as a short phrase."""
+    text = str(exc).splitlines()[0].strip() if str(exc).strip() else ""
+    return f"{type(exc).__name__}: {text[:120]}" if text else type(exc).__name__
 
-        rows = CalamineWorkbook.from_filelike(io.BytesIO(data)).get_sheet_by_index(
-            0).to_python(skip_empty_area=False)
-    except Exception:  # noqa: BLE001 - openpyxl will report a broken file itself
+
+def _formula_text(cell):
+    """The formula of a real formula cell (``<f>``), else None: text is never a formula."""
+    if getattr(cell, "data_type", None) != "f":
         return None
-    last = 1
-    for r, row in enumerate(rows, start=1):
-        if any(v not in ("", None) for v in row[:PARAMETER_COLUMNS]):
-            last = r
-    return last + 200
-
-
-def _formula_text(value):
+    value = cell.value
     if isinstance(value, str) and value.startswith("=") and len(value) > 1:
         return value
     text = getattr(value, "text", None)  # openpyxl ArrayFormula
@@ -159,26 +141,33 @@ def _formula_text(value):
 
 
 def _read_xls(path, data):
+    shown = guard.display(path)
+    for k, (rows, columns) in enumerate(guard.xls_extents(path, data)):
+        guard.check_extent(path, f"sheet {k + 1}", rows, columns, limits.MAX_XLS_CELLS)
     try:
         from python_calamine import CalamineWorkbook
 
         wb = CalamineWorkbook.from_filelike(io.BytesIO(data))
+        names = list(wb.sheet_names)
         sheets = {}
-        for name in wb.sheet_names:
-            rows = wb.get_sheet_by_name(name).to_python(skip_empty_area=False)
+        for name in names[:1] + [n for n in names[1:] if n.upper() == "OUTPUTS"]:
             first = not sheets
+            rows = wb.get_sheet_by_name(name).to_python(skip_empty_area=False)
             cells = {}
-            for r, row in enumerate(rows, start=1):
+            for r, row in enumerate(rows[:limits.BLOCK_ROWS], start=1):
                 for c, value in enumerate(row, start=1):
-                    if first and c > PARAMETER_COLUMNS and (r, c) != (1, 8):
+                    if c > (PARAMETER_COLUMNS if first else OTHER_COLUMNS) and (r, c) != (1, 8):
                         continue
                     if value is not None and value != "":
                         cells[(r, c)] = (value, None)
             sheets[name] = cells
+    except AirgunXlError:
+        raise
     except Exception as exc:  # noqa: BLE001 - calamine raises its own types for broken files
-        raise WorkbookError(f"{path}: is not a readable .xls workbook ({exc})") from None
+        raise WorkbookError(f"{shown}: is not a readable .xls workbook "
+                            f"({_reason(exc)})") from None
     if not sheets:
-        raise WorkbookError(f"{path}: has no worksheet, expected the report's parameter sheet")
+        raise WorkbookError(f"{shown}: has no worksheet, expected the report's parameter sheet")
     return sheets
 
 
@@ -197,7 +186,7 @@ def read_source(path):
         When the file is missing, unreadable, not a workbook, or password-protected.
     """
     path = Path(path)
-    data, kind = _sniff(path)
+    data, kind = guard.read_input(path)
     sheets = _read_zip(path, data) if kind == "zip" else _read_xls(path, data)
     title = next(iter(sheets))
     block = sheets.pop(title)

@@ -57,9 +57,9 @@ TRACKED_COLUMNS = (
 )
 
 
-def write_tracked(wb, result, keep, sheet_class):
+def write_tracked(wb, result, keep, sheet_class, name="Tracked"):
     """The Tracked sheet: step values the kernel recorded, every kept row."""
-    ws = wb.add_worksheet("Tracked", worksheet_class=sheet_class)
+    ws = wb.add_worksheet(name, worksheet_class=sheet_class)
     ws.set_column(0, len(TRACKED_COLUMNS) - 1, 16)
     h = result.history
     columns = {}
@@ -73,12 +73,12 @@ def write_tracked(wb, result, keep, sheet_class):
     refs = {}
     for col, (_, key) in enumerate(TRACKED_COLUMNS[1:], start=1):
         if col in columns and full:
-            refs[key] = Ref("Tracked", 0, col, 1, len(keep), len(keep))
+            refs[key] = Ref(ws.get_name(), 0, col, 1, len(keep), len(keep))
     return refs
 
 
-def write_spectrum(wb, spectrum, sheet_class):
-    ws = wb.add_worksheet("Spectrum", worksheet_class=sheet_class)
+def write_spectrum(wb, spectrum, sheet_class, name="Spectrum"):
+    ws = wb.add_worksheet(name, worksheet_class=sheet_class)
     ws.set_column(0, 1, 16)
     ws.write_string(0, 0, "Frequency (Hz)")
     ws.write_string(0, 1, "Amplitude (kG)")
@@ -86,15 +86,15 @@ def write_spectrum(wb, spectrum, sheet_class):
                           f"test-item acceleration in kG, 0-{SPECTRUM_MAX_HZ:,.0f} Hz")
     write_number_columns(ws, 1, {0: spectrum.frequency, 1: spectrum.amplitude})
     n = len(spectrum.frequency)
-    return {"spectrum": Ref("Spectrum", 0, 1, 1, n, n)} if n else {}
+    return {"spectrum": Ref(ws.get_name(), 0, 1, 1, n, n)} if n else {}
 
 
-def write_chart_data(wb, data, refs, sheet_class):
+def write_chart_data(wb, data, refs, sheet_class, name="ChartData"):
     """Copies on ChartData of the series that have no usable home; decimated past the budget.
 
     Returns the refs of all chart series, homes and copies.
     """
-    ws = wb.add_worksheet("ChartData", worksheet_class=sheet_class)
+    ws = wb.add_worksheet(name, worksheet_class=sheet_class)
     ws.write_string(0, 0, f"Chart series not on another sheet at full resolution; a series "
                           f"longer than {POINT_BUDGET:,} points is cut to {COPY_POINTS:,}, "
                           "the min and max of each bucket of consecutive points.")
@@ -109,7 +109,7 @@ def write_chart_data(wb, data, refs, sheet_class):
         ws.write_string(1, col, f"{key} x")
         ws.write_string(1, col + 1, key)
         write_number_columns(ws, 2, {col: x[index], col + 1: y[index]})
-        out[key] = Ref("ChartData", col, col + 1, 2, 1 + len(index), len(y))
+        out[key] = Ref(ws.get_name(), col, col + 1, 2, 1 + len(index), len(y))
         col += 2
     return out
 
@@ -173,9 +173,9 @@ def _summary_rows(result, summary, timings):
     return rows
 
 
-def write_summary(wb, result, summary, timings):
+def write_summary(wb, result, summary, timings, name="Summary"):
     """The Summary sheet: one labelled cell per figure (label A, value B, unit C, note D)."""
-    ws = wb.add_worksheet("Summary")
+    ws = wb.add_worksheet(name)
     ws.set_column(0, 0, 44)
     ws.set_column(1, 1, 24)
     ws.set_column(2, 2, 8)

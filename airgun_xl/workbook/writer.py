@@ -26,6 +26,7 @@ import datetime
 import math
 
 import numpy as np
+import xlsxwriter
 from xlsxwriter.utility import xl_rowcol_to_cell
 
 from ..cells import PARAMETER_COLUMNS
@@ -35,6 +36,7 @@ from ..outputs import SHEET_NAME, Outputs
 from .atomic import atomic_path, check_output
 from .columns_sheet import ColumnsWorksheet, fast_deflate
 from .formula_eval import Evaluator, FormulaFailure
+from .safe_text import WORKBOOK_OPTIONS, SafeWorksheet, copyable_formula, sheet_title
 from .sheets import (
     Ref,
     write_chart_data,
@@ -63,13 +65,30 @@ HEADERS = {
 }
 
 
-def new_workbook(path):
-    """An xlsxwriter Workbook with the project's fixed options and properties."""
-    import xlsxwriter
+class _Workbook(xlsxwriter.Workbook):
+    worksheet_class = SafeWorksheet  # every sheet's strings are text (safe_text)
 
-    wb = xlsxwriter.Workbook(str(path), {"nan_inf_to_errors": True, "in_memory": True})
+
+def new_workbook(path):
+    """An xlsxwriter Workbook with the project's fixed options and properties; strings are
+    never turned into formulas, links or numbers (:mod:`airgun_xl.workbook.safe_text`)."""
+    wb = _Workbook(str(path), dict(WORKBOOK_OPTIONS, in_memory=True))
     wb.set_properties(PROPERTIES)
     return wb
+
+
+#: The sheets a fill adds after sheet 1, by their fixed names.
+OUTPUT_SHEETS = ("Summary", "Charts", "Tracked", "Spectrum", "ChartData", SHEET_NAME)
+
+
+def sheet_names(source_title):
+    """Sheet 1's title (made valid) and the added sheets' names, renamed when sheet 1 already
+    has one of them (``Summary`` -> ``Summary (2)``)."""
+    first = sheet_title(source_title if source_title is not None else "Sheet1")
+    names = {"first": first}
+    for name in OUTPUT_SHEETS:
+        names[name] = sheet_title(name, taken=[first])
+    return names
 
 
 #: Sheet 1 result columns (0-based) -> (output group, History/Result attribute).
@@ -151,33 +170,41 @@ def _block_values(source, columns, rows, finals):
 
 
 def write_cells(ws, cells, values=None):
-    """Copy ``{(row, col): (value, formula)}`` cells (1-based) as they were.
+    """Copy ``{(row, col): (value, formula)}`` cells (1-based) as they were; return warnings.
 
-    Formulas stay formulas, cached with ``values[(row, col)]``; numbers are written exactly.
+    Formulas stay formulas, cached with ``values[(row, col)]``, unless they reach outside the
+    workbook (DDE, another file, a web call): those are written as their cached value. Text is
+    always written as text; numbers exactly.
     """
     values = values or {}
+    warnings = []
     for (row, col), (cached, formula) in sorted(cells.items()):
         r, c = row - 1, col - 1
-        if formula is not None:
+        if formula is not None and copyable_formula(formula):
             value = values.get((row, col), cached)
             ws.write_formula(r, c, formula, None, "" if value is None else value)
-        elif isinstance(cached, bool):
+            continue
+        if formula is not None:
+            warnings.append(f"{ws.get_name()}!{xl_rowcol_to_cell(r, c)}: the formula reaches "
+                            "outside the workbook (DDE, another file or a web call); written "
+                            "as its cached value")
+        if cached is None:
+            continue
+        if isinstance(cached, bool):
             ws.write_boolean(r, c, cached)
         elif isinstance(cached, (int, float)) and math.isfinite(cached):
             ws.write_number_column(r, c, [cached])  # exact: xlsxwriter keeps 16 digits
         elif isinstance(cached, (int, float)):
             ws.write_number(r, c, cached)  # NaN/inf: written as an error cell
-        elif isinstance(cached, (datetime.date, datetime.time)):
-            ws.write(r, c, str(cached))
         else:
-            ws.write_string(r, c, str(cached))
+            ws.write_string(r, c, str(cached))  # text stays text, whatever it starts with
+    return warnings
 
 
-def _write_sheet1(wb, result, outputs, keep, stride):
+def _write_sheet1(wb, result, outputs, keep, stride, title):
     """Sheet 1: the parameter block and the macro's columns; returns (refs, warnings)."""
     source = result.shot.source
-    ws = wb.add_worksheet(source.sheet_title if source is not None else "Sheet1",
-                          worksheet_class=ColumnsWorksheet)
+    ws = wb.add_worksheet(title, worksheet_class=ColumnsWorksheet)
     columns = _sheet1_columns(result, outputs, keep)
     rows = len(keep)
     finals = None
@@ -187,7 +214,7 @@ def _write_sheet1(wb, result, outputs, keep, stride):
     if source is not None:
         block = {k: v for k, v in source.block.items() if k[1] <= PARAMETER_COLUMNS}
         values, warnings = _block_values(source, columns, rows, finals)
-        write_cells(ws, block, values)
+        warnings += write_cells(ws, block, values)
     for col in sorted(set(columns) | {c for c, g in HEADER_GROUPS.items() if g in outputs}):
         ws.write_string(0, col, HEADERS[col])
     write_number_columns(ws, 1, columns)
@@ -241,23 +268,26 @@ def write_workbook(result, path, force=False, outputs=Outputs(), summary=None, i
     info = dict(info or {}, every=stride, sheet_rows=len(keep))
     with atomic_path(path) as tmp:
         wb = new_workbook(tmp)
-        refs, warnings = _write_sheet1(wb, result, outputs, keep, stride)
+        names = sheet_names(source.sheet_title if source is not None else None)
+        refs, warnings = _write_sheet1(wb, result, outputs, keep, stride, names["first"])
         if "summary" in outputs:
-            write_summary(wb, result, summary, info)
-        charts_ws = wb.add_worksheet("Charts") if "charts" in outputs else None
+            write_summary(wb, result, summary, info, names["Summary"])
+        charts_ws = wb.add_worksheet(names["Charts"]) if "charts" in outputs else None
         if "tracked" in outputs:
-            refs.update(write_tracked(wb, result, keep, ColumnsWorksheet))
+            refs.update(write_tracked(wb, result, keep, ColumnsWorksheet, names["Tracked"]))
         if "spectrum" in outputs:
-            refs.update(write_spectrum(wb, summary.spectrum, ColumnsWorksheet))
+            refs.update(write_spectrum(wb, summary.spectrum, ColumnsWorksheet,
+                                       names["Spectrum"]))
         if charts_ws is not None:
             data = series_data(result, summary.spectrum, info.get("compared"))
-            placed = write_chart_data(wb, data, refs, ColumnsWorksheet)
+            placed = write_chart_data(wb, data, refs, ColumnsWorksheet, names["ChartData"])
             compared = info.get("compared")
             labels = {"compared_kg": f"{compared.model} model"} if compared is not None else None
             add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]), labels)
         if source is not None and source.outputs_block:
-            write_cells(wb.add_worksheet(SHEET_NAME, worksheet_class=ColumnsWorksheet),
-                        source.outputs_block)
+            warnings += write_cells(wb.add_worksheet(names[SHEET_NAME],
+                                                     worksheet_class=ColumnsWorksheet),
+                                    source.outputs_block)
         with fast_deflate():
             wb.close()
     return warnings
