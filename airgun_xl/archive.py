@@ -2,18 +2,28 @@
 
 Layout of an archive folder::
 
+    .airgun-xl-archive      marker: this folder is an archive (JSON, the format version)
     index.sqlite            one row an entry (SQLite, WAL mode; no server)
     <shot>/v0001/           an entry: input, output.xlsx, params.json, history.parquet,
                             summary.json, provenance.json, manifest.json (SHA-256 of each)
-    .tmp/<pid>-<uuid>/      an entry being written
+    .airgun-xl-scratch/<owner>-<hex>/   an entry being written
 
-An entry is either fully there or not at all: its files are written and synced in a private
-folder under ``.tmp``, then, holding the index's write lock, the folder is renamed into place
-(an atomic rename) and its row inserted in the same transaction. A process killed at any point
-leaves either a ``.tmp`` folder (removed by the next writer, once its process is gone) or a
-complete folder whose row was not committed (indexed by the next writer from its manifest).
-Two processes writing at once queue on the lock and never take the same version.
+The tool only ever writes into a folder it created, an empty one, or one that holds the marker
+or an index of its own; a non-empty foreign folder is refused. It removes nothing but its own
+scratch folders, by their exact name pattern, once their owner process is gone.
+
+An entry is either fully there or not at all: its files are written and synced in a scratch
+folder, then, holding the index's write lock, the folder is renamed into place (an atomic
+rename: the commit point) and its row inserted in the same transaction. A process killed at any
+point leaves either a scratch folder (removed by the next writer) or a complete folder whose row
+was not committed (indexed by the next writer from its manifest). Two processes writing at once
+queue on the lock and never take the same version. A fill publishes its workbook and the entry
+together (:class:`PendingEntry` joins its :class:`airgun_xl.transaction.Publication`).
+
+``verify`` reports, rather than raises on, whatever it finds: a copied entry folder, a corrupt
+manifest, a missing or altered file, a row that points outside the archive.
 """
+import contextlib
 import datetime
 import hashlib
 import json
@@ -26,11 +36,16 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .errors import AirgunXlError, OptionError
+from .transaction import display, owner_alive, owner_token
 
 ENV = "AIRGUN_XL_ARCHIVE"
 INDEX = "index.sqlite"
-TMP = ".tmp"
+MARKER = ".airgun-xl-archive"
+SCRATCH = ".airgun-xl-scratch"
 MANIFEST = "manifest.json"
+FORMAT = 1
+_SCRATCH_NAME = re.compile(r"^(?P<owner>\d+\.\d+)-[0-9a-f]{32}$")
+_ENTRY_NAME = re.compile(r"^v(\d{4,})$")
 SCHEMA = """
 CREATE TABLE IF NOT EXISTS entries (
     id INTEGER PRIMARY KEY,
@@ -64,6 +79,8 @@ def safe_name(name):
     no leading dots, at most 100 characters (``../../x`` -> ``x``)."""
     text = re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._-")
     text = re.sub(r"\.{2,}", ".", text)[:100]
+    if text.lower().startswith(INDEX):  # index.sqlite, -wal, -shm are the index's own files
+        text = f"shot_{text}"[:100]
     return text or "shot"
 
 
@@ -102,28 +119,127 @@ class Entry:
         return f"{self.shot}@{self.version}"
 
     def manifest(self):
-        return json.loads((self.path / MANIFEST).read_text())
+        return self.load(MANIFEST)
 
     def load(self, name):
-        return json.loads((self.path / name).read_text())
+        """A JSON file of the entry.
+
+        Raises
+        ------
+        ArchiveError
+            When it is missing or not valid JSON (``archive verify`` lists such damage).
+        """
+        try:
+            return json.loads((self.path / name).read_text())
+        except FileNotFoundError:
+            raise ArchiveError(f"{self.ref}: {name} is missing from {display(self.path)}, "
+                               "expected a whole entry (see airgun-xl archive verify)") from None
+        except (OSError, ValueError) as exc:
+            raise ArchiveError(f"{self.ref}: {name} cannot be read ({exc}), expected a whole "
+                               "entry (see airgun-xl archive verify)") from None
+
+
+def _entry_version(folder):
+    """The version of an entry folder name (``v0003`` -> 3), else None."""
+    m = _ENTRY_NAME.match(folder.name)
+    return int(m.group(1)) if m else None
+
+
+def _read_manifest(folder):
+    """An entry folder's manifest, or None when missing, corrupt or not for this folder."""
+    try:
+        manifest = json.loads((folder / MANIFEST).read_text())
+        index = manifest["index"]
+        files = manifest["files"]
+        ok = (index["shot"] == folder.parent.name and index["version"] == _entry_version(folder)
+              and isinstance(files, dict)
+              and all(isinstance(n, str) and n == os.path.basename(n) and n not in ("", ".", "..")
+                      and isinstance(d, str) for n, d in files.items()))
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return None
+    return manifest if ok else None
+
+
+def _is_index(path):
+    """Whether ``path`` is an SQLite file with this tool's ``entries`` table."""
+    if not path.is_file():
+        return False
+    try:
+        conn = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+        try:
+            row = conn.execute("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = "
+                               "'entries'").fetchone()
+        finally:
+            conn.close()
+    except sqlite3.Error:
+        return False
+    return row is not None
 
 
 class Archive:
-    """An archive folder (created on first use)."""
+    """An archive folder.
 
-    def __init__(self, root):
+    Parameters
+    ----------
+    root : path
+    create : bool
+        Create the folder (its parent must exist), or adopt an empty one, for writing. Without
+        it, ``root`` must already be an archive.
+
+    Raises
+    ------
+    ArchiveError
+        When ``root`` is missing (without ``create``), not a folder, or a folder that holds
+        other files and is not an archive.
+    """
+
+    def __init__(self, root, create=False):
         self.root = Path(root)
-        if self.root.exists() and not self.root.is_dir():
-            raise ArchiveError(f"{self.root}: is not a folder, expected an archive folder")
+        shown = display(self.root)
+        if not self.root.exists():
+            if not create:
+                raise ArchiveError(f"{shown}: no such archive, expected a folder written by "
+                                   "airgun-xl fill --archive")
+            try:
+                os.mkdir(self.root)
+            except FileNotFoundError:
+                raise ArchiveError(f"{shown}: its folder {display(self.root.parent)} does not "
+                                   "exist, expected an existing folder for the archive") from None
+            except OSError as exc:
+                raise ArchiveError(f"{shown}: cannot be created ({exc.strerror})") from None
+        if not self.root.is_dir():
+            raise ArchiveError(f"{shown}: is not a folder, expected an archive folder")
+        marked = (self.root / MARKER).is_file() or _is_index(self.root / INDEX)
+        if not marked:
+            try:
+                empty = not any(os.scandir(self.root))
+            except OSError as exc:
+                raise ArchiveError(f"{shown}: cannot be read ({exc.strerror})") from None
+            if not (create and empty):
+                raise ArchiveError(
+                    f"{shown}: is not an airgun-xl archive (no {MARKER} or {INDEX}), expected "
+                    + ("an archive, an empty folder or a new folder name" if create
+                       else "a folder written by airgun-xl fill --archive"))
+        if create and not (self.root / MARKER).is_file():
+            try:
+                with open(self.root / MARKER, "x") as fh:
+                    json.dump({"format": FORMAT, "tool": "airgun-xl"}, fh)
+            except FileExistsError:
+                pass
+            except OSError as exc:
+                raise ArchiveError(f"{shown}: cannot be written ({exc.strerror})") from None
 
     # -- the index ------------------------------------------------------------------------
     def _connect(self):
-        self.root.mkdir(parents=True, exist_ok=True)
-        conn = sqlite3.connect(self.root / INDEX, timeout=120, isolation_level=None)
-        conn.row_factory = sqlite3.Row
-        conn.execute("PRAGMA journal_mode=WAL")
-        conn.execute("PRAGMA synchronous=FULL")
-        conn.execute(SCHEMA)
+        try:
+            conn = sqlite3.connect(self.root / INDEX, timeout=120, isolation_level=None)
+            conn.row_factory = sqlite3.Row
+            conn.execute("PRAGMA journal_mode=WAL")
+            conn.execute("PRAGMA synchronous=FULL")
+            conn.execute(SCHEMA)
+        except sqlite3.Error as exc:
+            raise ArchiveError(f"{display(self.root / INDEX)}: cannot be used ({exc}), expected "
+                               "the archive's SQLite index") from None
         return conn
 
     def _insert(self, conn, manifest, path):
@@ -132,37 +248,49 @@ class Archive:
             "INSERT INTO entries (shot, version, path, created, input_sha256, v0, delta, "
             "max_time, sigmay, rcone, peak_kg, integrator, model, engine) VALUES "
             "(?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
-            (meta["shot"], meta["version"], str(path.relative_to(self.root)), meta["created"],
-             meta.get("input_sha256"), meta.get("v0"), meta.get("delta"), meta.get("max_time"),
-             meta.get("sigmay"), meta.get("rcone"), meta.get("peak_kg"),
+            (meta["shot"], meta["version"], path.relative_to(self.root).as_posix(),
+             meta["created"], meta.get("input_sha256"), meta.get("v0"), meta.get("delta"),
+             meta.get("max_time"), meta.get("sigmay"), meta.get("rcone"), meta.get("peak_kg"),
              meta.get("integrator"), meta.get("model"), meta.get("engine")))
+
+    def _entry_folders(self):
+        """``(folder, version)`` of every folder shaped like an entry, ``<shot>/vNNNN``."""
+        for shot in sorted(self.root.iterdir()):
+            if shot.name.startswith(".") or not shot.is_dir() or shot.is_symlink():
+                continue
+            for folder in sorted(shot.iterdir()):
+                version = _entry_version(folder)
+                if version is not None and folder.is_dir() and not folder.is_symlink():
+                    yield folder, version
 
     def _recover(self, conn):
         """Under the write lock: index complete entries whose row was lost to a kill, and
-        remove the private folders of writers that are gone."""
+        remove the scratch folders of writers that are gone (only those)."""
         known = {r["path"] for r in conn.execute("SELECT path FROM entries")}
-        for manifest_path in self.root.glob(f"*/v*/{MANIFEST}"):
-            folder = manifest_path.parent
-            rel = str(folder.relative_to(self.root))
-            if rel not in known and self._complete(folder):
-                self._insert(conn, json.loads(manifest_path.read_text()), folder)
-        tmp = self.root / TMP
-        for folder in tmp.glob("*") if tmp.is_dir() else ():
-            pid = folder.name.split("-", 1)[0]
-            if not pid.isdigit() or not _alive(int(pid)):
+        for folder, _ in self._entry_folders():
+            rel = folder.relative_to(self.root).as_posix()
+            if rel in known:
+                continue
+            manifest = _read_manifest(folder)
+            if manifest is not None and self._complete(folder, manifest):
+                with contextlib.suppress(sqlite3.IntegrityError):  # a clash: verify reports it
+                    self._insert(conn, manifest, folder)
+        scratch = self.root / SCRATCH
+        for folder in scratch.iterdir() if scratch.is_dir() else ():
+            m = _SCRATCH_NAME.match(folder.name)
+            if m and folder.is_dir() and not folder.is_symlink() and not owner_alive(
+                    m["owner"]):
                 shutil.rmtree(folder, ignore_errors=True)
 
-    def _complete(self, folder):
-        try:
-            manifest = json.loads((folder / MANIFEST).read_text())
-        except (OSError, ValueError):
-            return False
+    def _complete(self, folder, manifest):
         return all((folder / name).is_file() and sha256(folder / name) == digest
                    for name, digest in manifest["files"].items())
 
     # -- writing --------------------------------------------------------------------------
-    def add(self, shot, files, documents, index, generated=None):
-        """Store one entry.
+    def prepare(self, shot, files, documents, index, generated=None):
+        """Write an entry's files into a scratch folder; return the :class:`PendingEntry`
+        that commits it (alone with :meth:`PendingEntry.commit_alone`, or inside a
+        :class:`airgun_xl.transaction.Publication`).
 
         Parameters
         ----------
@@ -176,16 +304,16 @@ class Archive:
             Columns of the index row (v0, delta, peak_kg, ...).
         generated : dict, optional
             Entry file name -> function that writes that file at the path it is given.
-
-        Returns
-        -------
-        Entry
         """
         shot = safe_name(shot)
-        tmp_root = self.root / TMP
-        tmp_root.mkdir(parents=True, exist_ok=True)
-        work = tmp_root / f"{os.getpid()}-{uuid.uuid4().hex}"
-        work.mkdir()
+        scratch = self.root / SCRATCH
+        try:
+            scratch.mkdir(exist_ok=True)
+            work = scratch / f"{owner_token()}-{uuid.uuid4().hex}"
+            work.mkdir()
+        except OSError as exc:
+            raise ArchiveError(f"{display(scratch)}: cannot be written ({exc.strerror})") from None
+        pending = PendingEntry(self, shot, work)
         try:
             for name, source in files.items():
                 shutil.copyfile(source, work / name)
@@ -194,42 +322,28 @@ class Archive:
             for name, write in (generated or {}).items():
                 write(work / name)
             digests = {p.name: sha256(p) for p in sorted(work.iterdir())}
-            created = datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")
-            manifest = {"files": digests, "index": dict(index, shot=shot, created=created)}
             for p in work.iterdir():
                 with open(p, "rb") as fh:
                     os.fsync(fh.fileno())
-            conn = self._connect()
-            try:
-                conn.execute("BEGIN IMMEDIATE")  # the write lock: one writer at a time
-                self._recover(conn)
-                version = self._next_version(conn, shot)
-                manifest["index"]["version"] = version
-                (work / MANIFEST).write_text(json.dumps(manifest, indent=1, default=str))
-                with open(work / MANIFEST, "rb") as fh:
-                    os.fsync(fh.fileno())
-                _fsync_dir(work)
-                final = self.root / shot / f"v{version:04d}"
-                final.parent.mkdir(exist_ok=True)
-                os.rename(work, final)  # the entry appears whole
-                _fsync_dir(final.parent)
-                self._insert(conn, manifest, final)
-                conn.execute("COMMIT")
-            except BaseException:
-                if conn.in_transaction:
-                    conn.execute("ROLLBACK")
-                raise
-            finally:
-                conn.close()
-        finally:
-            if work.exists():
-                shutil.rmtree(work, ignore_errors=True)
-        return self.get(f"{shot}@{version}")
+        except BaseException as exc:
+            pending.release()
+            if isinstance(exc, OSError):
+                raise ArchiveError(f"{display(self.root)}: the entry cannot be written "
+                                   f"({exc.strerror or exc})") from None
+            raise
+        created = datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")
+        pending.manifest = {"files": digests, "index": dict(index, shot=shot, created=created)}
+        return pending
+
+    def add(self, shot, files, documents, index, generated=None):
+        """Store one entry on its own (see :meth:`prepare`); return the :class:`Entry`."""
+        return self.prepare(shot, files, documents, index, generated).commit_alone()
 
     def _next_version(self, conn, shot):
         row = conn.execute("SELECT MAX(version) FROM entries WHERE shot = ?", (shot,)).fetchone()
-        on_disk = [int(p.name[1:]) for p in (self.root / shot).glob("v*")
-                   if p.name[1:].isdigit()] if (self.root / shot).is_dir() else []
+        folder = self.root / shot
+        on_disk = [v for v in (_entry_version(p) for p in folder.iterdir()) if v is not None] \
+            if folder.is_dir() else []
         return max([row[0] or 0] + on_disk) + 1
 
     # -- reading --------------------------------------------------------------------------
@@ -246,18 +360,28 @@ class Archive:
                 sql += " AND created >= ?"
                 args.append(since)
             rows = conn.execute(sql + " ORDER BY created, shot, version", args).fetchall()
+        except sqlite3.Error as exc:
+            raise ArchiveError(f"{display(self.root / INDEX)}: cannot be read ({exc})") from None
         finally:
             conn.close()
-        return [self._entry(r) for r in rows]
+        return [e for e in (self._entry(r) for r in rows) if e is not None]
 
     def _entry(self, r):
-        return Entry(r["id"], r["shot"], r["version"], self.root / r["path"], r["created"],
-                     dict(r))
+        """An Entry from an index row; None for a row whose path is not ``<shot>/vNNNN``."""
+        path = str(r["path"])
+        parts = path.split("/")
+        if len(parts) != 2 or parts[0] != safe_name(parts[0]) or not _ENTRY_NAME.match(parts[1]):
+            return None
+        return Entry(r["id"], r["shot"], r["version"], self.root / parts[0] / parts[1],
+                     r["created"], dict(r))
 
     def get(self, ref):
         """An entry by ``shot@version``, ``shot`` (its latest version), ``shot/v0003`` or
         ``#id``."""
         ref = str(ref).strip()
+        if not ref:
+            raise ArchiveError("ENTRY: found an empty name, expected SHOT, SHOT@VERSION or #ID "
+                               "(see airgun-xl history)")
         candidates = self.entries()
         by_id = re.fullmatch(r"#?(\d+)", ref)
         if by_id:
@@ -269,14 +393,16 @@ class Archive:
                      and (version is None or e.version == int(version))]
             found = found[-1:]
         if not found:
-            raise ArchiveError(f"{ref}: no such entry in {self.root}, expected SHOT, "
+            raise ArchiveError(f"{ref}: no such entry in {display(self.root)}, expected SHOT, "
                                "SHOT@VERSION or #ID (see airgun-xl history)")
         return found[0]
 
     def verify(self):
         """Re-hash every file of every entry; return the problems found (empty when clean).
 
-        Recovery runs first, under the write lock, as any writer's would.
+        Recovery runs first, under the write lock, as any writer's would. Damage is reported,
+        never raised: a copied or stray entry folder, a corrupt manifest, a missing or altered
+        file, a row whose path is not an entry.
         """
         problems = []
         conn = self._connect()
@@ -287,33 +413,123 @@ class Archive:
             check = conn.execute("PRAGMA integrity_check").fetchone()[0]
             if check != "ok":
                 problems.append(f"{INDEX}: {check}")
+            rows = conn.execute("SELECT * FROM entries ORDER BY shot, version").fetchall()
+        except sqlite3.Error as exc:
+            problems.append(f"{INDEX}: cannot be read ({exc})")
+            rows = []
         finally:
             conn.close()
         indexed = set()
-        for e in self.entries():
-            indexed.add(e.path)
-            if not (e.path / MANIFEST).is_file():
-                problems.append(f"{e.ref}: missing {e.path}")
+        for r in rows:
+            e = self._entry(r)
+            if e is None:
+                problems.append(f"row #{r['id']}: its path {r['path']!r} is not an entry folder")
                 continue
-            for name, digest in e.manifest()["files"].items():
+            indexed.add(e.path)
+            if not e.path.is_dir():
+                problems.append(f"{e.ref}: missing {e.path.relative_to(self.root)}")
+                continue
+            manifest = _read_manifest(e.path)
+            if manifest is None:
+                problems.append(f"{e.ref}: {MANIFEST} is missing, corrupt or names another "
+                                "entry")
+                continue
+            for name, digest in manifest["files"].items():
                 f = e.path / name
                 if not f.is_file():
                     problems.append(f"{e.ref}: missing {name}")
                 elif sha256(f) != digest:
                     problems.append(f"{e.ref}: {name} altered (SHA-256 differs)")
-        for folder in self.root.glob("*/v*"):
-            if folder.is_dir() and folder not in indexed:
-                problems.append(f"{folder.relative_to(self.root)}: not in the index")
+        for folder, _ in self._entry_folders():
+            if folder not in indexed:
+                why = ("its manifest is missing, corrupt or names another entry"
+                       if _read_manifest(folder) is None else "incomplete or clashing")
+                problems.append(f"{folder.relative_to(self.root).as_posix()}: not in the index "
+                                f"({why})")
+        for shot in sorted(self.root.iterdir()):
+            if shot.name.startswith(".") or not shot.is_dir():
+                continue
+            for folder in sorted(shot.iterdir()):
+                if _entry_version(folder) is None or folder.is_symlink():
+                    problems.append(f"{folder.relative_to(self.root).as_posix()}: not an entry "
+                                    "(a copied or stray file?)")
         return problems
 
 
-def _alive(pid):
-    if pid == os.getpid():
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
+class PendingEntry:
+    """An entry written to scratch, waiting to be committed.
+
+    As a participant of a :class:`airgun_xl.transaction.Publication`: :meth:`prepare` takes
+    the index's write lock and picks the version, :meth:`commit` renames the folder into place
+    and commits the row, :meth:`release` drops the lock and the scratch folder.
+    """
+
+    def __init__(self, archive, shot, work):
+        self.archive, self.shot, self.work = archive, shot, work
+        self.manifest = None
+        self.conn = None
+        self.final = None
+        self.entry = None
+
+    def prepare(self, txn=None):
+        """Lock the index, recover, pick the version; return the path of the manifest that
+        names ``txn`` once the entry is committed."""
+        self.conn = self.archive._connect()
+        try:
+            self.conn.execute("BEGIN IMMEDIATE")  # the write lock: one writer at a time
+            self.archive._recover(self.conn)
+            version = self.archive._next_version(self.conn, self.shot)
+        except sqlite3.Error as exc:
+            raise ArchiveError(f"{display(self.archive.root / INDEX)}: cannot be used "
+                               f"({exc})") from None
+        self.manifest["index"]["version"] = version
+        if txn is not None:
+            self.manifest["txn"] = txn
+        with open(self.work / MANIFEST, "w") as fh:
+            json.dump(self.manifest, fh, indent=1, default=str)
+            fh.flush()
+            os.fsync(fh.fileno())
+        _fsync_dir(self.work)
+        self.final = self.archive.root / self.shot / f"v{version:04d}"
+        return (self.final / MANIFEST).resolve()
+
+    def commit(self):
+        """Rename the entry into place and commit its row (under the lock from prepare)."""
+        try:
+            self.final.parent.mkdir(exist_ok=True)
+            os.rename(self.work, self.final)  # the entry appears whole: the commit point
+        except OSError as exc:
+            raise ArchiveError(f"{display(self.final)}: cannot be written "
+                               f"({exc.strerror})") from None
+        try:
+            _fsync_dir(self.final.parent)
+            self.archive._insert(self.conn, self.manifest, self.final)
+            self.conn.execute("COMMIT")
+        except BaseException:
+            with contextlib.suppress(OSError):
+                os.rename(self.final, self.work)  # not committed after all
+            raise
+        self.conn.close()
+        self.conn = None
+        self.entry = Entry(0, self.shot, self.manifest["index"]["version"], self.final,
+                           self.manifest["index"]["created"], {})
+
+    def release(self):
+        """Give up: roll back the index transaction and remove the scratch folder."""
+        if self.conn is not None:
+            with contextlib.suppress(sqlite3.Error):
+                if self.conn.in_transaction:
+                    self.conn.execute("ROLLBACK")
+            self.conn.close()
+            self.conn = None
+        if self.work.exists():
+            shutil.rmtree(self.work, ignore_errors=True)
+
+    def commit_alone(self):
+        """Commit without a publication; return the :class:`Entry`."""
+        try:
+            self.prepare()
+            self.commit()
+        finally:
+            self.release()
+        return self.archive.get(f"{self.shot}@{self.manifest['index']['version']}")

@@ -2,14 +2,16 @@
 import dataclasses
 import datetime
 import platform
+from pathlib import Path
 from importlib import metadata
 
 import numpy as np
 
 from . import __version__
-from .archive import Archive, safe_name
+from .archive import safe_name
 from .cells import CELLS
-from .workbook.sidecar import have_parquet, write_history
+from .transaction import display
+from .workbook.sidecar import have_parquet, render_history
 
 LIBRARIES = ("numpy", "pandas", "openpyxl", "xlsxwriter", "formulas", "python-calamine",
              "scipy", "pyarrow", "matplotlib")
@@ -48,8 +50,22 @@ def shot_name(shot, given=None):
     return "shot"
 
 
-def archive_fill(root, name, shot, output, filled, options, started_at, seconds):
-    """Store a finished fill as one archive entry; return the Entry."""
+def prepare_entry(archive, request, shot, workbook, filled, options, seconds):
+    """Write a finished fill's archive entry to scratch; return the
+    :class:`airgun_xl.archive.PendingEntry` that the fill's publication commits.
+
+    Parameters
+    ----------
+    archive : airgun_xl.archive.Archive
+    request : airgun_xl.pipeline.ArchiveRequest
+    shot : airgun_xl.shot.Shot
+    workbook : pathlib.Path
+        The output workbook as written (its temp file, not yet published).
+    filled : airgun_xl.pipeline.Filled
+    options : airgun_xl.pipeline.Options
+    seconds : float
+        Run time so far [s].
+    """
     p, result, s = shot.params, filled.result, filled.summary
     params = [{"cell": c.address, "label": c.label, "value": getattr(p, c.name),
                "unit": c.unit, "meaning": c.meaning} for c in CELLS]
@@ -60,12 +76,13 @@ def archive_fill(root, name, shot, output, filled, options, started_at, seconds)
     summary.update(rows=result.rows, peak_kg=_plain(result.peak_kg),
                    time_of_peak=_plain(result.time_of_peak))
     provenance = {"engine": __version__, "versions": _versions(),
-                  "input": str(shot.source.path) if shot.source else None,
+                  "input": display(shot.source.path) if shot.source else None,
                   "input_sha256": shot.source.sha256 if shot.source else None,
-                  "started": started_at, "run_seconds": seconds,
-                  "command": list(options.command), "integrator": options.integrator,
-                  "model": options.model, "host": options.host, "stride": filled.stride}
-    files = {"output.xlsx": output}
+                  "started": request.started_at, "run_seconds": seconds,
+                  "command": [display(a) for a in options.command],
+                  "integrator": options.integrator, "model": options.model,
+                  "host": options.host, "stride": filled.stride}
+    files = {"output.xlsx": workbook}
     if shot.source is not None:
         files["input" + shot.source.path.suffix.lower()] = shot.source.path
     history = "history.parquet" if have_parquet() else "history.csv"
@@ -73,10 +90,10 @@ def archive_fill(root, name, shot, output, filled, options, started_at, seconds)
              "max_time": p.max_time, "sigmay": p.sigmay, "rcone": p.rcone,
              "peak_kg": summary["peak_kg"], "integrator": options.integrator,
              "model": options.model, "engine": __version__}
-    return Archive(root).add(
-        safe_name(name), files,
+    return archive.prepare(
+        safe_name(request.name), files,
         {"params.json": params, "summary.json": summary, "provenance.json": provenance},
-        index, {history: lambda path: write_history(result, path)})
+        index, {history: lambda path: render_history(result, path, shown=Path(history))})
 
 
 def now():

@@ -1,14 +1,18 @@
 """A fill from start to finish, shared by ``fill`` and ``design``: check, run, summarize,
-write the workbook and the sidecar. Reports go through a ``warn`` callback."""
+then publish the workbook, its sidecar and its archive entry as one transaction
+(:class:`airgun_xl.transaction.Publication`): all of them, or none. Reports go through a
+``warn`` callback."""
 import dataclasses
 import time
+from pathlib import Path
 
 from . import __version__
 from .checks import StabilityError, after_run, before_run
 from .engine.summary import summarize
 from .models import apply_model
-from .workbook.atomic import check_output
-from .workbook.sidecar import sidecar_path, write_history
+from .transaction import Publication, check_output
+from .workbook.sidecar import SIDECAR_SUFFIXES, render_history, sidecar_path
+from .workbook.writer import render_workbook
 
 
 @dataclasses.dataclass
@@ -22,6 +26,15 @@ class Options:
     reproducible: bool = False
     track_all: bool = False  # record every step value (an archived run keeps them all)
     command: tuple = ()  # the command line, for provenance
+    archive: object = None  # an ArchiveRequest: also store the run as an archive entry
+    force_word: str = "--force"  # how messages name `force`
+
+
+@dataclasses.dataclass
+class ArchiveRequest:
+    root: Path
+    name: str  # the shot's name in the archive (sanitized there)
+    started_at: str  # ISO time the command started, for provenance
 
 
 @dataclasses.dataclass
@@ -31,6 +44,7 @@ class Filled:
     stride: int
     sidecar: object
     compared: object = None  # the other model's Result, with --compare-models
+    entry: object = None  # the archive Entry, when the run was archived
 
 
 def fill_workbook(shot, output, outputs, options, warn, started=None):
@@ -45,10 +59,18 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
     inputs = [shot.source.path] if shot.source is not None else []
     model_shot = dataclasses.replace(shot, params=apply_model(shot.params, options.model))
     rows = shot.params.rows
+    output = Path(output)
     sidecar = sidecar_path(output) if outputs.writes_sidecar(rows) else None
-    check_output(output, options.force, inputs=inputs)  # before the run, not after
+    check_output(output, options.force, inputs=inputs,  # before the run, not after
+                 force_word=options.force_word)
     if sidecar is not None:
-        check_output(sidecar, options.force, inputs=inputs)
+        check_output(sidecar, options.force, inputs=inputs, suffixes=(".parquet", ".csv"),
+                     force_word=options.force_word)
+    archive = None
+    if options.archive is not None:
+        from .archive import Archive
+
+        archive = Archive(options.archive.root, create=True)  # a foreign folder: refused now
     warn(shot.warnings)
     crit, findings = before_run(model_shot.params, options.integrator)
     if crit.ratio > 1 and not options.allow_unstable:
@@ -77,7 +99,23 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
     if not options.reproducible:
         info.update(kernel_seconds=result.history.kernel_seconds,
                     run_seconds=time.perf_counter() - started)
-    warn(result.write(output, force=options.force, outputs=outputs, summary=summary, info=info))
-    if sidecar is not None:
-        write_history(result, sidecar)
-    return Filled(result, summary, outputs.stride(rows), sidecar, compared)
+    filled = Filled(result, summary, outputs.stride(rows), sidecar, compared)
+    with Publication(options.force, options.force_word) as pub:
+        warn(render_workbook(result, pub.stage(output), outputs, summary, info, shown=output))
+        workbook = pub.files[0][0]
+        if sidecar is not None:
+            render_history(result, pub.stage(sidecar), shown=sidecar)
+        if options.force:  # a sidecar left by an earlier run must not pair with this workbook
+            for stale in (output.with_name(output.stem + s) for s in SIDECAR_SUFFIXES):
+                if stale != sidecar:
+                    pub.remove(stale)
+        pending = None
+        if archive is not None:
+            from .archiving import prepare_entry
+
+            pending = prepare_entry(archive, options.archive, shot, workbook, filled, options,
+                                    time.perf_counter() - started)
+            pub.join(pending)
+        pub.commit()
+    filled.entry = pending.entry if pending is not None else None
+    return filled

@@ -1,6 +1,13 @@
-"""The ``airgun-xl`` command: parses arguments and hands off to one module per subcommand."""
+"""The ``airgun-xl`` command: parses arguments and hands off to one module per subcommand.
+
+Exit codes: 0 done, 1 a comparison found differences, 2 bad input (one line on stderr, nothing
+written), 128 + N for signal N. SIGTERM and SIGHUP clean up like Ctrl-C (temp files go, nothing
+is half published); SIGXFSZ is ignored, so a file-size limit (``ulimit -f``) is a write error.
+"""
 import argparse
+import contextlib
 import os
+import signal
 import sys
 
 from .. import __version__
@@ -28,21 +35,64 @@ def build_parser():
     return parser
 
 
+class Interrupted(KeyboardInterrupt):
+    """A termination signal, raised where the program is, so that cleanup runs."""
+
+    def __init__(self, signum):
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _raise_interrupted(signum, frame):
+    raise Interrupted(signum)
+
+
+@contextlib.contextmanager
+def _signals():
+    """SIGTERM and SIGHUP raise like SIGINT; SIGXFSZ is ignored (in the main thread only)."""
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    wanted = {getattr(signal, n): _raise_interrupted for n in ("SIGTERM", "SIGHUP")
+              if hasattr(signal, n)}
+    if hasattr(signal, "SIGXFSZ"):
+        wanted[signal.SIGXFSZ] = signal.SIG_IGN
+    saved = {s: signal.signal(s, h) for s, h in wanted.items()}
+    try:
+        yield
+    finally:
+        for s, h in saved.items():
+            signal.signal(s, h)
+
+
+def _say(text):
+    """One line to stderr, whatever the file names in it hold."""
+    stream = sys.stderr
+    encoding = getattr(stream, "encoding", None) or "utf-8"
+    print(text.encode(encoding, "backslashreplace").decode(encoding, "replace"), file=stream)
+
+
 def main(argv=None):
-    """Run the CLI; return the exit code (0 ok, 2 bad input)."""
+    """Run the CLI; return the exit code (0 ok, 1 differences, 2 bad input, 128+N signal N)."""
     parser = build_parser()
     try:
-        args = parser.parse_args(argv)
-        args.argv = ["airgun-xl", *(sys.argv[1:] if argv is None else argv)]
-        if args.command is None:
-            parser.print_help()
-            return 2
-        return args.run(args)
+        with _signals():
+            args = parser.parse_args(argv)
+            args.argv = ["airgun-xl", *(sys.argv[1:] if argv is None else argv)]
+            if args.command is None:
+                parser.print_help()
+                return 2
+            return args.run(args)
     except AirgunXlError as exc:
-        print(f"airgun-xl: error: {exc}", file=sys.stderr)
+        _say(f"airgun-xl: error: {exc}")
         return exc.exit_code
+    except Interrupted as exc:
+        _say(f"airgun-xl: stopped by signal {exc.signum}; nothing was left half-written")
+        return 128 + exc.signum
     except KeyboardInterrupt:
-        print("airgun-xl: interrupted", file=sys.stderr)
+        _say("airgun-xl: interrupted; nothing was left half-written")
         return 130
     except BrokenPipeError:  # e.g. `airgun-xl history | head`
         sys.stdout = open(os.devnull, "w")
@@ -52,4 +102,4 @@ def main(argv=None):
 def warn(messages):
     """Print warnings, one line each, to stderr."""
     for message in messages:
-        print(f"airgun-xl: warning: {message}", file=sys.stderr)
+        _say(f"airgun-xl: warning: {message}")

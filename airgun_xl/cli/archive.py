@@ -109,9 +109,18 @@ def _history(entry):
     """The entry's full time history, column -> array."""
     import pandas as pd
 
-    path = next(p for p in (entry.path / "history.parquet", entry.path / "history.csv")
-                if p.exists())
-    frame = pd.read_parquet(path) if path.suffix == ".parquet" else pd.read_csv(path)
+    from ..archive import ArchiveError
+
+    path = next((p for p in (entry.path / "history.parquet", entry.path / "history.csv")
+                 if p.exists()), None)
+    if path is None:
+        raise ArchiveError(f"{entry.ref}: its history is missing, expected history.parquet or "
+                           "history.csv (see airgun-xl archive verify)")
+    try:
+        frame = pd.read_parquet(path) if path.suffix == ".parquet" else pd.read_csv(path)
+    except Exception as exc:  # noqa: BLE001 - pyarrow and pandas raise their own types
+        raise ArchiveError(f"{entry.ref}: {path.name} cannot be read ({type(exc).__name__}), "
+                           "expected an intact entry (see airgun-xl archive verify)") from None
     frame.columns = [c.split(" [")[0] for c in frame.columns]
     return {c: frame[c].to_numpy() for c in frame.columns}
 

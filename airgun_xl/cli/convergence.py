@@ -6,7 +6,7 @@ from ..engine.convergence import default_ladder, ladder, parse_duration
 from ..engine.integrators import INTEGRATORS
 from ..errors import OptionError
 from ..shot import Shot
-from ..workbook.atomic import check_output
+from ..transaction import check_output
 from ..workbook.convergence import write_convergence, write_png
 
 
@@ -57,11 +57,11 @@ def run(args):
         shot_path.stem + ".convergence.xlsx")
     png = output.with_suffix(".png")
     check_output(output, args.force, inputs=[args.shot])
-    check_output(png, args.force, inputs=[args.shot])
+    check_output(png, args.force, inputs=[args.shot], suffixes=(".png",))
     warn(shot.warnings)
     ladders = [ladder(shot, deltas, name, rtol) for name in integrators]
     write_convergence(ladders, output, args.force, shot)
-    warn([] if write_png(ladders, png) else ["matplotlib is not installed: no PNG"])
+    warn([] if write_png(ladders, png, args.force) else ["matplotlib is not installed: no PNG"])
     print_table(ladders)
     print(f"wrote {output} and {png}")
     return 0

@@ -40,7 +40,7 @@ def run(args):
 
     rtol, atol = _tolerance("--rtol", args.rtol), _tolerance("--atol", args.atol)
     if args.report:
-        from ..workbook.atomic import check_output
+        from ..transaction import check_output
 
         check_output(args.report, args.force, inputs=[args.legacy, args.new])
     report = diff_workbooks(args.legacy, args.new, rtol, atol)

@@ -4,14 +4,15 @@ import time
 from pathlib import Path
 
 from ..archive import ENV, archive_dir
-from ..archiving import archive_fill, now, shot_name
+from ..archiving import now, shot_name
 from ..engine.filtered import HOSTS
 from ..engine.integrators import INTEGRATORS
 from ..engine.summary import PULSE_FRACTION
 from ..models import MODELS
 from ..outputs import GROUPS, SIDECAR_MODES, from_sheet
-from ..pipeline import Options, fill_workbook
+from ..pipeline import ArchiveRequest, Options, fill_workbook
 from ..shot import Shot
+from ..transaction import display
 
 
 def add_parser(sub):
@@ -106,11 +107,9 @@ def run(args):
     if root is not None:
         outputs = dataclasses.replace(outputs, sidecar="never")  # the entry holds the history
         options.track_all = True
-    started_at = now()
+        options.archive = ArchiveRequest(root, shot_name(shot, args.name), now())
     filled = fill_workbook(shot, output, outputs, options, warn, started)
     print_summary(output, filled)
-    if root is not None:
-        entry = archive_fill(root, shot_name(shot, args.name), shot, output, filled, options,
-                             started_at, time.perf_counter() - started)
-        print(f"  archived as {entry.ref} in {root}")
+    if filled.entry is not None:
+        print(f"  archived as {filled.entry.ref} in {display(root)}")
     return 0

@@ -8,7 +8,7 @@ from ..errors import OptionError
 from ..models import MODELS
 from ..shot import Shot
 from ..sweeps import grid, monte_carlo, parse_sd, parse_vary, spread
-from ..workbook.atomic import check_output
+from ..transaction import check_output
 from ..workbook.sweep import write_sweep
 
 

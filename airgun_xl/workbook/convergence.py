@@ -2,16 +2,15 @@
 import math
 
 from ..engine.convergence import QUANTITIES
-from .atomic import atomic_path
-from .columns_sheet import fast_deflate
-from .writer import new_workbook
+from ..transaction import atomic_path
+from .writer import close_workbook, new_workbook
 
 COLORS = ("#1f4e79", "#c00000", "#548235")
 
 
 def write_convergence(ladders, path, force, shot):
     """Write the ladders' table and an error-against-run-time chart to ``path``."""
-    with atomic_path(path) as tmp:
+    with atomic_path(path, force) as tmp:
         wb = new_workbook(tmp)
         ws = wb.add_worksheet("Convergence")
         bold = wb.add_format({"bold": True})
@@ -73,8 +72,7 @@ def write_convergence(ladders, path, force, shot):
                           "max": hi_e, "num_format": "0E+0"})
         chart.set_size({"width": 720, "height": 420})
         ws.insert_chart(row + 2, 0, chart)
-        with fast_deflate():
-            wb.close()
+        close_workbook(wb, path)
 
 
 def _decades(values):
@@ -85,7 +83,7 @@ def _decades(values):
         math.log10(max(positive)))
 
 
-def write_png(ladders, path):
+def write_png(ladders, path, force=False):
     """Error against run time, and against the time step, as a PNG; False without matplotlib."""
     try:
         import matplotlib
@@ -112,7 +110,7 @@ def write_png(ladders, path):
         ax.legend(fontsize=8)
     fig.suptitle("airgun-xl convergence: error against run time and time step")
     fig.tight_layout()
-    with atomic_path(path) as tmp:
+    with atomic_path(path, force) as tmp:
         fig.savefig(tmp, format="png", dpi=110, metadata={"Software": None})
     plt.close(fig)
     return True

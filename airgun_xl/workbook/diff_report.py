@@ -3,15 +3,15 @@ curves with their difference."""
 import numpy as np
 
 from ..engine.decimate import minmax_indices
-from .atomic import atomic_path, check_output
-from .columns_sheet import ColumnsWorksheet, fast_deflate
+from ..transaction import atomic_path, check_output
+from .columns_sheet import ColumnsWorksheet
 from .sheets import write_number_columns
-from .writer import new_workbook
+from .writer import close_workbook, new_workbook
 
 
 def write_diff_report(report, path, force=False):
     check_output(path, force)
-    with atomic_path(path) as tmp:
+    with atomic_path(path, force) as tmp:
         wb = new_workbook(tmp)
         ws = wb.add_worksheet("Diff")
         bold = wb.add_format({"bold": True})
@@ -53,8 +53,7 @@ def write_diff_report(report, path, force=False):
                 ws.write_string(row, 1, "; ".join(names))
         if report.worst is not None:
             _write_worst(wb, *report.worst)
-        with fast_deflate():
-            wb.close()
+        close_workbook(wb, path)
 
 
 def _write_worst(wb, name, time, x, y):

@@ -4,7 +4,12 @@ from pathlib import Path
 import numpy as np
 
 from ..result import FRAME_UNITS
-from .atomic import atomic_path
+from ..errors import OutputError
+from ..transaction import atomic_path, display
+
+
+#: The sidecar's name beside ``run.xlsx``: ``run`` + one of these.
+SIDECAR_SUFFIXES = (".history.parquet", ".history.csv")
 
 
 def have_parquet():
@@ -19,33 +24,47 @@ def sidecar_path(output, parquet=None):
     """``run.xlsx`` -> ``run.history.parquet`` (or ``.csv`` without pyarrow)."""
     output = Path(output)
     parquet = have_parquet() if parquet is None else parquet
-    return output.with_name(output.stem + (".history.parquet" if parquet else ".history.csv"))
+    return output.with_name(output.stem + SIDECAR_SUFFIXES[0 if parquet else 1])
 
 
-def write_history(result, path):
-    """Write every row of every per-row series of ``result`` to ``path``, atomically.
+def write_history(result, path, force=False):
+    """Write every row of every per-row series of ``result`` to ``path``, atomically."""
+    with atomic_path(path, force) as tmp:
+        render_history(result, tmp, shown=path)
+    return path
+
+
+def render_history(result, tmp, shown=None):
+    """Write every row of every per-row series of ``result`` into the file ``tmp``.
 
     Columns are those of :meth:`Result.to_frame` with the time first, units in the Parquet
     schema metadata (or in the CSV header as ``name [unit]``). Series that were not tracked
-    are left out.
+    are left out. The format follows ``tmp``'s final name: ``.parquet`` or ``.csv``.
+
+    Raises
+    ------
+    airgun_xl.errors.OutputError
+        When the file cannot be written (a full disk, a file-size limit).
     """
-    path = Path(path)
+    shown = Path(shown if shown is not None else tmp)
     columns = {"time": result.history.time}
     for name, values in result.frame_columns().items():
         if values is not None:
             columns[name] = values
     units = dict(FRAME_UNITS, time="s")
-    with atomic_path(path) as tmp:
-        if path.suffix == ".parquet":
+    try:
+        if shown.suffix == ".parquet":
             import pyarrow as pa
             import pyarrow.parquet as pq
 
             table = pa.table(columns)  # wraps the numpy buffers, no copy
             table = table.replace_schema_metadata({f"unit:{k}": units[k] for k in columns})
             # dictionary encoding of float columns costs 1 s on 1.2M rows and saves nothing
-            pq.write_table(table, tmp, use_dictionary=False)
+            pq.write_table(table, str(tmp), use_dictionary=False)
         else:
             header = ",".join(f"{k} [{units[k]}]" for k in columns)
             data = np.column_stack(list(columns.values()))
             np.savetxt(tmp, data, delimiter=",", header=header, comments="", fmt="%.17g")
-    return path
+    except OSError as exc:  # pyarrow's ArrowIOError is an OSError too
+        raise OutputError(f"{display(shown)}: cannot be written "
+                          f"({exc.strerror or str(exc).splitlines()[0]})") from None

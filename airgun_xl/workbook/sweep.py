@@ -4,10 +4,10 @@ import numpy as np
 
 from ..cells import BY_ADDRESS
 from ..engine.batch import FIGURES
-from .atomic import atomic_path, check_output
-from .columns_sheet import ColumnsWorksheet, fast_deflate
+from ..transaction import atomic_path, check_output
+from .columns_sheet import ColumnsWorksheet
 from .sheets import write_number_columns
-from .writer import new_workbook
+from .writer import close_workbook, new_workbook
 
 FIGURE_HEADERS = {"peak_kg": "Peak (kG)", "time_of_peak": "Time of peak (s)",
                   "filtered_peak_kg": "Filtered peak (kG)",
@@ -21,7 +21,7 @@ def _label(cell):
 
 def write_sweep(result, path, force, stats=None):
     check_output(path, force)
-    with atomic_path(path) as tmp:
+    with atomic_path(path, force) as tmp:
         wb = new_workbook(tmp)
         ws = wb.add_worksheet("Sweep", worksheet_class=ColumnsWorksheet)
         bold = wb.add_format({"bold": True})
@@ -53,8 +53,7 @@ def write_sweep(result, path, force, stats=None):
             charts.insert_chart(1 + 20 * i, 1, chart)
         if stats is not None:
             _write_spread(wb, result, stats, bold)
-        with fast_deflate():
-            wb.close()
+        close_workbook(wb, path)
 
 
 def _write_spread(wb, result, stats, bold):

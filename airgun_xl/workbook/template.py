@@ -17,9 +17,9 @@ legacy macro reads) cached values of .xlsx files without recalculating them.
 """
 from ..outputs import SHEET_NAME as OUTPUTS_SHEET
 from ..outputs import block_cells
-from .atomic import atomic_path, check_output
+from ..transaction import atomic_path, check_output
 from .formula_eval import Evaluator, SheetView
-from .writer import new_workbook
+from .writer import close_workbook, new_workbook
 
 SHEET = "Sheet1"
 
@@ -95,7 +95,7 @@ def write_template(path, force=False):
     """
     check_output(path, force)
     values = template_values()
-    with atomic_path(path) as tmp:
+    with atomic_path(path, force) as tmp:
         wb = new_workbook(tmp)
         ws = wb.add_worksheet(SHEET)
         for columns, width in COLUMN_WIDTHS.items():
@@ -109,7 +109,7 @@ def write_template(path, force=False):
             else:
                 ws.write_number(address, content)
         write_outputs_sheet(wb)
-        wb.close()
+        close_workbook(wb, path)
 
 
 def write_outputs_sheet(wb):

@@ -32,8 +32,9 @@ from xlsxwriter.utility import xl_rowcol_to_cell
 from ..cells import PARAMETER_COLUMNS
 from ..charts import add_charts, series_data
 from ..engine.summary import summarize
+from ..errors import OutputError
 from ..outputs import SHEET_NAME, Outputs
-from .atomic import atomic_path, check_output
+from ..transaction import atomic_path, check_output, display
 from .columns_sheet import ColumnsWorksheet, fast_deflate
 from .formula_eval import Evaluator, FormulaFailure
 from .safe_text import WORKBOOK_OPTIONS, SafeWorksheet, copyable_formula, sheet_title
@@ -233,8 +234,23 @@ def _write_sheet1(wb, result, outputs, keep, stride, title):
     return refs, warnings
 
 
-def write_workbook(result, path, force=False, outputs=Outputs(), summary=None, info=None):
-    """Write ``result`` to a new .xlsx at ``path``, atomically.
+def close_workbook(wb, path):
+    """Close (package) an xlsxwriter Workbook at deflate level 1; a full disk, a file-size
+    limit or any other failure to write becomes one :class:`OutputError` line."""
+    from xlsxwriter.exceptions import XlsxFileError
+
+    try:
+        with fast_deflate():
+            wb.close()
+    except OSError as exc:
+        raise OutputError(f"{display(path)}: cannot be written ({exc.strerror or exc})") from None
+    except XlsxFileError as exc:
+        raise OutputError(f"{display(path)}: cannot be written ({exc})") from None
+
+
+def write_workbook(result, path, force=False, outputs=Outputs(), summary=None, info=None,
+                   force_word="force=True"):
+    """Write ``result`` to a new .xlsx at ``path``, atomically (see :func:`render_workbook`).
 
     Parameters
     ----------
@@ -242,52 +258,74 @@ def write_workbook(result, path, force=False, outputs=Outputs(), summary=None, i
     path : str or pathlib.Path
     force : bool
         Overwrite an existing file.
-    outputs : airgun_xl.outputs.Outputs
-        Which groups, sheets and charts to write, and the row stride.
-    summary : airgun_xl.engine.summary.Summary, optional
-        Computed here when a selected output needs it and none is given.
-    info : dict, optional
-        Provenance for the Summary sheet (input, SHA-256, run times, ...).
+    outputs, summary, info
+        As :func:`render_workbook`.
+    force_word : str
+        How the "already exists" message names ``force``.
 
     Returns
     -------
     list of str
-        Warnings (block formulas that could not be evaluated keep the input's cached value).
+        Warnings.
 
     Raises
     ------
     airgun_xl.errors.OutputError
     """
     source = result.shot.source
-    check_output(path, force, inputs=[source.path] if source is not None else [])
+    check_output(path, force, inputs=[source.path] if source is not None else [],
+                 force_word=force_word)
+    with atomic_path(path, force, force_word) as tmp:
+        return render_workbook(result, tmp, outputs, summary, info, shown=path)
+
+
+def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, shown=None):
+    """Render ``result`` into the file ``tmp`` (a temp file that the caller publishes).
+
+    Parameters
+    ----------
+    result : airgun_xl.result.Result
+    tmp : pathlib.Path
+    outputs : airgun_xl.outputs.Outputs
+        Which groups, sheets and charts to write, and the row stride.
+    summary : airgun_xl.engine.summary.Summary, optional
+        Computed here when a selected output needs it and none is given.
+    info : dict, optional
+        Provenance for the Summary sheet (input, SHA-256, run times, ...).
+    shown : path, optional
+        The output's final name, for messages.
+
+    Returns
+    -------
+    list of str
+        Warnings (block formulas that could not be evaluated keep the input's cached value).
+    """
+    source = result.shot.source
     stride = outputs.stride(result.rows)
     keep = np.arange(0, result.rows, stride)
     needs_summary = outputs.groups & {"summary", "spectrum", "charts"}
     if summary is None and needs_summary:
         summary = summarize(result)
     info = dict(info or {}, every=stride, sheet_rows=len(keep))
-    with atomic_path(path) as tmp:
-        wb = new_workbook(tmp)
-        names = sheet_names(source.sheet_title if source is not None else None)
-        refs, warnings = _write_sheet1(wb, result, outputs, keep, stride, names["first"])
-        if "summary" in outputs:
-            write_summary(wb, result, summary, info, names["Summary"])
-        charts_ws = wb.add_worksheet(names["Charts"]) if "charts" in outputs else None
-        if "tracked" in outputs:
-            refs.update(write_tracked(wb, result, keep, ColumnsWorksheet, names["Tracked"]))
-        if "spectrum" in outputs:
-            refs.update(write_spectrum(wb, summary.spectrum, ColumnsWorksheet,
-                                       names["Spectrum"]))
-        if charts_ws is not None:
-            data = series_data(result, summary.spectrum, info.get("compared"))
-            placed = write_chart_data(wb, data, refs, ColumnsWorksheet, names["ChartData"])
-            compared = info.get("compared")
-            labels = {"compared_kg": f"{compared.model} model"} if compared is not None else None
-            add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]), labels)
-        if source is not None and source.outputs_block:
-            warnings += write_cells(wb.add_worksheet(names[SHEET_NAME],
-                                                     worksheet_class=ColumnsWorksheet),
-                                    source.outputs_block)
-        with fast_deflate():
-            wb.close()
+    wb = new_workbook(tmp)
+    names = sheet_names(source.sheet_title if source is not None else None)
+    refs, warnings = _write_sheet1(wb, result, outputs, keep, stride, names["first"])
+    if "summary" in outputs:
+        write_summary(wb, result, summary, info, names["Summary"])
+    charts_ws = wb.add_worksheet(names["Charts"]) if "charts" in outputs else None
+    if "tracked" in outputs:
+        refs.update(write_tracked(wb, result, keep, ColumnsWorksheet, names["Tracked"]))
+    if "spectrum" in outputs:
+        refs.update(write_spectrum(wb, summary.spectrum, ColumnsWorksheet, names["Spectrum"]))
+    if charts_ws is not None:
+        data = series_data(result, summary.spectrum, info.get("compared"))
+        placed = write_chart_data(wb, data, refs, ColumnsWorksheet, names["ChartData"])
+        compared = info.get("compared")
+        labels = {"compared_kg": f"{compared.model} model"} if compared is not None else None
+        add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]), labels)
+    if source is not None and source.outputs_block:
+        warnings += write_cells(wb.add_worksheet(names[SHEET_NAME],
+                                                 worksheet_class=ColumnsWorksheet),
+                                source.outputs_block)
+    close_workbook(wb, shown if shown is not None else tmp)
     return warnings

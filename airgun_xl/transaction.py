@@ -1,0 +1,403 @@
+"""All-or-nothing output: a command's files are all published, or none is.
+
+A :class:`Publication` stages each output as a temp file beside its final name
+(``.NAME.<owner>-<hex>.airgun-xl-tmp``), written while the command works. :meth:`commit` then,
+holding an exclusive lock on the output folder and with SIGINT, SIGTERM and SIGHUP held back:
+
+1. recovers what a killed publisher left in that folder (below);
+2. writes a journal (``.NAME.<owner>-<hex>.airgun-xl-journal``) naming every temp, final
+   name, backup and the temps' inodes;
+3. publishes each file: without ``force`` by ``link(2)``, which fails when the name exists, so
+   of two commands writing one output exactly one wins; with ``force`` the old file (or
+   symlink, never its target) is first renamed to a backup;
+4. commits a participant, such as an archive entry, whose marker file then names this
+   publication;
+5. deletes the journal (the commit point, when there is no participant), then the temps and
+   backups.
+
+Any failure before the commit point rolls back: published names that still hold our inode are
+removed and backups renamed back. A process killed with SIGKILL leaves temps, backups or a
+journal whose owner is gone; the next publisher in the folder rolls such a journal back, or
+forward when its participant's marker shows the participant committed, and removes the rest.
+Only names that match these patterns, of owners that are gone, are ever touched.
+"""
+import contextlib
+import errno
+import json
+import os
+import re
+import secrets
+import signal
+import stat
+from pathlib import Path
+
+from .errors import OutputError
+
+SUFFIX = "airgun-xl"
+_OWNED = re.compile(r"^\.(?P<name>.+)\.(?P<owner>\d+\.\d+)-(?P<hex>[0-9a-f]{16})"
+                    r"\.airgun-xl-(?P<kind>tmp|bak|journal)$")
+_HELD = [s for s in (getattr(signal, n, None) for n in ("SIGINT", "SIGTERM", "SIGHUP")) if s]
+
+
+def display(path):
+    """A path as printable text (undecodable bytes of a name become \\x escapes)."""
+    return os.fsdecode(path).encode("utf-8", "backslashreplace").decode("utf-8")
+
+
+# -- who owns a temp file ---------------------------------------------------------------------
+def _start_time(pid):
+    """A process's start time in clock ticks since boot (Linux), 0 when unknown."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as fh:
+            return int(fh.read().rsplit(b")", 1)[1].split()[19])
+    except (OSError, ValueError, IndexError):
+        return 0
+
+
+def owner_token():
+    """This process as ``<pid>.<start time>``: a reused pid does not look like its owner."""
+    pid = os.getpid()
+    return f"{pid}.{_start_time(pid)}"
+
+
+def owner_alive(token):
+    """Whether the process an :func:`owner_token` names is still running."""
+    pid_text, _, started = token.partition(".")
+    try:
+        pid = int(pid_text)
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        pass
+    except (ValueError, OverflowError):
+        return False
+    now = _start_time(pid)
+    return not (now and started.isdigit() and int(started) and now != int(started))
+
+
+# -- output names -----------------------------------------------------------------------------
+_KINDS = ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
+          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+
+
+def check_output(path, force=False, inputs=(), suffixes=(".xlsx",), force_word="--force"):
+    """Refuse an output that cannot be written as a new regular file.
+
+    Refused: a name without one of ``suffixes``; a folder, FIFO, device or socket; an
+    existing file or symlink without ``force`` (with it, a symlink itself is replaced, never
+    its target); one of ``inputs``; a missing or read-only folder.
+
+    Raises
+    ------
+    OutputError
+    """
+    path = Path(path)
+    shown = display(path)
+    if suffixes and path.suffix.lower() not in suffixes:
+        raise OutputError(f"{shown}: has the extension {path.suffix or '(none)'!s}, expected "
+                          f"{' or '.join(suffixes)}")
+    try:
+        st = os.lstat(path)
+    except FileNotFoundError:
+        st = None
+    except OSError as exc:
+        raise OutputError(f"{shown}: cannot be checked ({exc.strerror})") from None
+    if st is not None:
+        if stat.S_ISDIR(st.st_mode):
+            raise OutputError(f"{shown}: is a folder, expected an output file name")
+        for test, kind in _KINDS:
+            if test(st.st_mode):
+                raise OutputError(f"{shown}: is {kind}, expected a regular file name")
+        if not force:
+            link = " (a symbolic link)" if stat.S_ISLNK(st.st_mode) else ""
+            raise OutputError(f"{shown}: already exists{link}, expected a new file name or "
+                              f"{force_word}")
+    for given in inputs:
+        with contextlib.suppress(OSError):
+            if os.path.exists(path) and os.path.samefile(path, given):
+                raise OutputError(f"{shown}: is the input workbook, expected a different "
+                                  "output file (the input is never modified)")
+    folder = path.parent
+    if not folder.is_dir():
+        raise OutputError(f"{shown}: its folder {display(folder)} does not exist, expected an "
+                          "existing folder")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise OutputError(f"{shown}: its folder {display(folder)} is not writable, expected a "
+                          "writable folder")
+
+
+# -- locks and signals ------------------------------------------------------------------------
+@contextlib.contextmanager
+def folder_lock(folder):
+    """An exclusive ``flock`` on a folder (no lock file is created); a no-op off POSIX."""
+    try:
+        import fcntl
+    except ImportError:  # Windows: publication is still atomic per file
+        yield
+        return
+    fd = os.open(folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # releases the lock
+
+
+@contextlib.contextmanager
+def signals_held():
+    """Hold SIGINT, SIGTERM and SIGHUP back; they are delivered when the block ends."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def _fsync(path, directory=False):
+    with contextlib.suppress(OSError):
+        fd = os.open(path, os.O_RDONLY | (getattr(os, "O_DIRECTORY", 0) if directory else 0))
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+def _lexists(path):
+    return os.path.lexists(path)
+
+
+# -- the publication --------------------------------------------------------------------------
+class Publication:
+    """Files staged and published together; see the module docstring.
+
+    Parameters
+    ----------
+    force : bool
+        Replace existing outputs (kept as backups until the commit).
+    force_word : str
+        How messages name ``force``: ``--force`` for the CLI, ``force=True`` for the API.
+    """
+
+    def __init__(self, force=False, force_word="--force"):
+        self.force = force
+        self.force_word = force_word
+        self.token = f"{owner_token()}-{secrets.token_hex(8)}"
+        self.files = []  # (temp, final)
+        self.removals = []  # finals to remove at the commit (a stale sidecar, with force)
+        self.participant = None
+        self.committed = False
+
+    def _name(self, final, kind):
+        return final.parent / f".{final.name}.{self.token}.{SUFFIX}-{kind}"
+
+    def stage(self, final):
+        """A new empty temp file for ``final``, to be written by the caller."""
+        final = Path(final)
+        if self.files and final.parent != self.files[0][1].parent:
+            raise ValueError("a publication's files share one folder")
+        temp = self._name(final, "tmp")
+        try:
+            os.close(os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644))
+        except OSError as exc:
+            raise OutputError(f"{display(final)}: cannot be written ({exc.strerror})") from None
+        self.files.append((temp, final))
+        return temp
+
+    def remove(self, final):
+        """Remove ``final`` at the commit, if it exists (restored on a rollback)."""
+        self.removals.append(Path(final))
+
+    def join(self, participant):
+        """Commit ``participant`` with the files. It has ``prepare(token)``, which locks and
+        returns the path of a JSON file whose ``txn`` will be ``token`` once committed,
+        ``commit()`` and ``release()``; see :class:`airgun_xl.archive.PendingEntry`."""
+        self.participant = participant
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        if not self.committed:
+            self.abort()
+        return False
+
+    def abort(self):
+        """Drop every temp file and the participant's scratch work."""
+        for temp, _ in self.files:
+            with contextlib.suppress(OSError):
+                os.unlink(temp)
+        if self.participant is not None:
+            self.participant.release()
+
+    def commit(self):
+        """Publish every staged file and commit the participant, or none of it.
+
+        Raises
+        ------
+        OutputError
+            When an output exists (created meanwhile by another command, or without force) or
+            cannot be published; nothing is left changed.
+        """
+        if not self.files:
+            raise ValueError("nothing staged")
+        folder = self.files[0][1].parent
+        for temp, _ in self.files:
+            _fsync(temp)
+        with folder_lock(folder), signals_held():
+            recover(folder)
+            record = self._record()
+            journal = self._name(self.files[0][1], "journal")
+            try:
+                if self.participant is not None:
+                    marker = self.participant.prepare(self.token)
+                    record["marker"] = {"path": str(marker), "token": self.token}
+                with open(journal, "x") as fh:
+                    json.dump(record, fh)
+                    fh.flush()
+                    os.fsync(fh.fileno())
+                _fsync(folder, directory=True)
+                for temp, final in self.files:
+                    self._publish(temp, final)
+                for final in self.removals:
+                    if _lexists(final):
+                        os.rename(final, self._name(final, "bak"))
+                if self.participant is not None:
+                    self.participant.commit()
+            except BaseException:
+                _roll_back(folder, record)
+                with contextlib.suppress(OSError):
+                    os.unlink(journal)
+                if self.participant is not None:
+                    self.participant.release()
+                raise
+            os.unlink(journal)  # the commit point
+            _fsync(folder, directory=True)
+            self.committed = True
+            _clean(folder, record)
+
+    def _record(self):
+        files = []
+        for temp, final in self.files:
+            st = os.stat(temp)
+            files.append({"final": final.name, "inode": [st.st_dev, st.st_ino]})
+        return {"token": self.token, "files": files,
+                "removals": [f.name for f in self.removals]}
+
+    def _publish(self, temp, final):
+        if _lexists(final):
+            if not self.force:
+                raise OutputError(f"{display(final)}: already exists (another command wrote it "
+                                  f"first), expected a new file name or {self.force_word}")
+            os.rename(final, self._name(final, "bak"))  # a symlink itself, never its target
+        try:
+            os.link(temp, final)  # fails if the name exists: exactly one writer wins
+        except FileExistsError:
+            raise OutputError(f"{display(final)}: already exists (another command wrote it "
+                              f"first), expected a new file name or {self.force_word}") from None
+        except OSError as exc:
+            if exc.errno not in (errno.EPERM, errno.EOPNOTSUPP, errno.ENOTSUP, errno.EMLINK):
+                raise OutputError(f"{display(final)}: cannot be written "
+                                  f"({exc.strerror})") from None
+            # no hard links here (e.g. FAT): claim the name, then move the temp onto it
+            try:
+                os.close(os.open(final, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644))
+            except FileExistsError:
+                raise OutputError(f"{display(final)}: already exists (another command wrote "
+                                  f"it first), expected a new file name or "
+                                  f"{self.force_word}") from None
+            os.replace(temp, final)
+
+
+def _names(folder, record, final, kind):
+    return folder / f".{final}.{record['token']}.{SUFFIX}-{kind}"
+
+
+def _roll_back(folder, record):
+    """Undo a publication: our inodes leave the final names, backups come back."""
+    for f in reversed(record["files"]):
+        final = folder / f["final"]
+        with contextlib.suppress(OSError):
+            st = os.lstat(final)
+            if [st.st_dev, st.st_ino] == f["inode"]:
+                os.unlink(final)
+        backup = _names(folder, record, f["final"], "bak")
+        if _lexists(backup) and not _lexists(final):
+            with contextlib.suppress(OSError):
+                os.rename(backup, final)
+        with contextlib.suppress(OSError):
+            os.unlink(_names(folder, record, f["final"], "tmp"))
+    for name in record["removals"]:
+        backup = _names(folder, record, name, "bak")
+        if _lexists(backup) and not _lexists(folder / name):
+            with contextlib.suppress(OSError):
+                os.rename(backup, folder / name)
+
+
+def _clean(folder, record):
+    """After the commit: the temps (now extra links) and the backups go."""
+    for name in [f["final"] for f in record["files"]] + record["removals"]:
+        for kind in ("tmp", "bak"):
+            with contextlib.suppress(OSError):
+                os.unlink(_names(folder, record, name, kind))
+
+
+def _committed(record):
+    marker = record.get("marker")
+    if not marker:
+        return False
+    try:
+        with open(marker["path"]) as fh:
+            return json.load(fh).get("txn") == marker["token"]
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
+def _valid(record, token):
+    names = [f.get("final") for f in record.get("files", [])] + record.get("removals", [])
+    return record.get("token") == token and all(
+        isinstance(n, str) and n and "/" not in n and n not in (".", "..") for n in names)
+
+
+def recover(folder):
+    """Finish what killed publishers left in ``folder``: roll their journals back (or forward
+    when their participant committed), then remove their temps and backups."""
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return
+    owned = [(e, _OWNED.match(e.name)) for e in entries]
+    owned = [(e, m) for e, m in owned if m and not owner_alive(m["owner"])]
+    for entry, m in owned:
+        if m["kind"] != "journal":
+            continue
+        token = f"{m['owner']}-{m['hex']}"
+        try:
+            with open(entry.path) as fh:
+                record = json.load(fh)
+        except (OSError, ValueError):
+            record = None
+        if isinstance(record, dict) and _valid(record, token):
+            if _committed(record):
+                _clean(Path(folder), record)
+            else:
+                _roll_back(Path(folder), record)
+        with contextlib.suppress(OSError):
+            os.unlink(entry.path)
+    for entry, m in owned:
+        if m["kind"] in ("tmp", "bak"):
+            with contextlib.suppress(OSError):
+                if entry.is_file(follow_symlinks=False) or entry.is_symlink():
+                    os.unlink(entry.path)
+
+
+@contextlib.contextmanager
+def atomic_path(path, force=False, force_word="--force"):
+    """Yield a temp path for ``path``; publish it on success (see :class:`Publication`)."""
+    with Publication(force, force_word) as pub:
+        temp = pub.stage(path)
+        yield temp
+        pub.commit()
