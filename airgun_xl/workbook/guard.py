@@ -137,7 +137,34 @@ def open_zip(path, data):
     for m in members:
         if _parsed_whole(m.filename):
             _defused(shown, zf, m)
+        elif _streamed(m.filename):
+            _defused_prolog(shown, zf, m)
     return zf
+
+
+def _defused_prolog(shown, zf, member, size=1 << 16):
+    """A streamed worksheet's first bytes through defusedxml: a DTD or an entity declaration
+    sits in the prolog, before any cell."""
+    import defusedxml
+    from defusedxml.ElementTree import DefusedXMLParser, ParseError
+
+    try:
+        with zf.open(member) as fh:
+            head = fh.read(size)
+        DefusedXMLParser(forbid_dtd=True).feed(head)
+    except defusedxml.DefusedXmlException as exc:
+        raise WorkbookError(f"{shown}: member {member.filename} declares a DTD or entities "
+                            f"({type(exc).__name__}), expected plain spreadsheet XML") from None
+    except ParseError:
+        pass  # a malformed sheet is reported by the parser that reads it
+    except (zipfile.BadZipFile, OSError, EOFError, ValueError, zlib_error()) as exc:
+        raise WorkbookError(f"{shown}: is not a readable .xlsx workbook ({exc})") from None
+
+
+def zlib_error():
+    import zlib
+
+    return zlib.error
 
 
 def _defused(shown, zf, member):
@@ -154,7 +181,7 @@ def _defused(shown, zf, member):
     except ParseError as exc:
         raise WorkbookError(f"{shown}: member {member.filename} is not well-formed XML "
                             f"({exc})") from None
-    except (zipfile.BadZipFile, OSError, EOFError, ValueError) as exc:
+    except (zipfile.BadZipFile, OSError, EOFError, ValueError, zlib_error()) as exc:
         raise WorkbookError(f"{shown}: is not a readable .xlsx workbook ({exc})") from None
 
 
