@@ -15,6 +15,8 @@ Checks
 
 ``limit`` bounds the magnitude. The limits are far beyond any air gun shot; they exist so that a
 typo such as ``1e300`` is reported on its cell instead of overflowing somewhere in the kernel.
+``floor`` does the same at the other end for cells whose tiny values overflow a quotient: a
+mass of 1e-300 kg, a filter frequency of 5e-324 Hz, a radius or wedge of 1e-300 m.
 """
 from dataclasses import dataclass
 
@@ -29,16 +31,18 @@ class Cell:
     check: str
     limit: float
     alternative: str = ""  # a second accepted form, for the reduced models
+    floor: float = 0.0  # smallest magnitude of a non-zero value (0: none)
 
 
 #: The parameter cells, in the order the macro reads them (ArtSim.bas, head of the Sub).
 CELLS = (
-    Cell("A2", "m1", "M1", "kg", "MEM mass, without the mitigator", "positive", 1e9),
-    Cell("B2", "m31", "M31", "kg", "OBR front plate mass", "positive", 1e9),
+    Cell("A2", "m1", "M1", "kg", "MEM mass, without the mitigator", "positive", 1e9,
+         floor=1e-6),
+    Cell("B2", "m31", "M31", "kg", "OBR front plate mass", "positive", 1e9, floor=1e-6),
     Cell("C2", "m32", "M32", "kg", "OBR back plate mass", "positive", 1e9,
-         "blank or 0 with B6, C6 blank and D2 blank or 0, for an OBR of one mass"),
+         "blank or 0 with B6, C6 blank and D2 blank or 0, for an OBR of one mass", 1e-6),
     Cell("D2", "m33", "M33", "kg", "test item mass", "positive", 1e9,
-         "blank or 0 with C6 blank, for a scene without a test item"),
+         "blank or 0 with C6 blank, for a scene without a test item", 1e-6),
     Cell("B6", "k2", "K2", "N/m", "spring between m31 and m32, negative by the sheet's convention",
          "negative", 1e16, "blank with C2, C6 and D2 blank, for an OBR of one mass"),
     Cell("C6", "k3", "K3", "N/m", "spring between m32 and m33, negative by the sheet's convention",
@@ -46,8 +50,10 @@ CELLS = (
     Cell("E2", "delta", "Timestep", "s", "time step", "positive", 1.0),
     Cell("E6", "max_time", "Max Time", "s", "simulated duration", "positive", 1e3),
     Cell("E10", "rho", "Density of Honeycomb", "kg/m^3", "honeycomb density", "positive", 1e5),
-    Cell("E13", "rcone", "Radius of Mitigator", "m", "mitigator radius", "positive", 10.0),
-    Cell("E16", "hcone", "Length of Wedge Part", "m", "wedge (cone) length", "positive", 100.0),
+    Cell("E13", "rcone", "Radius of Mitigator", "m", "mitigator radius", "positive", 10.0,
+         floor=1e-6),
+    Cell("E16", "hcone", "Length of Wedge Part", "m", "wedge (cone) length", "positive", 100.0,
+         floor=1e-6),
     Cell("E19", "hcylinder", "Length of Cylindrical Part", "m", "cylinder length",
          "nonnegative", 100.0),
     Cell("E25", "mmitigator", "Mass of Mitigator", "kg", "mitigator mass, added to M1",
@@ -57,7 +63,7 @@ CELLS = (
     Cell("E31", "E", "Elastic Modulus of Mitigator", "Pa", "elastic modulus for unloading",
          "positive", 1e13),
     Cell("E34", "filter_frequency", "Filter Frequency", "Hz",
-         "sampling frequency of the filtered acceleration", "positive", 1e12),
+         "sampling frequency of the filtered acceleration", "positive", 1e12, floor=1e-6),
     Cell("E37", "ec", "Compacting Strain", "", "honeycomb compacting strain", "fraction", 1.0),
     Cell("E40", "sigmay", "Yield Stress", "Pa", "honeycomb static crush stress", "positive", 1e12),
     Cell("E43", "zeta", "Damping Factor (Zeta)", "", "damping ratio of the OBR springs",
@@ -98,6 +104,8 @@ def expectation(cell):
         "fraction": "a number greater than 0 and at most 1",
         "any": f"a number{of}",
     }[cell.check]
-    if cell.check != "fraction":
+    if cell.check != "fraction" and cell.floor:
+        base = f"{base}, from {cell.floor:g} to {cell.limit:g} in magnitude"
+    elif cell.check != "fraction":
         base = f"{base}, at most {cell.limit:g} in magnitude"
     return f"{base}; or {cell.alternative}" if cell.alternative else base

@@ -44,3 +44,7 @@ class OutputError(AirgunXlError):
 
 class OptionError(AirgunXlError):
     """A command-line option has a value the command cannot use."""
+
+
+class ResourceError(AirgunXlError):
+    """A run would need more memory than the machine has (estimated before it starts)."""

@@ -46,3 +46,96 @@ MAX_EVERY = 10**9
 
 #: Most shots of one sweep or Monte Carlo run.
 MAX_SHOTS = 10**7
+
+
+# -- memory, estimated before a run -------------------------------------------------------------
+#: Environment variable that sets the memory a command may plan to use, e.g. ``2GB``; by default
+#: the machine's available memory (MemAvailable, or a cgroup's limit when lower).
+MEMORY_ENV = "AIRGUN_XL_MEMORY"
+
+#: Resident size of a fill process before its run: Python, numpy, pandas, openpyxl, xlsxwriter
+#: [bytes]. Measured 144-150 MB by extrapolating fills of 1.2 M and 3 M rows to zero rows.
+BASE_BYTES = 200 * 2**20
+
+#: Bytes a time row costs a fill beyond the tracked step values: time and four displacements,
+#: the derived acceleration columns and their temporaries (FFT, decimation). Measured 137-140
+#: B/row with no tracked series (``--only positions``, ``--only summary``), 184 with all 8.
+ROW_BYTES = 144
+
+#: Bytes a shot costs a sweep: its parameters, values and figures. Measured ~1 KB.
+SHOT_BYTES = 1_100
+
+
+def parse_bytes(text):
+    """``"2GB"``, ``"500 MB"``, ``"1.5e9"`` -> bytes; None when not a size."""
+    import re
+
+    m = re.fullmatch(r"\s*([0-9.eE+]+)\s*([KMGT]?i?B?)?\s*", str(text), re.IGNORECASE)
+    if not m:
+        return None
+    try:
+        value = float(m.group(1))
+    except ValueError:
+        return None
+    unit = (m.group(2) or "").upper().rstrip("B").rstrip("I")
+    scale = {"": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}[unit]
+    return int(value * scale) if value > 0 else None
+
+
+def available_memory():
+    """Bytes a command may plan to use: $AIRGUN_XL_MEMORY, else MemAvailable (Linux), lowered
+    to the cgroup's limit when there is one; None when unknown (no check)."""
+    import os
+
+    given = os.environ.get(MEMORY_ENV)
+    if given:
+        value = parse_bytes(given)
+        if value is None:
+            from .errors import OptionError
+
+            raise OptionError(f"${MEMORY_ENV}: found {given!r}, expected a size such as 2GB")
+        return value
+    found = []
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    found.append(int(line.split()[1]) * 1024)
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        with open("/sys/fs/cgroup/memory.max") as fh:
+            text = fh.read().strip()
+        if text.isdigit():
+            with open("/sys/fs/cgroup/memory.current") as fh:
+                found.append(int(text) - int(fh.read().strip()))
+    except (OSError, ValueError):
+        pass
+    return min(found) if found else None
+
+
+def fill_bytes(rows, tracked, csv_sidecar=False):
+    """Peak memory of a fill of ``rows`` time rows recording ``tracked`` step values [bytes]."""
+    per_row = ROW_BYTES + 8 * tracked + (8 * (6 + tracked) * 3 if csv_sidecar else 0)
+    return BASE_BYTES + rows * per_row
+
+
+def sweep_bytes(shots, rows, threads=2, block=128):
+    """Peak memory of a sweep of ``shots`` shots of ``rows`` rows [bytes]."""
+    return BASE_BYTES + shots * SHOT_BYTES + threads * block * rows * 8 * 6
+
+
+def check_memory(needed, what, way_out):
+    """Refuse a run whose estimate ``needed`` passes the available memory.
+
+    Raises
+    ------
+    airgun_xl.errors.ResourceError
+        Naming the figure, the memory available and ``way_out``.
+    """
+    available = available_memory()
+    if available is not None and needed > available:
+        from .errors import ResourceError
+
+        raise ResourceError(f"{what} needs about {needed / 2**30:,.2f} GB, more than the "
+                            f"{available / 2**30:,.2f} GB available; expected {way_out}")

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field, replace
 
 from .engine.integrators import TRACKED
 from .errors import OptionError
+from .limits import MAX_EVERY
 
 #: Output groups: name -> what it writes.
 GROUPS = {
@@ -111,8 +112,8 @@ def parse_groups(text):
     return frozenset(names)
 
 
-def positive_int(option, value):
-    """A whole number >= 1 from a flag or cell (``3``, ``3.0``, ``"3"``)."""
+def positive_int(option, value, most=MAX_EVERY):
+    """A whole number from 1 to ``most`` from a flag or cell (``3``, ``3.0``, ``"3"``)."""
     number = None
     if not isinstance(value, bool):
         try:
@@ -120,8 +121,9 @@ def positive_int(option, value):
             number = int(as_float) if as_float.is_integer() else None
         except (TypeError, ValueError, OverflowError):
             number = None
-    if number is None or number < 1:
-        raise OptionError(f"{option}: found {value!r}, expected a whole number of at least 1")
+    if number is None or not 1 <= number <= most:
+        raise OptionError(f"{option}: found {value!r}, expected a whole number from 1 to "
+                          f"{most:,}")
     return number
 
 

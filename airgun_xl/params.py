@@ -55,7 +55,8 @@ def check_value(cell, raw):
     if isinstance(raw, bool) or not isinstance(raw, (int, float)):
         raise CellError(cell.address, cell.label, describe(raw), expectation(cell))
     value = float(raw)
-    ok = math.isfinite(value) and abs(value) <= cell.limit
+    ok = math.isfinite(value) and abs(value) <= cell.limit and (
+        value == 0 or abs(value) >= cell.floor)
     if ok:
         ok = {
             "positive": value > 0,

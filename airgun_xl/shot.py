@@ -5,6 +5,7 @@ from dataclasses import dataclass, field
 
 from .engine import filtered_acceleration, get_integrator, test_item_derivatives
 from .engine.integrators import TRACKED
+from .limits import check_memory, fill_bytes
 from .params import ShotParams
 
 
@@ -66,10 +67,20 @@ class Shot:
         Returns
         -------
         airgun_xl.result.Result
+
+        Raises
+        ------
+        airgun_xl.errors.ResourceError
+            Before stepping, when the run's estimated memory passes what is available
+            (:func:`airgun_xl.limits.check_memory`).
         """
         from .result import Result
 
         p = self.params
+        check_memory(fill_bytes(p.rows, len(track)),
+                     f"a run of {p.rows:,} rows ({len(track)} step values tracked)",
+                     "fewer rows (a larger E2 or a shorter E6) or fewer outputs (--only "
+                     "summary; an archived run tracks every step value)")
         started = time.perf_counter()
         history = get_integrator(integrator)(p, track)
         last = last_mass(history, p)  # the test item, or the last mass of a reduced model

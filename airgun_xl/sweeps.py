@@ -1,5 +1,6 @@
 """Grids and Monte Carlo over a shot's parameters, run with the batch kernel."""
 import itertools
+import math
 import re
 from dataclasses import dataclass
 
@@ -7,6 +8,7 @@ import numpy as np
 
 from .cells import BY_ADDRESS, CELLS
 from .engine.batch import FIGURES, run_batch
+from . import limits
 from .errors import AirgunXlError, OptionError
 from .models import apply_model
 
@@ -31,9 +33,9 @@ def parse_vary(text):
         lo, hi, n = float(match.group(2)), float(match.group(3)), int(match.group(4))
     except (AttributeError, ValueError):
         n = 0
-    if n < 1:
-        raise OptionError(f"--vary: found {text!r}, expected CELL=LO:HI:N such as "
-                          "A28=100:260:161")
+    if n < 1 or n > limits.MAX_SHOTS or not (math.isfinite(lo) and math.isfinite(hi)):
+        raise OptionError(f"--vary: found {text!r}, expected CELL=LO:HI:N with finite LO and "
+                          f"HI and 1 <= N <= {limits.MAX_SHOTS:,}, such as A28=100:260:161")
     cell, fields = fields_of(match.group(1), "--vary")
     return cell, fields, np.linspace(lo, hi, n)
 
@@ -45,7 +47,7 @@ def parse_sd(text):
         sd = float(match.group(2))
     except (AttributeError, ValueError):
         sd = -1.0
-    if not sd >= 0:
+    if not (sd >= 0 and math.isfinite(sd)):
         raise OptionError(f"--sd: found {text!r}, expected CELL=SD or CELL=SD% such as E40=3%")
     cell, fields = fields_of(match.group(1), "--sd")
     return cell, fields, sd / 100 if match.group(3) else sd, bool(match.group(3))

@@ -76,6 +76,9 @@ def _say(text):
 
 def main(argv=None):
     """Run the CLI; return the exit code (0 ok, 1 differences, 2 bad input, 128+N signal N)."""
+    for stream in (sys.stdout, sys.stderr):  # a file name may hold undecodable bytes
+        with contextlib.suppress(AttributeError, ValueError, OSError):
+            stream.reconfigure(errors="backslashreplace")
     parser = build_parser()
     try:
         with _signals():

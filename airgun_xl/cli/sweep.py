@@ -4,6 +4,7 @@ import time
 from pathlib import Path
 
 from ..engine.integrators import INTEGRATORS
+from .. import limits
 from ..errors import OptionError
 from ..models import MODELS
 from ..shot import Shot
@@ -52,9 +53,13 @@ def run(args):
             n = int(args.mc)
         except ValueError:
             n = 0
-        if n < 2 or not sds:
+        if n < 2 or n > limits.MAX_SHOTS or not sds:
             raise OptionError(f"--mc: found {args.mc!r}{'' if sds else ' without --sd'}, "
-                              "expected a number of shots of at least 2, with --sd")
+                              f"expected a number of shots from 2 to {limits.MAX_SHOTS:,}, "
+                              "with --sd")
+        if args.seed is not None and not 0 <= args.seed < 2**128:
+            raise OptionError(f"--seed: found {args.seed}, expected a whole number from 0 "
+                              "to 2**128 - 1")
         if varies:
             raise OptionError("--vary: found a grid with --mc, expected one or the other")
     elif not varies:
@@ -66,6 +71,12 @@ def run(args):
     total = n if args.mc is not None else 1
     for _, _, values in varies:
         total *= len(values)
+    if total > limits.MAX_SHOTS:
+        raise OptionError(f"--vary: found a grid of {total:,} shots, expected at most "
+                          f"{limits.MAX_SHOTS:,} (fewer points per cell)")
+    limits.check_memory(limits.sweep_bytes(total, shot.params.rows),
+                        f"a sweep of {total:,} shots of {shot.params.rows:,} rows",
+                        "fewer shots (--mc, or fewer points per --vary) or fewer rows")
     bar, progress = _progress_bar(total)
     started = time.perf_counter()
     try:

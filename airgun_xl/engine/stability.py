@@ -90,6 +90,8 @@ def spectral_radius(dt, M, C, K):
 
 
 def _critical(M, C, K):
+    if not (np.isfinite(M).all() and np.isfinite(C).all() and np.isfinite(K).all()):
+        return 0.0, math.inf  # the inputs overflow: no step is stable
     omega_max = math.sqrt(max(np.max(np.real(np.linalg.eigvals(np.linalg.solve(M, K)))),
                               1e-300))
     lo, hi = 0.0, 4.0 / omega_max  # the damped bound is below 2/omega, so hi is unstable

@@ -5,6 +5,8 @@ Pure functions of arrays in SI units; :func:`summarize` gathers them for a
 """
 from dataclasses import dataclass, field
 
+import math
+
 import numpy as np
 
 #: Pulse duration: the span where the acceleration is at least this fraction of its peak.
@@ -61,7 +63,10 @@ def natural_frequencies(masses, springs):
     K = np.zeros((n, n))
     for i, k in enumerate(springs):
         K[i:i + 2, i:i + 2] += k * np.array([[1.0, -1.0], [-1.0, 1.0]])
-    w2 = np.sort(np.real(np.linalg.eigvals(K / np.asarray(masses)[:, None])))
+    A = K / np.asarray(masses)[:, None]
+    if not np.isfinite(A).all():
+        return [math.nan] * (n - 1)  # beyond floating point: no frequency to report
+    w2 = np.sort(np.real(np.linalg.eigvals(A)))
     return [float(np.sqrt(max(w, 0.0)) / (2 * np.pi)) for w in w2[1:]]
 
 KG = -9800.0  # the macro's m/s^2 -> kG divisor

@@ -45,8 +45,9 @@ def write_sweep(result, path, force, stats=None):
             finite = result.values[:, i][np.isfinite(result.values[:, i])]
             peaks = result.figures[:, 0][np.isfinite(result.figures[:, 0])]
             chart.set_title({"name": f"Peak acceleration against {cell}"})
-            chart.set_x_axis({"name": _label(cell), "min": float(finite.min()),
-                              "max": float(finite.max())})
+            chart.set_x_axis({"name": _label(cell),
+                              "min": float(finite.min()) if len(finite) else 0.0,
+                              "max": float(finite.max()) if len(finite) else 1.0})
             chart.set_y_axis({"name": "Peak (kG)", "min": 0.0,
                               "max": float(np.ceil(peaks.max())) if len(peaks) else 1.0})
             chart.set_legend({"none": True})

@@ -190,3 +190,13 @@ def xls_far_cell():
     ole = olefile.OleFileIO(out, write_mode=True)
     ole.write_stream("Workbook", bytes(stream))
     return out.getvalue()
+
+
+def million_rows(rows=1_000_000):
+    """The template followed by ``rows`` more rows of numbers in A and B: ~15 MB of zip."""
+    parts = members()
+    head, tail = parts[SHEET].decode().split("</sheetData>")
+    body = "".join(f'<row r="{r}"><c r="A{r}"><v>{r}</v></c><c r="B{r}"><v>{r % 997}.5</v></c>'
+                   f'</row>' for r in range(44, 44 + rows))
+    parts[SHEET] = (head + body + "</sheetData>" + tail).encode()
+    return rezip(parts, level=6)

@@ -1,0 +1,96 @@
+"""What every hostile test asserts: one line, exit 2, no traceback, nothing written or deleted;
+and helpers to run the CLI in a child process and read its peak memory."""
+import hashlib
+import json
+import os
+import re
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+from airgun_xl.cli import main
+
+#: A command reading any input under 50 MB stays under this resident size (issue 9).
+MEMORY_CAP = 500 * 2**20
+
+
+def snapshot(*folders):
+    """``{path: sha256}`` of every file under ``folders`` (symlinks by their target text)."""
+    out = {}
+    for folder in folders:
+        for root, dirs, files in os.walk(folder):
+            for name in dirs + files:
+                p = Path(root) / name
+                if p.is_symlink():
+                    out[str(p)] = "link:" + os.readlink(p)
+                elif p.is_file():
+                    out[str(p)] = hashlib.sha256(p.read_bytes()).hexdigest()
+                elif not p.is_dir():
+                    out[str(p)] = "special"
+    return out
+
+
+def refused(capsys, argv, *folders, naming=()):
+    """Run ``main(argv)`` in-process; assert the promise of a refusal and return its line.
+
+    Exit 2, exactly one line on stderr that starts ``airgun-xl: error:`` and names each of
+    ``naming``, no traceback, nothing on stdout, and no file under ``folders`` created,
+    changed or removed.
+    """
+    before = snapshot(*folders)
+    capsys.readouterr()
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    lines = err.strip().splitlines()
+    assert code == 2, (code, out, err)
+    assert len(lines) == 1 and lines[0].startswith("airgun-xl: error:"), err
+    assert "Traceback" not in err and out == ""
+    for word in naming:
+        assert word in lines[0], (word, lines[0])
+    assert snapshot(*folders) == before
+    return lines[0]
+
+
+CHILD = """
+import json, resource, sys
+from airgun_xl.cli import main
+code = main(sys.argv[2:])
+with open(sys.argv[1], "w") as fh:
+    json.dump({"code": code, "maxrss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss}, fh)
+sys.exit(code)
+"""
+
+
+def run_child(tmp_path, argv, timeout=300, **kwargs):
+    """Run the CLI in a child process; return (exit code, stderr, peak RSS in bytes)."""
+    report = tmp_path / f"child-{os.getpid()}-{len(list(tmp_path.iterdir()))}.json"
+    proc = subprocess.run([sys.executable, "-c", CHILD, str(report), *map(str, argv)],
+                          capture_output=True, text=True, timeout=timeout, **kwargs)
+    rss = None
+    if report.exists():
+        rss = json.loads(report.read_text())["maxrss"] * 1024  # Linux reports kB
+        report.unlink()
+    return proc.returncode, proc.stderr, rss
+
+
+def formulas_in(path):
+    """Every ``<f>`` formula text in a workbook's worksheets and every ``<c:f>`` in its charts."""
+    found = []
+    with zipfile.ZipFile(path) as zf:
+        for name in zf.namelist():
+            if name.endswith(".xml") and ("worksheets/" in name or "charts/" in name):
+                text = zf.read(name).decode("utf-8")
+                found += re.findall(r"<(?:c:)?f(?:\s[^>]*)?>(.*?)</(?:c:)?f>", text, re.S)
+    return found
+
+
+def strings_in(path):
+    """Every text of a workbook's shared strings and inline strings."""
+    found = []
+    with zipfile.ZipFile(path) as zf:
+        for name in zf.namelist():
+            if name.endswith(".xml") and ("sharedStrings" in name or "worksheets/" in name):
+                text = zf.read(name).decode("utf-8")
+                found += re.findall(r"<t(?:\s[^>]*)?>(.*?)</t>", text, re.S)
+    return found
