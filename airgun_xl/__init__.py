@@ -10,13 +10,26 @@ Load a shot from a workbook in the report's layout, run it, and get the result::
 __version__ = "0.1.0"
 
 from .errors import AirgunXlError, CellError, OptionError, OutputError, WorkbookError
-from .params import ShotParams
-from .result import Result
-from .shot import Shot
+
+#: Loaded on first use (PEP 562), so that ``airgun-xl`` can set up its signal handling before
+#: numpy and the engine load.
+_LAZY = {"ShotParams": "params", "Result": "result", "Shot": "shot"}
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def load(path):
     """Read a :class:`Shot` from a workbook (see :meth:`Shot.from_workbook`)."""
+    from .shot import Shot
+
     return Shot.from_workbook(path)
 
 

@@ -2,7 +2,9 @@
 
 A :class:`Publication` stages each output as a temp file beside its final name
 (``.NAME.<owner>-<hex>.airgun-xl-tmp``), written while the command works. :meth:`commit` then,
-holding an exclusive lock on the output folder and with SIGINT, SIGTERM and SIGHUP held back:
+holding an exclusive lock on the output folder and with SIGINT, SIGTERM and SIGHUP held back
+(:func:`signals_held`; from the commit on they stay held, so a late signal cannot make a
+finished command look failed):
 
 1. recovers what a killed publisher left in that folder (below);
 2. writes a journal (``.NAME.<owner>-<hex>.airgun-xl-journal``) naming every temp, final
@@ -27,7 +29,6 @@ import json
 import os
 import re
 import secrets
-import signal
 import stat
 from pathlib import Path
 
@@ -36,7 +37,6 @@ from .errors import OutputError
 SUFFIX = "airgun-xl"
 _OWNED = re.compile(r"^\.(?P<name>.+)\.(?P<owner>\d+\.\d+)-(?P<hex>[0-9a-f]{16})"
                     r"\.airgun-xl-(?P<kind>tmp|bak|journal)$")
-_HELD = [s for s in (getattr(signal, n, None) for n in ("SIGINT", "SIGTERM", "SIGHUP")) if s]
 
 
 def display(path):
@@ -94,9 +94,6 @@ def check_output(path, force=False, inputs=(), suffixes=(".xlsx",), force_word="
     """
     path = Path(path)
     shown = display(path)
-    if suffixes and path.suffix.lower() not in suffixes:
-        raise OutputError(f"{shown}: has the extension {path.suffix or '(none)'!s}, expected "
-                          f"{' or '.join(suffixes)}")
     try:
         st = os.lstat(path)
     except FileNotFoundError:
@@ -113,6 +110,9 @@ def check_output(path, force=False, inputs=(), suffixes=(".xlsx",), force_word="
             link = " (a symbolic link)" if stat.S_ISLNK(st.st_mode) else ""
             raise OutputError(f"{shown}: already exists{link}, expected a new file name or "
                               f"{force_word}")
+    if suffixes and path.suffix.lower() not in suffixes:
+        raise OutputError(f"{shown}: has the extension {path.suffix or '(none)'!s}, expected "
+                          f"{' or '.join(suffixes)}")
     for given in inputs:
         with contextlib.suppress(OSError):
             if os.path.exists(path) and os.path.samefile(path, given):
@@ -144,17 +144,50 @@ def folder_lock(folder):
         os.close(fd)  # releases the lock
 
 
+class Interrupted(KeyboardInterrupt):
+    """SIGINT, SIGTERM or SIGHUP, raised where the program is, so that cleanup runs."""
+
+    def __init__(self, signum):
+        super().__init__(signum)
+        self.signum = signum
+
+
+#: The signal state of this command: sections holding signals back, a signal that arrived
+#: while held (or was swallowed by a finalizer), and whether a publication has committed.
+SIGNALS = {"held": 0, "pending": None, "committed": False}
+
+
+def reset_signals():
+    SIGNALS.update(held=0, pending=None, committed=False)
+
+
+def on_signal(signum, frame=None):
+    """The handler the CLI installs for SIGINT, SIGTERM and SIGHUP: raise :class:`Interrupted`,
+    or, inside :func:`signals_held`, note the signal for the end of the section. Python runs
+    it in the main thread, whichever thread the signal reached."""
+    if SIGNALS["held"]:
+        SIGNALS["pending"] = signum
+        return
+    raise Interrupted(signum)
+
+
+def note_signal(signum):
+    """A signal whose :class:`Interrupted` was swallowed (raised inside a finalizer)."""
+    SIGNALS["pending"] = signum
+
+
 @contextlib.contextmanager
 def signals_held():
-    """Hold SIGINT, SIGTERM and SIGHUP back; they are delivered when the block ends."""
-    if not hasattr(signal, "pthread_sigmask"):
-        yield
-        return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+    """Hold SIGINT, SIGTERM and SIGHUP back (see :func:`on_signal`); one that arrived is
+    raised when the section ends normally."""
+    SIGNALS["held"] += 1
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        SIGNALS["held"] -= 1
+    if not SIGNALS["held"] and SIGNALS["pending"] is not None:
+        signum, SIGNALS["pending"] = SIGNALS["pending"], None
+        raise Interrupted(signum)
 
 
 def _fsync(path, directory=False):
@@ -248,6 +281,9 @@ class Publication:
         for temp, _ in self.files:
             _fsync(temp)
         with folder_lock(folder), signals_held():
+            if SIGNALS["pending"] is not None:  # swallowed earlier: stop before publishing
+                signum, SIGNALS["pending"] = SIGNALS["pending"], None
+                raise Interrupted(signum)
             recover(folder)
             record = self._record()
             journal = self._name(self.files[0][1], "journal")
@@ -278,6 +314,8 @@ class Publication:
             _fsync(folder, directory=True)
             self.committed = True
             _clean(folder, record)
+            SIGNALS["held"] += 1  # done: a signal from now on no longer stops the command
+            SIGNALS["committed"] = True
 
     def _record(self):
         files = []

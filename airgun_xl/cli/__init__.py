@@ -4,67 +4,48 @@ Exit codes: 0 done, 1 a comparison found differences, 2 bad input (one line on s
 written), 128 + N for signal N. SIGTERM and SIGHUP clean up like Ctrl-C (temp files go, nothing
 is half published); SIGXFSZ is ignored, so a file-size limit (``ulimit -f``) is a write error.
 """
-import argparse
 import contextlib
 import os
 import signal
 import sys
 
-from .. import __version__
-from ..errors import AirgunXlError, OptionError
-from . import archive, check, convergence, design, diff, fill, sweep, template
-
-COMMANDS = (fill, diff, archive, check, convergence, design, sweep, template)
-
-
-class _Parser(argparse.ArgumentParser):
-    """argparse, but a usage mistake becomes one line through the error tree."""
-
-    def error(self, message):
-        raise OptionError(f"{self.prog}: {message}")
-
-
-def build_parser():
-    parser = _Parser(prog="airgun-xl",
-                     description="ArtSim air gun impact simulation, from the report's workbook "
-                                 "to a new workbook.")
-    parser.add_argument("--version", action="version", version=f"airgun-xl {__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
-    for module in COMMANDS:
-        module.add_parser(sub)
-    return parser
-
-
-class Interrupted(KeyboardInterrupt):
-    """A termination signal, raised where the program is, so that cleanup runs."""
-
-    def __init__(self, signum):
-        super().__init__(signum)
-        self.signum = signum
-
-
-def _raise_interrupted(signum, frame):
-    raise Interrupted(signum)
+from ..errors import AirgunXlError
+from ..transaction import SIGNALS, Interrupted, note_signal, on_signal, reset_signals
 
 
 @contextlib.contextmanager
-def _signals():
-    """SIGTERM and SIGHUP raise like SIGINT; SIGXFSZ is ignored (in the main thread only)."""
+def _signals(restore=True):
+    """SIGTERM and SIGHUP raise like SIGINT; SIGXFSZ is ignored (in the main thread only).
+
+    Afterwards the handlers are restored, or, for the command itself (``restore=False``),
+    the signals are ignored: the work is done, and interpreter shutdown must not turn a late
+    Ctrl-C into a traceback."""
     import threading
 
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    wanted = {getattr(signal, n): _raise_interrupted for n in ("SIGTERM", "SIGHUP")
+    wanted = {getattr(signal, n): on_signal for n in ("SIGINT", "SIGTERM", "SIGHUP")
               if hasattr(signal, n)}
     if hasattr(signal, "SIGXFSZ"):
         wanted[signal.SIGXFSZ] = signal.SIG_IGN
+    reset_signals()
     saved = {s: signal.signal(s, h) for s, h in wanted.items()}
+    hook = sys.unraisablehook
+
+    def swallowed(unraisable):  # an interrupt raised inside a finalizer: keep it for later
+        if isinstance(unraisable.exc_value, KeyboardInterrupt):
+            note_signal(getattr(unraisable.exc_value, "signum", signal.SIGINT))
+        else:
+            hook(unraisable)
+
+    sys.unraisablehook = swallowed
     try:
         yield
     finally:
         for s, h in saved.items():
-            signal.signal(s, h)
+            signal.signal(s, h if restore else signal.SIG_IGN)
+        sys.unraisablehook = hook
 
 
 def _say(text):
@@ -79,15 +60,21 @@ def main(argv=None):
     for stream in (sys.stdout, sys.stderr):  # a file name may hold undecodable bytes
         with contextlib.suppress(AttributeError, ValueError, OSError):
             stream.reconfigure(errors="backslashreplace")
-    parser = build_parser()
     try:
-        with _signals():
+        with _signals(restore=argv is not None):  # before numpy and the engine load
+            from .commands import build_parser
+
+            parser = build_parser()
             args = parser.parse_args(argv)
             args.argv = ["airgun-xl", *(sys.argv[1:] if argv is None else argv)]
             if args.command is None:
                 parser.print_help()
                 return 2
-            return args.run(args)
+            code = args.run(args)
+            if SIGNALS["pending"] is not None and SIGNALS["committed"]:
+                _say(f"airgun-xl: signal {SIGNALS['pending']} arrived after the outputs were "
+                     "complete; nothing was lost")
+            return code
     except AirgunXlError as exc:
         _say(f"airgun-xl: error: {exc}")
         return exc.exit_code

@@ -1,0 +1,26 @@
+"""The argument parser: one subparser per subcommand module, each of which hands off."""
+import argparse
+
+from .. import __version__
+from ..errors import OptionError
+from . import archive, check, convergence, design, diff, fill, sweep, template
+
+COMMANDS = (fill, diff, archive, check, convergence, design, sweep, template)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but a usage mistake becomes one line through the error tree."""
+
+    def error(self, message):
+        raise OptionError(f"{self.prog}: {message}")
+
+
+def build_parser():
+    parser = _Parser(prog="airgun-xl",
+                     description="ArtSim air gun impact simulation, from the report's workbook "
+                                 "to a new workbook.")
+    parser.add_argument("--version", action="version", version=f"airgun-xl {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    for module in COMMANDS:
+        module.add_parser(sub)
+    return parser
