@@ -185,6 +185,8 @@ class Archive:
     create : bool
         Create the folder (its parent must exist), or adopt an empty one, for writing. Without
         it, ``root`` must already be an archive.
+    dry_run : bool
+        With ``create``: check that it could, and change nothing.
 
     Raises
     ------
@@ -193,9 +195,14 @@ class Archive:
         other files and is not an archive.
     """
 
-    def __init__(self, root, create=False):
+    def __init__(self, root, create=False, dry_run=False):
         self.root = Path(root)
         shown = display(self.root)
+        if dry_run and not self.root.exists():  # what create would do, without doing it
+            if not self.root.parent.is_dir():
+                raise ArchiveError(f"{shown}: its folder {display(self.root.parent)} does not "
+                                   "exist, expected an existing folder for the archive")
+            return
         if not self.root.exists():
             if not create:
                 raise ArchiveError(f"{shown}: no such archive, expected a folder written by "
@@ -220,7 +227,7 @@ class Archive:
                     f"{shown}: is not an airgun-xl archive (no {MARKER} or {INDEX}), expected "
                     + ("an archive, an empty folder or a new folder name" if create
                        else "a folder written by airgun-xl fill --archive"))
-        if create and not (self.root / MARKER).is_file():
+        if create and not dry_run and not (self.root / MARKER).is_file():
             try:
                 with open(self.root / MARKER, "x") as fh:
                     json.dump({"format": FORMAT, "tool": "airgun-xl"}, fh)

@@ -2,8 +2,8 @@
 import dataclasses
 import datetime
 import platform
-from pathlib import Path
 from importlib import metadata
+from pathlib import Path
 
 import numpy as np
 

@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
+from . import limits
 from .cells import CELLS
 from .errors import WorkbookError
-from . import limits
 from .workbook import guard
 
 #: Default tolerance: Calc and Excel keep 15 significant digits.

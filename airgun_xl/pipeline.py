@@ -66,11 +66,10 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
     if sidecar is not None:
         check_output(sidecar, options.force, inputs=inputs, suffixes=(".parquet", ".csv"),
                      force_word=options.force_word)
-    archive = None
     if options.archive is not None:
         from .archive import Archive
 
-        archive = Archive(options.archive.root, create=True)  # a foreign folder: refused now
+        Archive(options.archive.root, create=True, dry_run=True)  # a foreign folder: now
     warn(shot.warnings)
     crit, findings = before_run(model_shot.params, options.integrator)
     if crit.ratio > 1 and not options.allow_unstable:
@@ -110,9 +109,10 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
                 if stale != sidecar:
                     pub.remove(stale)
         pending = None
-        if archive is not None:
+        if options.archive is not None:
             from .archiving import prepare_entry
 
+            archive = Archive(options.archive.root, create=True)  # created once the run is done
             pending = prepare_entry(archive, options.archive, shot, workbook, filled, options,
                                     time.perf_counter() - started)
             pub.join(pending)

@@ -6,9 +6,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import limits
 from .cells import BY_ADDRESS, CELLS
 from .engine.batch import FIGURES, run_batch
-from . import limits
 from .errors import AirgunXlError, OptionError
 from .models import apply_model
 

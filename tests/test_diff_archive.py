@@ -12,9 +12,9 @@ import openpyxl
 import pytest
 from conftest import CASES, REFERENCE, TEMPLATE
 
-from airgun_xl.transaction import recover
 from airgun_xl.archive import SCRATCH, Archive, safe_name
 from airgun_xl.cli import main
+from airgun_xl.transaction import recover
 
 CALC_HOST_CASES = {"samplerate_non_integer"}
 

@@ -3,8 +3,8 @@ import sys
 import time
 from pathlib import Path
 
-from ..engine.integrators import INTEGRATORS
 from .. import limits
+from ..engine.integrators import INTEGRATORS
 from ..errors import OptionError
 from ..models import MODELS
 from ..shot import Shot

@@ -3,9 +3,8 @@
 Pure functions of arrays in SI units; :func:`summarize` gathers them for a
 :class:`airgun_xl.result.Result`.
 """
-from dataclasses import dataclass, field
-
 import math
+from dataclasses import dataclass, field
 
 import numpy as np
 

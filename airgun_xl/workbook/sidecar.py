@@ -3,10 +3,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..result import FRAME_UNITS
 from ..errors import OutputError
+from ..result import FRAME_UNITS
 from ..transaction import atomic_path, display
-
 
 #: The sidecar's name beside ``run.xlsx``: ``run`` + one of these.
 SIDECAR_SUFFIXES = (".history.parquet", ".history.csv")

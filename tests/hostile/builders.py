@@ -142,10 +142,11 @@ def bad_shared_string():
                                            '<c r="A1" t="s"><v>99999</v></c>'))
 
 
-def first_sheet_named(name):
+def first_sheet_named(name, data=None):
     """The parameter sheet renamed in workbook.xml (Excel would refuse some of these)."""
     escaped = name.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;")
-    return edit("xl/workbook.xml", lambda s: s.replace('name="Sheet1"', f'name="{escaped}"'))
+    return edit("xl/workbook.xml", lambda s: s.replace('name="Sheet1"', f'name="{escaped}"'),
+                data)
 
 
 def text_cells(cells):

@@ -74,23 +74,22 @@ def run_child(tmp_path, argv, timeout=300, **kwargs):
     return proc.returncode, proc.stderr, rss
 
 
-def formulas_in(path):
-    """Every ``<f>`` formula text in a workbook's worksheets and every ``<c:f>`` in its charts."""
+def _xml_texts(path, pattern, wanted):
+    """Every match of ``pattern`` in the workbook's XML members whose name has one of
+    ``wanted`` in it."""
     found = []
     with zipfile.ZipFile(path) as zf:
         for name in zf.namelist():
-            if name.endswith(".xml") and ("worksheets/" in name or "charts/" in name):
-                text = zf.read(name).decode("utf-8")
-                found += re.findall(r"<(?:c:)?f(?:\s[^>]*)?>(.*?)</(?:c:)?f>", text, re.S)
+            if name.endswith(".xml") and any(w in name for w in wanted):
+                found += re.findall(pattern, zf.read(name).decode("utf-8"), re.S)
     return found
+
+
+def formulas_in(path):
+    """Every ``<f>`` formula text in a workbook's worksheets and every ``<c:f>`` in its charts."""
+    return _xml_texts(path, r"<(?:c:)?f(?:\s[^>]*)?>(.*?)</(?:c:)?f>", ("worksheets/", "charts/"))
 
 
 def strings_in(path):
     """Every text of a workbook's shared strings and inline strings."""
-    found = []
-    with zipfile.ZipFile(path) as zf:
-        for name in zf.namelist():
-            if name.endswith(".xml") and ("sharedStrings" in name or "worksheets/" in name):
-                text = zf.read(name).decode("utf-8")
-                found += re.findall(r"<t(?:\s[^>]*)?>(.*?)</t>", text, re.S)
-    return found
+    return _xml_texts(path, r"<t(?:\s[^>]*)?>(.*?)</t>", ("sharedStrings", "worksheets/"))

@@ -10,7 +10,7 @@ import time
 
 import builders as b
 import pytest
-from support import refused, snapshot
+from support import refused
 
 from airgun_xl.archive import Archive
 from airgun_xl.cli import main

@@ -184,3 +184,25 @@ def test_diff_report_keeps_a_hostile_header_as_text(tmp_path):
     assert main(["diff", str(legacy), str(filled), "--report", str(report)]) == 1
     assert set(snapshot(tmp_path)) - set(before) == {str(report)}
     assert not any("cmd" in f for f in formulas_in(report))
+
+
+@pytest.mark.skipif(shutil.which("soffice") is None, reason="LibreOffice is not installed")
+def test_libreoffice_shows_the_text_and_does_not_run_it(tmp_path):
+    """In a real spreadsheet app: the label '=1+1' reads back as those characters, not 2, and
+    a parameter sheet named Summary opens beside the renamed 'Summary (2)'."""
+    import subprocess
+
+    shot = tmp_path / "shot.xlsx"
+    shot.write_bytes(b.text_cells({"A1": "=1+1", "G1": "=cmd|' /C calc'!A0"}))
+    shot.write_bytes(b.first_sheet_named("Summary", data=shot.read_bytes()))
+    assert main(["fill", str(shot), "--only", "summary,positions"]) == 0
+    out = tmp_path / "shot.out.xlsx"
+    done = subprocess.run(["soffice", f"-env:UserInstallation=file://{tmp_path}/lo",
+                           "--headless", "--convert-to", "csv", "--outdir", str(tmp_path),
+                           str(out)], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    import csv
+
+    rows = list(csv.reader((tmp_path / "shot.out.csv").open()))
+    assert rows[0][0] == "=1+1" and rows[0][6] == "=cmd|' /C calc'!A0"
+    assert rows[0][7] == "Time" and float(rows[1][4]) == 5e-07  # E2 as written
