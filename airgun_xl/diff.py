@@ -56,7 +56,8 @@ def _first_sheet(path):
     data, kind = guard.read_input(path)
     if kind == "zip":
         zf = guard.open_zip(path, data)
-        rows, columns = guard.sheet_extent(path, zf, guard.first_sheet_member(path, zf))
+        rows, columns = guard.sheet_extent(path, zf, guard.first_sheet_member(path, zf),
+                                           cap=limits.MAX_DIFF_CELLS)
     else:
         extents = guard.xls_extents(path, data)
         rows, columns = extents[0] if extents else (0, 0)

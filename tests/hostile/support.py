@@ -52,12 +52,16 @@ def refused(capsys, argv, *folders, naming=()):
     return lines[0]
 
 
+#: The child reports VmHWM, the peak resident size of its own address space: ru_maxrss would
+#: carry over the parent's peak through fork and exec on Linux.
 CHILD = """
-import json, resource, sys
+import json, sys
 from airgun_xl.cli import main
 code = main(sys.argv[2:])
+with open("/proc/self/status") as fh:
+    peak = next(int(line.split()[1]) for line in fh if line.startswith("VmHWM:"))
 with open(sys.argv[1], "w") as fh:
-    json.dump({"code": code, "maxrss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss}, fh)
+    json.dump({"code": code, "peak_kb": peak}, fh)
 sys.exit(code)
 """
 
@@ -69,7 +73,7 @@ def run_child(tmp_path, argv, timeout=300, **kwargs):
                           capture_output=True, text=True, timeout=timeout, **kwargs)
     rss = None
     if report.exists():
-        rss = json.loads(report.read_text())["maxrss"] * 1024  # Linux reports kB
+        rss = json.loads(report.read_text())["peak_kb"] * 1024
         report.unlink()
     return proc.returncode, proc.stderr, rss
 

@@ -16,7 +16,7 @@ from airgun_xl.cli import main
 
 #: builder, what fill's line must name (None: fill runs), what diff's line must name.
 REFUSED = {
-    "far_cell": (b.far_cell, None, "1,048,576 rows x 16,384 columns"),
+    "far_cell": (b.far_cell, None, "at least 1,048,576 rows"),
     "whitespace_bomb": (b.whitespace_bomb, "zip bomb", "zip bomb"),
     "many_members": (b.many_members, "5,011 zip members", "5,011 zip members"),
     "xxe_strings": (b.xxe_strings, "DTD", "DTD"),
@@ -26,7 +26,7 @@ REFUSED = {
     "crc_error": (b.crc_error, "CRC", "CRC"),
     "corrupt_sheet": (b.corrupt_sheet, "not a readable", "not a readable"),
     "bad_shared_string": (b.bad_shared_string, "not a readable", "not a readable"),
-    "million_rows": (b.million_rows, None, "1,000,043 rows"),
+    "million_rows": (b.million_rows, None, "at least 500,001 rows x 8 columns"),
 }
 
 
