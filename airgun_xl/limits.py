@@ -13,9 +13,10 @@ MAX_INPUT_BYTES = 50 * 2**20
 MAX_ZIP_MEMBERS = 1_000
 
 #: Largest inflated size of a zip member that is parsed whole (workbook, styles, shared
-#: strings, relationships, properties) [bytes]. A shot's are a few kB; past this, the Python
-#: objects they become could pass the memory budget.
-MAX_MEMBER_BYTES = 16 * 2**20
+#: strings, relationships, properties) [bytes]. A shot's are a few kB and Excel's styles a few
+#: hundred; openpyxl builds each into Python objects (twice: formulas, then cached values),
+#: ~5 s and ~150 MB for 4 MB of distinct styles or strings.
+MAX_MEMBER_BYTES = 4 * 2**20
 
 #: Largest inflated size of the whole package [bytes]. Worksheets are streamed, and only their
 #: first rows are read by ``fill``; a 1M-row legacy sheet inflates to ~500 MB.

@@ -201,3 +201,17 @@ def million_rows(rows=1_000_000):
                    f'</row>' for r in range(44, 44 + rows))
     parts[SHEET] = (head + body + "</sheetData>" + tail).encode()
     return rezip(parts, level=6)
+
+
+def distinct_strings(size=15 * 2**20, seed=1):
+    """A shared-strings table of ``size`` bytes of distinct numbers-as-text: random enough to
+    pass the inflation-ratio check, so only the whole-parse size cap stops it."""
+    import random
+
+    rng = random.Random(seed)
+    parts = members()
+    text = parts[STRINGS].decode()
+    k = text.index("<si>")
+    filler = "".join(f"<si><t>{rng.randrange(10**6)}</t></si>" for _ in range(size // 22))
+    parts[STRINGS] = (text[:k] + filler + text[k:]).encode()
+    return rezip(parts)

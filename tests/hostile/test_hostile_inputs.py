@@ -27,6 +27,7 @@ REFUSED = {
     "corrupt_sheet": (b.corrupt_sheet, "not a readable", "not a readable"),
     "bad_shared_string": (b.bad_shared_string, "not a readable", "not a readable"),
     "million_rows": (b.million_rows, None, "at least 500,001 rows x 8 columns"),
+    "distinct_strings": (b.distinct_strings, "expected at most 4.0 MB", "expected at most 4.0 MB"),
 }
 
 
