@@ -7,7 +7,7 @@ from ..engine.integrators import INTEGRATORS
 from ..errors import OptionError
 from ..shot import Shot
 from ..transaction import check_output
-from ..workbook.convergence import write_convergence, write_png
+from ..workbook.convergence import write_convergence
 
 
 def add_parser(sub):
@@ -60,8 +60,8 @@ def run(args):
     check_output(png, args.force, inputs=[args.shot], suffixes=(".png",))
     warn(shot.warnings)
     ladders = [ladder(shot, deltas, name, rtol) for name in integrators]
-    write_convergence(ladders, output, args.force, shot)
-    warn([] if write_png(ladders, png, args.force) else ["matplotlib is not installed: no PNG"])
+    drew = write_convergence(ladders, output, args.force, shot, png)
+    warn([] if drew else ["matplotlib is not installed: no PNG"])
     print_table(ladders)
     print(f"wrote {output} and {png}")
     return 0

@@ -117,3 +117,14 @@ def test_a_killed_fill_leaves_at_most_temp_files_that_the_next_run_removes(tmp_p
     assert main(["fill", str(SHOT), "-o", str(out), "--force", "--only", "summary"]) == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["o.xlsx"]
     assert leftovers >= 1  # some kills did leave temps behind for the recovery to remove
+
+
+def test_convergence_writes_its_workbook_and_png_together(tmp_path):
+    """The workbook (9.5 kB) fits a 30 kB file-size limit, the PNG (64 kB) does not: neither
+    is left, since both are one publication."""
+    proc = subprocess.run([sys.executable, "-m", "airgun_xl", "convergence", str(SHOT),
+                           "--levels", "5us,2us,1us", "-o", str(tmp_path / "c.xlsx")],
+                          capture_output=True, text=True, preexec_fn=_limited(30_000))
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and "cannot be written" in lines[-1], proc.stderr
+    assert "Traceback" not in proc.stderr and sorted(tmp_path.iterdir()) == []
