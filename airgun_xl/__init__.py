@@ -9,7 +9,14 @@ Load a shot from a workbook in the report's layout, run it, and get the result::
 """
 __version__ = "0.1.0"
 
-from .errors import AirgunXlError, CellError, OptionError, OutputError, WorkbookError
+from .errors import (
+    AirgunXlError,
+    CellError,
+    OptionError,
+    OutputError,
+    ResourceError,
+    WorkbookError,
+)
 
 #: Loaded on first use (PEP 562), so that ``airgun-xl`` can set up its signal handling before
 #: numpy and the engine load.
@@ -38,6 +45,7 @@ __all__ = [
     "CellError",
     "OptionError",
     "OutputError",
+    "ResourceError",
     "Result",
     "Shot",
     "ShotParams",

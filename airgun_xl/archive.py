@@ -456,6 +456,9 @@ class Archive:
         for shot in sorted(self.root.iterdir()):
             if shot.name.startswith(".") or not shot.is_dir():
                 continue
+            if shot.is_symlink():
+                problems.append(f"{shot.name}: a symbolic link, not a shot folder (not followed)")
+                continue
             for folder in sorted(shot.iterdir()):
                 if _entry_version(folder) is None or folder.is_symlink():
                     problems.append(f"{folder.relative_to(self.root).as_posix()}: not an entry "

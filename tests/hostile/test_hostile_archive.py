@@ -157,3 +157,13 @@ def test_a_refused_run_does_not_create_its_archive(tmp_path, capsys):
     refused(capsys, ["fill", stiff, "--archive", tmp_path / "new_archive"], tmp_path,
             naming=["unstable"])
     assert not (tmp_path / "new_archive").exists()
+
+
+def test_a_symlinked_shot_folder_is_reported_not_followed(tmp_path, capsys, archive):
+    elsewhere = tmp_path / "elsewhere"
+    (elsewhere / "v0001").mkdir(parents=True)
+    (archive / "linked").symlink_to(elsewhere)
+    capsys.readouterr()
+    assert main(["archive", "verify", str(archive)]) == 1
+    assert "linked: a symbolic link, not a shot folder (not followed)" in capsys.readouterr().out
+    assert sorted(p.name for p in elsewhere.iterdir()) == ["v0001"]
