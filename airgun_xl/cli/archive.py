@@ -2,32 +2,46 @@
 import json
 
 from ..archive import ENV, Archive, archive_dir
+from ..transaction import display
 
 
 def add_parser(sub):
-    h = sub.add_parser("history", help="list the shots of an archive",
-                       description=f"List archived runs with key inputs and peak (DIR defaults "
-                                   f"to ${ENV}).")
-    h.add_argument("dir", nargs="?", metavar="DIR")
-    h.add_argument("--shot", metavar="NAME")
-    h.add_argument("--since", metavar="DATE", help="ISO date, e.g. 2026-11-01")
-    h.add_argument("--json", action="store_true")
+    where = f"DIR defaults to ${ENV}."
+    h = sub.add_parser("history", help="list the runs stored in an archive",
+                       description=f"List archived runs with their key inputs and peak. {where}")
+    h.add_argument("dir", nargs="?", metavar="DIR", help="the archive folder")
+    h.add_argument("--shot", metavar="NAME", help="only this shot's runs")
+    h.add_argument("--since", metavar="DATE", help="only runs from this ISO date on, e.g. "
+                                                   "2026-11-01")
+    h.add_argument("--json", action="store_true", help="print the list as JSON")
     h.set_defaults(run=run_history)
-    s = sub.add_parser("show", help="print one archived run")
-    s.add_argument("entry", metavar="ENTRY", help="SHOT, SHOT@VERSION or #ID")
-    s.add_argument("--archive", metavar="DIR")
-    s.add_argument("--json", action="store_true")
+    s = sub.add_parser("show", help="print one archived run: inputs, figures, provenance",
+                       description=f"Print one archived run. {where}")
+    s.add_argument("entry", metavar="ENTRY", help="SHOT (its latest run), SHOT@VERSION or #ID")
+    s.add_argument("--archive", metavar="DIR", help="the archive folder")
+    s.add_argument("--json", action="store_true", help="print the run as JSON")
     s.set_defaults(run=run_show)
-    c = sub.add_parser("compare", help="diff two archived runs: inputs, then outputs")
-    c.add_argument("entry1", metavar="ENTRY1")
-    c.add_argument("entry2", metavar="ENTRY2")
-    c.add_argument("--archive", metavar="DIR")
-    c.add_argument("--rtol", type=float, default=1e-12)
+    c = sub.add_parser("compare", help="diff two archived runs: inputs, then every series",
+                       description=f"Compare two archived runs: the parameter cells first, "
+                                   f"then every series of their full histories. Exit 0 when "
+                                   f"they agree, 1 when they differ. {where}")
+    c.add_argument("entry1", metavar="ENTRY1", help="SHOT, SHOT@VERSION or #ID")
+    c.add_argument("entry2", metavar="ENTRY2", help="SHOT, SHOT@VERSION or #ID")
+    c.add_argument("--archive", metavar="DIR", help="the archive folder")
+    c.add_argument("--rtol", type=float, default=1e-12,
+                   help="relative to each series' largest magnitude (default 1e-12)")
     c.set_defaults(run=run_compare)
-    a = sub.add_parser("archive", help="archive maintenance: verify")
-    a.add_argument("action", choices=["verify"])
-    a.add_argument("dir", nargs="?", metavar="DIR")
+    a = sub.add_parser("archive", help="archive maintenance: verify",
+                       description=f"verify: finish what killed writers left, re-hash every "
+                                   f"file of every entry, and list anything missing, altered "
+                                   f"or out of place. Exit 0 clean, 1 with problems. {where}")
+    a.add_argument("action", choices=["verify"], help="verify the archive")
+    a.add_argument("dir", nargs="?", metavar="DIR", help="the archive folder")
     a.set_defaults(run=run_verify)
+
+
+def _count(n, one, many):
+    return f"{n} {one if n == 1 else many}"
 
 
 def _archive(given):
@@ -131,5 +145,6 @@ def run_verify(args):
     entries = archive.entries()
     for p in problems:
         print(f"problem: {p}")
-    print(f"{len(entries)} entries, {len(problems)} problems in {archive.root}")
+    print(f"{_count(len(entries), 'entry', 'entries')}, "
+          f"{_count(len(problems), 'problem', 'problems')} in {display(archive.root)}")
     return 0 if not problems else 1

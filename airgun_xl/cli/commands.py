@@ -11,8 +11,9 @@ COMMANDS = (fill, diff, archive, check, convergence, design, sweep, template)
 class _Parser(argparse.ArgumentParser):
     """argparse, but a usage mistake becomes one line through the error tree."""
 
-    def error(self, message):
-        raise OptionError(f"{self.prog}: {message}")
+    def error(self, message):  # "fill: the following arguments are required: SHOT.xlsx"
+        command = self.prog.removeprefix("airgun-xl").strip()
+        raise OptionError(f"{command}: {message}" if command else message)
 
 
 def build_parser():

@@ -48,6 +48,10 @@ def run(args):
         deltas = [parse_duration(t) for t in args.levels.split(",") if t.strip()]
     else:
         deltas = default_ladder(shot.params.delta)
+    if len(deltas) < 2 and not args.levels:
+        raise OptionError(f"--levels: the sheet's time step E2 = {shot.params.delta:g} s is "
+                          "already at the finest default level (5 ns), expected --levels with "
+                          "two or more time steps, e.g. --levels 10ns,5ns,2ns")
     if len(deltas) < 2:
         raise OptionError(f"--levels: found {args.levels!r}, expected at least two time steps")
     for d in deltas:

@@ -76,8 +76,10 @@ def print_summary(output, filled):
              + (" (rigid)" if result.model == "rigid" else "")
              + f", {result.integrator} integrator"]
     if s is not None:
-        lines.append(f"  peak {s.peak_kg:.5f} kG at {_ms(s.time_of_peak)}; filtered "
-                     f"{s.filtered_peak_kg:.5f} kG at {_ms(s.time_of_filtered_peak)}")
+        filtered = ("no filtered samples" if s.filtered_peak_kg != s.filtered_peak_kg else
+                    f"filtered {s.filtered_peak_kg:.5f} kG at "
+                    f"{_ms(s.time_of_filtered_peak)}")
+        lines.append(f"  peak {s.peak_kg:.5f} kG at {_ms(s.time_of_peak)}; {filtered}")
         lines.append(f"  pulse {_ms(s.pulse_duration)} (>= {PULSE_FRACTION:.0%} of peak), "
                      f"max crush {s.max_crush:.4f} m, final length {s.final_length:.4f} m")
         if s.spectrum.peaks:

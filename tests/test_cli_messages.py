@@ -1,0 +1,61 @@
+"""Wording a new user meets: one prefix, counts in the singular, no 'nan' figures, a way out
+named, and help for every archive command and argument."""
+import re
+
+import openpyxl
+import pytest
+from conftest import TEMPLATE
+
+from airgun_xl.cli import main
+
+
+def _variant(tmp_path, **cells):
+    path = tmp_path / "shot.xlsx"
+    wb = openpyxl.load_workbook(TEMPLATE)
+    for address, value in cells.items():
+        wb.worksheets[0][address] = value
+    wb.save(path)
+    return path
+
+
+def test_a_usage_mistake_has_one_prefix(capsys):
+    assert main(["fill"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "airgun-xl: error: fill: the following arguments are required: SHOT.xlsx"
+
+
+def test_no_filtered_samples_is_said_in_words(tmp_path, capsys):
+    shot = _variant(tmp_path, E34=10.0)  # one sample every 0.1 s: none in 6 ms
+    assert main(["fill", str(shot), "--only", "summary"]) == 0
+    out = capsys.readouterr().out
+    assert "no filtered samples" in out and not re.search(r"\bnan\b", out)
+
+
+def test_verify_counts_in_the_singular(tmp_path, capsys):
+    archive = tmp_path / "a"
+    assert main(["fill", str(TEMPLATE), "-o", str(tmp_path / "o.xlsx"), "--only", "summary",
+                 "--archive", str(archive)]) == 0
+    capsys.readouterr()
+    assert main(["archive", "verify", str(archive)]) == 0
+    assert capsys.readouterr().out.strip().startswith("1 entry, 0 problems in ")
+
+
+def test_convergence_at_the_finest_level_says_what_to_do(tmp_path, capsys):
+    shot = _variant(tmp_path, E2=5e-9, E6=1e-5)
+    assert main(["convergence", str(shot)]) == 2
+    err = capsys.readouterr().err
+    assert "already at the finest default level (5 ns)" in err and "--levels 10ns" in err
+
+
+@pytest.mark.parametrize("command,words", [
+    ("history", ["the archive folder", "only this shot's runs", "ISO date", "as JSON"]),
+    ("show", ["SHOT (its latest run)", "the archive folder"]),
+    ("compare", ["Exit 0 when", "SHOT, SHOT@VERSION or #ID", "largest magnitude"]),
+    ("archive", ["re-hash every", "verify the archive", "the archive folder"]),
+])
+def test_archive_commands_have_help(capsys, command, words):
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    for word in words:
+        assert word in text, word
