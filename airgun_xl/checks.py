@@ -53,17 +53,26 @@ def stability(p, integrator="legacy"):
     return crit, None
 
 
+def impact_speed_finding(p):
+    """The warning for an impact speed past the crush-factor fit, or None.
+
+    (A bird slower than the MEM crushes nothing at first: no warning.)"""
+    lo, hi = CRUSH_FIT_RANGE
+    v_rel = p.v31 - p.v1
+    if v_rel <= hi:
+        return None
+    return Finding("warning", "A28", f"the bird meets the MEM at {v_rel:.4g} m/s, outside "
+                   f"{lo:g}..{hi:g} m/s where the crush-factor polynomial (Eq. 8) holds: it is "
+                   f"extrapolated there (crush factor {crush_factor(v_rel):.3g})")
+
+
 def before_run(p, integrator="legacy"):
     """Findings that need no run. Returns (CriticalStep, list of Finding)."""
     crit, finding = stability(p, integrator)
     found = [finding] if finding else []
-    lo, hi = CRUSH_FIT_RANGE
-    v_rel = p.v31 - p.v1
-    if v_rel > hi:  # (a bird slower than the MEM crushes nothing at first: no warning)
-        found.append(Finding("warning", "A28", f"the bird meets the MEM at {v_rel:.4g} m/s, "
-                             f"outside {lo:g}..{hi:g} m/s where the crush-factor polynomial "
-                             f"(Eq. 8) holds: it is extrapolated there (crush factor "
-                             f"{crush_factor(v_rel):.3g})"))
+    speed = impact_speed_finding(p)
+    if speed is not None:
+        found.append(speed)
     if p.v1 == p.v31 == p.v32 == p.v33:
         found.append(Finding("note", "A28", f"all masses start at {p.v31:g} m/s: nothing "
                              "crushes the mitigator, the response is free flight"))

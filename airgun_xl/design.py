@@ -11,7 +11,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .engine.batch import run_batch
-from .engine.legacy_law import CRUSH_FIT_RANGE
 from .errors import AirgunXlError, OptionError
 from .models import apply_model
 
@@ -204,8 +203,9 @@ def design_warnings(p, target_kg, achieved):
     if abs(achieved - target_kg) > 1e-3 * abs(target_kg):
         out.append(f"the peak jumps across the target here: {achieved:.5g} kG is the closest "
                    "this parameter reaches")
-    if p.v31 - p.v1 > CRUSH_FIT_RANGE[1]:
-        out.append(f"A28: the solution's impact speed {p.v31 - p.v1:.4g} m/s is beyond "
-                   f"{CRUSH_FIT_RANGE[1]:g} m/s, where the crush-factor polynomial is "
-                   "extrapolated")
+    from .checks import impact_speed_finding
+
+    speed = impact_speed_finding(p)
+    if speed is not None:  # the words the fill of the designed shot uses too
+        out.append(str(speed))
     return out

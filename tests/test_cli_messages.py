@@ -59,3 +59,19 @@ def test_archive_commands_have_help(capsys, command, words):
     text = " ".join(capsys.readouterr().out.split())
     for word in words:
         assert word in text, word
+
+
+def test_design_warns_once_about_extrapolation(tmp_path, capsys):
+    """14 kG needs 255.9 m/s, past the crush-factor fit: said once, not by design and again by
+    the fill of the designed shot."""
+    assert main(["design", str(TEMPLATE), "--target-peak", "14kG", "-o",
+                 str(tmp_path / "d.xlsx")]) == 0
+    err = capsys.readouterr().err
+    assert err.count("extrapolated") == 1 and "the bird meets the MEM at 255.9 m/s" in err
+
+
+def test_the_rigid_model_names_no_modes(tmp_path, capsys):
+    assert main(["fill", str(TEMPLATE), "-o", str(tmp_path / "r.xlsx"), "--model", "rigid",
+                 "--only", "summary"]) == 0
+    out = capsys.readouterr().out
+    assert "(rigid)" in out and "dominant frequencies" not in out

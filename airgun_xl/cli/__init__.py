@@ -57,6 +57,7 @@ def _say(text):
 
 def main(argv=None):
     """Run the CLI; return the exit code (0 ok, 1 differences, 2 bad input, 128+N signal N)."""
+    _WARNED.clear()
     for stream in (sys.stdout, sys.stderr):  # a file name may hold undecodable bytes
         with contextlib.suppress(AttributeError, ValueError, OSError):
             stream.reconfigure(errors="backslashreplace")
@@ -89,7 +90,14 @@ def main(argv=None):
         return 0
 
 
+_WARNED = set()
+
+
 def warn(messages):
-    """Print warnings, one line each, to stderr."""
+    """Print warnings, one line each, to stderr; a warning already given by this command is
+    not repeated (design warns about its solution, then the fill of it does)."""
     for message in messages:
-        _say(f"airgun-xl: warning: {message}")
+        line = f"airgun-xl: warning: {message}"
+        if line not in _WARNED:
+            _WARNED.add(line)
+            _say(line)

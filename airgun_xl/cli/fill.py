@@ -82,7 +82,7 @@ def print_summary(output, filled):
         lines.append(f"  peak {s.peak_kg:.5f} kG at {_ms(s.time_of_peak)}; {filtered}")
         lines.append(f"  pulse {_ms(s.pulse_duration)} (>= {PULSE_FRACTION:.0%} of peak), "
                      f"max crush {s.max_crush:.4f} m, final length {s.final_length:.4f} m")
-        if s.spectrum.peaks:
+        if s.spectrum.peaks and result.model != "rigid":  # one body: no modes to name
             lines.append("  dominant frequencies "
                          + ", ".join(f"{f / 1e3:.2f}" for f in s.spectrum.peaks) + " kHz")
     else:
