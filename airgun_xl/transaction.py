@@ -81,6 +81,12 @@ _KINDS = ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
           (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
 
 
+def special_kind(mode):
+    """``"a FIFO"``, ``"a character device"``... for a file that is neither a regular file,
+    a folder nor a symlink; None otherwise."""
+    return next((kind for test, kind in _KINDS if test(mode)), None)
+
+
 def check_output(path, force=False, inputs=(), suffixes=(".xlsx",), force_word="--force"):
     """Refuse an output that cannot be written as a new regular file.
 
@@ -103,9 +109,9 @@ def check_output(path, force=False, inputs=(), suffixes=(".xlsx",), force_word="
     if st is not None:
         if stat.S_ISDIR(st.st_mode):
             raise OutputError(f"{shown}: is a folder, expected an output file name")
-        for test, kind in _KINDS:
-            if test(st.st_mode):
-                raise OutputError(f"{shown}: is {kind}, expected a regular file name")
+        kind = special_kind(st.st_mode)
+        if kind is not None:
+            raise OutputError(f"{shown}: is {kind}, expected a regular file name")
         if not force:
             link = " (a symbolic link)" if stat.S_ISLNK(st.st_mode) else ""
             raise OutputError(f"{shown}: already exists{link}, expected a new file name or "

@@ -23,15 +23,12 @@ from pathlib import Path
 
 from .. import limits
 from ..errors import WorkbookError
+from ..transaction import display, special_kind
 
 ZIP_MAGIC = b"PK\x03\x04"
 CFB_MAGIC = bytes.fromhex("D0CF11E0A1B11AE1")  # OLE compound file: .xls, or an encrypted .xlsx
 ENCRYPTED_STREAM = "EncryptedPackage".encode("utf-16-le")
 EXPECTED = "expected a workbook (.xlsx, .xlsm or .xls)"
-
-_KINDS = ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
-          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
-
 
 def _mib(n):
     return f"{n / 2**20:,.1f} MB"
@@ -60,9 +57,9 @@ def read_input(path):
         st = os.fstat(fd)
         if stat.S_ISDIR(st.st_mode):
             raise WorkbookError(f"{shown}: is a folder, {EXPECTED}")
-        for test, kind in _KINDS:
-            if test(st.st_mode):
-                raise WorkbookError(f"{shown}: is {kind}, expected a regular workbook file")
+        kind = special_kind(st.st_mode)
+        if kind is not None:
+            raise WorkbookError(f"{shown}: is {kind}, expected a regular workbook file")
         if st.st_size > limits.MAX_INPUT_BYTES:
             raise WorkbookError(f"{shown}: is {_mib(st.st_size)}, expected a workbook of at most "
                                 f"{_mib(limits.MAX_INPUT_BYTES)}")
@@ -83,12 +80,6 @@ def read_input(path):
                                 "workbook (save a copy without a password)")
         return data, "xls"
     raise WorkbookError(f"{shown}: is not a workbook, {EXPECTED}")
-
-
-def display(path):
-    """A path as printable text: undecodable bytes of a file name become \\x escapes."""
-    text = os.fsdecode(path) if not isinstance(path, str) else path
-    return text.encode("utf-8", "backslashreplace").decode("utf-8")
 
 
 # -- .xlsx / .xlsm -----------------------------------------------------------------------------
