@@ -37,6 +37,11 @@ class Variable:
 
     def bounds(self, p):
         lo, hi = self.range
+        if self.relative and self.value(p) == 0:
+            from .errors import OptionError
+
+            raise OptionError(f"--range: {self.cell} is 0 on the sheet, so the default range "
+                              f"(x{lo:g} to x{hi:g} of it) is empty; expected --range LO:HI")
         return (lo * self.value(p), hi * self.value(p)) if self.relative else (lo, hi)
 
     def apply(self, p, x):

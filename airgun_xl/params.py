@@ -187,6 +187,11 @@ class ShotParams:
         for f in fields(self):
             if f.name not in left_out:
                 check_value(BY_NAME[f.name], getattr(self, f.name))
+        if self.hcone == 0 and self.hcylinder == 0:
+            c = BY_NAME["hcone"]
+            raise CellError(c.address, c.label, "0 with E19 (Length of Cylindrical Part) 0",
+                            "a mitigator of some length: E16 or E19 above 0 (the macro "
+                            "divides 0/0)")
         if self.delta > self.max_time:
             c = BY_NAME["delta"]
             raise CellError(c.address, c.label, repr(self.delta),

@@ -75,3 +75,17 @@ def test_the_rigid_model_names_no_modes(tmp_path, capsys):
                  "--only", "summary"]) == 0
     out = capsys.readouterr().out
     assert "(rigid)" in out and "dominant frequencies" not in out
+
+
+def test_a_mitigator_of_no_length_is_one_line(tmp_path, capsys):
+    shot = _variant(tmp_path, E16=0, E19=0)
+    assert main(["fill", str(shot)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("airgun-xl: error: E16 (Length of Wedge Part): found 0 with E19")
+    assert "E16 or E19 above 0" in err
+
+
+def test_design_of_a_wedge_from_a_sheet_without_one_asks_for_a_range(tmp_path, capsys):
+    shot = _variant(tmp_path, E16=0, E6=0.002)
+    assert main(["design", str(shot), "--target-peak", "8kG", "--vary", "E16"]) == 2
+    assert "--range: E16 is 0 on the sheet" in capsys.readouterr().err

@@ -2,6 +2,8 @@
 
 The outputs in legacy_reference/ were written by ArtSim itself running in LibreOffice Calc.
 """
+import json
+
 import numpy as np
 import pytest
 from conftest import (
@@ -93,6 +95,30 @@ def test_every_branch_is_covered():
             seen.add("fractional samplerate")
         if not float(p.max_time / p.delta).is_integer():
             seen.add("fractional row count")
+        if p.hcone == 0:
+            seen.add("no wedge")
     assert seen >= {"unloading", "loading only", "cylinder", "wedge only", "crush factor clamped",
                     "force clamped", "filtered", "no filtered samples", "fractional samplerate",
-                    "front past the wedge on the first step", "fractional row count"}
+                    "front past the wedge on the first step", "fractional row count",
+                    "no wedge"}
+
+
+ERROR_CASES = json.loads((REFERENCE / "error_cases.json").read_text())
+
+
+@pytest.mark.parametrize("name", sorted(ERROR_CASES))
+def test_where_the_macro_fails_fill_refuses_naming_the_cell(tmp_path, capsys, name):
+    """The macro stopped with a runtime error (the runner wrote it into AZ1): fill refuses with
+    one line naming the cell, at the same row, and writes nothing."""
+    import openpyxl
+
+    case = ERROR_CASES[name]
+    legacy = openpyxl.load_workbook(REFERENCE / case["legacy_output"]).worksheets[0]
+    assert legacy["AZ1"].value == case["macro_error"]
+    shot = REFERENCE / case["input"]
+    out = tmp_path / "o.xlsx"
+    assert main(["fill", str(shot), "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith("airgun-xl: error: E16 (Length of Wedge Part): found 0 with the "
+                          "plastic front not yet moved on a loading step (row 4,")
+    assert "Division by zero" in err and not out.exists()

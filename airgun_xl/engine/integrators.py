@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import AirgunXlError, OptionError
+from ..errors import AirgunXlError, CellError, OptionError
 from ._artsim import legacy_kernel, newmark_kernel
 
 #: Order of the parameters the compiled kernel takes (``_artsim.c``, enum at its top).
@@ -107,6 +107,20 @@ def displacement_bound(p):
     return 10 * (v * p.max_time + p.hcone + p.hcylinder) + 1.0
 
 
+def no_wedge_error(p, row):
+    """E16 = 0 and a loading step before the plastic front has moved: the wedge's area is
+    0/0 there. The macro stops with "Division by zero"; the kernel gets NaN and stops."""
+    from ..cells import BY_ADDRESS
+
+    c = BY_ADDRESS["E16"]
+    return CellError(c.address, c.label,
+                     f"0 with the plastic front not yet moved on a loading step (row "
+                     f"{row + 2}, t = {(row - 1) * p.delta:.4g} s), where the macro divides 0/0 "
+                     "(its 'Division by zero')",
+                     "a positive wedge length, or a bird that moves into the MEM from the "
+                     "first step")
+
+
 def _run(kernel, name, p, track):
     rows = p.rows
     arrays = [np.zeros(rows) for _ in range(5)] + [
@@ -116,6 +130,8 @@ def _run(kernel, name, p, track):
     final_m1, final_m31, bad, x_plastic, max_v, min_v, max_crushed, max_crush = kernel(
         values, rows, *arrays)
     elapsed = time.perf_counter() - started
+    if bad >= 0 and p.hcone == 0 and not x_plastic > 0:
+        raise no_wedge_error(p, bad)
     if bad >= 0:
         raise DivergenceError(name, p, bad, arrays)
     history = History(*arrays, final_m1, final_m31, elapsed)
