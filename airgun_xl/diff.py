@@ -181,6 +181,10 @@ class DiffReport:
     rtol: float
     atol: float
     notes: list = field(default_factory=list)
+    #: How the two sides are named; archived runs are named by entry, not LEGACY and NEW.
+    labels: tuple = ("LEGACY", "NEW")
+    #: Whether the parameter cells were compared here (archived runs: by the caller).
+    inputs_compared: bool = True
 
     @property
     def same(self):
@@ -310,20 +314,24 @@ def diff_histories(name_a, a, name_b, b, rtol=DEFAULT_RTOL, atol=0.0):
     only_a = [k for k in a if k not in b]
     only_b = [k for k in b if k not in a]
     report = DiffReport(name_a, name_b, (len(ta), len(tb)), [], columns, only_a, only_b, rtol,
-                        atol)
+                        atol, labels=(name_a, name_b), inputs_compared=False)
     report.worst = None
     return report
 
 
 def format_report(report):
     """The report as a readable table."""
-    lines = [f"LEGACY {report.legacy} ({report.rows[0]:,} rows)",
-             f"NEW    {report.new} ({report.rows[1]:,} rows)"]
-    if report.inputs:
+    if report.labels == ("LEGACY", "NEW"):
+        lines = [f"LEGACY {report.legacy} ({report.rows[0]:,} rows)",
+                 f"NEW    {report.new} ({report.rows[1]:,} rows)"]
+    else:
+        lines = [f"rows: {report.rows[0]:,} in {report.labels[0]}, {report.rows[1]:,} in "
+                 f"{report.labels[1]}"]
+    if report.inputs_compared and report.inputs:
         lines.append("inputs differ (so the numbers may differ for that reason):")
         for addr, label, x, y in report.inputs:
             lines.append(f"  {addr} {label}: {x!r} vs {y!r}")
-    else:
+    elif report.inputs_compared:
         lines.append(f"inputs: the {len(CELLS)} parameter cells agree")
     lines.append(f"  {'column':<30} {'rows':>13} {'max abs':>10} {'max rel':>10} "
                  f"{'outside':>8}  first outside")
@@ -333,7 +341,7 @@ def format_report(report):
             f = c.first_outside
             when = "" if f["time"] is None else f" t={f['time']:.6g}"
             first = f"row {f['row']}{when}: {f['legacy']!r} vs {f['new']!r}"
-        lines.append(f"  {(c.column + ' ' + c.header)[:30]:<30} "
+        lines.append(f"  {(c.column + ' ' + c.header).strip()[:30]:<30} "
                      f"{c.rows_legacy:>6,}/{c.rows_new:<6,} {c.max_abs:>10.2e} "
                      f"{c.max_rel:>10.2e} {c.outside:>8,}  {first}")
     for label, names in (("only in legacy", report.only_legacy),

@@ -152,7 +152,10 @@ def test_archive_from_the_environment_and_the_finding_commands(tmp_path, capsys,
     assert "A28" in capsys.readouterr().out
     assert main(["compare", "shot@1", "shot@2"]) == 1
     out = capsys.readouterr().out
-    assert "input A28" in out and "DIFFERENT" in out
+    assert "inputs differ (so the numbers may differ for that reason), shot@1 vs shot@2:" in out
+    assert "  A28 Initial Velocity Matrix (Y31): 243.53532 vs 200" in out
+    assert "DIFFERENT" in out and "agree" not in out  # said once, and not contradicted
+    assert "LEGACY" not in out and "NEW" not in out and "rows: " in out  # runs by entry
     assert main(["show", "nothing@9"]) == 2
     assert main(["archive", "verify"]) == 0
 

@@ -108,10 +108,13 @@ def run_compare(args):
     pb = {p["cell"]: p for p in b.load("params.json")}
     differing = [(c, pa[c]["label"], pa[c]["value"], pb[c]["value"]) for c in pa
                  if pa[c]["value"] != pb[c]["value"]]
+    if differing:
+        print(f"inputs differ (so the numbers may differ for that reason), {a.ref} vs "
+              f"{b.ref}:")
     for cell, label, x, y in differing:
-        print(f"  input {cell} {label}: {x!r} vs {y!r}")
+        print(f"  {cell} {label}: {x!r} vs {y!r}")
     if not differing:
-        print("  inputs: the same")
+        print(f"inputs: the {len(pa)} parameter cells agree")
     from ..diff import diff_histories, format_report
 
     report = diff_histories(a.ref, _history(a), b.ref, _history(b), args.rtol)
