@@ -19,6 +19,7 @@ import posixpath
 import stat
 import struct
 import zipfile
+import zlib
 from pathlib import Path
 
 from .. import limits
@@ -29,6 +30,10 @@ ZIP_MAGIC = b"PK\x03\x04"
 CFB_MAGIC = bytes.fromhex("D0CF11E0A1B11AE1")  # OLE compound file: .xls, or an encrypted .xlsx
 ENCRYPTED_STREAM = "EncryptedPackage".encode("utf-16-le")
 EXPECTED = "expected a workbook (.xlsx, .xlsm or .xls)"
+
+#: What reading a zip member can raise on damaged bytes: zipfile reports a bad CRC as
+#: BadZipFile, but a broken deflate stream as zlib.error.
+_READ_ERRORS = (zipfile.BadZipFile, OSError, EOFError, ValueError, zlib.error)
 
 def _mib(n):
     return f"{n / 2**20:,.1f} MB"
@@ -133,6 +138,11 @@ def open_zip(path, data):
     return zf
 
 
+def _declares(shown, member, exc):
+    return WorkbookError(f"{shown}: member {member} declares a DTD or entities "
+                         f"({type(exc).__name__}), expected plain spreadsheet XML")
+
+
 def _defused_prolog(shown, zf, member, size=1 << 16):
     """A streamed worksheet's first bytes through defusedxml: a DTD or an entity declaration
     sits in the prolog, before any cell."""
@@ -144,18 +154,11 @@ def _defused_prolog(shown, zf, member, size=1 << 16):
             head = fh.read(size)
         DefusedXMLParser(forbid_dtd=True).feed(head)
     except defusedxml.DefusedXmlException as exc:
-        raise WorkbookError(f"{shown}: member {member.filename} declares a DTD or entities "
-                            f"({type(exc).__name__}), expected plain spreadsheet XML") from None
+        raise _declares(shown, member.filename, exc) from None
     except ParseError:
         pass  # a malformed sheet is reported by the parser that reads it
-    except (zipfile.BadZipFile, OSError, EOFError, ValueError, zlib_error()) as exc:
+    except _READ_ERRORS as exc:
         raise WorkbookError(f"{shown}: is not a readable .xlsx workbook ({exc})") from None
-
-
-def zlib_error():
-    import zlib
-
-    return zlib.error
 
 
 def _defused(shown, zf, member):
@@ -167,12 +170,11 @@ def _defused(shown, zf, member):
         if data.strip():
             fromstring(data, forbid_dtd=True)
     except defusedxml.DefusedXmlException as exc:
-        raise WorkbookError(f"{shown}: member {member.filename} declares a DTD or entities "
-                            f"({type(exc).__name__}), expected plain spreadsheet XML") from None
+        raise _declares(shown, member.filename, exc) from None
     except ParseError as exc:
         raise WorkbookError(f"{shown}: member {member.filename} is not well-formed XML "
                             f"({exc})") from None
-    except (zipfile.BadZipFile, OSError, EOFError, ValueError, zlib_error()) as exc:
+    except _READ_ERRORS as exc:
         raise WorkbookError(f"{shown}: is not a readable .xlsx workbook ({exc})") from None
 
 
@@ -280,9 +282,8 @@ def sheet_extent(path, zf, member, cap=None):
                             f"rows x {parser.columns:,} columns, expected at most {cap:,} "
                             "cells") from None
     except defusedxml.DefusedXmlException as exc:
-        raise WorkbookError(f"{display(path)}: {member} declares a DTD or entities "
-                            f"({type(exc).__name__}), expected plain spreadsheet XML") from None
-    except (xml.sax.SAXException, zipfile.BadZipFile, OSError, EOFError, ValueError) as exc:
+        raise _declares(display(path), member, exc) from None
+    except (xml.sax.SAXException, *_READ_ERRORS) as exc:
         raise WorkbookError(f"{display(path)}: {member} is not a readable worksheet "
                             f"({exc})") from None
     return parser.rows, _column_number(parser.widest[1]) + parser.widest_run

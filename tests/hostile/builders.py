@@ -215,3 +215,22 @@ def distinct_strings(size=15 * 2**20, seed=1):
     filler = "".join(f"<si><t>{rng.randrange(10**6)}</t></si>" for _ in range(size // 22))
     parts[STRINGS] = (text[:k] + filler + text[k:]).encode()
     return rezip(parts)
+
+
+def corrupt_deflate(rows=20_000, good=200_000):
+    """A sheet whose deflate stream turns invalid after its first ``good`` inflated bytes: the
+    prolog reads clean, a reader that goes on gets zlib.error (not BadZipFile)."""
+    import zlib
+
+    data = bytearray(million_rows(rows))
+    with zipfile.ZipFile(io.BytesIO(bytes(data))) as zf:
+        info = zf.getinfo(SHEET)
+        xml = zf.read(SHEET)
+    name_len, extra_len = struct.unpack_from("<HH", data, info.header_offset + 26)
+    start = info.header_offset + 30 + name_len + extra_len
+    comp = zlib.compressobj(6, zlib.DEFLATED, -15)
+    head = comp.compress(xml[:good]) + comp.flush(zlib.Z_FULL_FLUSH)
+    assert len(head) < info.compress_size
+    # 0xff bytes: a final block of the reserved type 11, "invalid block type"
+    data[start:start + info.compress_size] = head + b"\xff" * (info.compress_size - len(head))
+    return bytes(data)
