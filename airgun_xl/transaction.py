@@ -205,10 +205,6 @@ def _fsync(path, directory=False):
             os.close(fd)
 
 
-def _lexists(path):
-    return os.path.lexists(path)
-
-
 # -- the publication --------------------------------------------------------------------------
 class Publication:
     """Files staged and published together; see the module docstring.
@@ -231,7 +227,11 @@ class Publication:
         self.committed = False
 
     def _name(self, final, kind):
-        return final.parent / f".{final.name}.{self.token}.{SUFFIX}-{kind}"
+        return _owned(final.parent, final.name, self.token, kind)
+
+    def _exists_error(self, final):
+        return OutputError(f"{display(final)}: already exists (another command wrote it first), "
+                           f"expected a new file name or {self.force_word}")
 
     def stage(self, final):
         """A new empty temp file for ``final``, to be written by the caller."""
@@ -305,7 +305,7 @@ class Publication:
                 for temp, final in self.files:
                     self._publish(temp, final)
                 for final in self.removals:
-                    if _lexists(final):
+                    if os.path.lexists(final):
                         os.rename(final, self._name(final, "bak"))
                 if self.participant is not None:
                     self.participant.commit()
@@ -332,16 +332,14 @@ class Publication:
                 "removals": [f.name for f in self.removals]}
 
     def _publish(self, temp, final):
-        if _lexists(final):
+        if os.path.lexists(final):
             if not self.force:
-                raise OutputError(f"{display(final)}: already exists (another command wrote it "
-                                  f"first), expected a new file name or {self.force_word}")
+                raise self._exists_error(final)
             os.rename(final, self._name(final, "bak"))  # a symlink itself, never its target
         try:
             os.link(temp, final)  # fails if the name exists: exactly one writer wins
         except FileExistsError:
-            raise OutputError(f"{display(final)}: already exists (another command wrote it "
-                              f"first), expected a new file name or {self.force_word}") from None
+            raise self._exists_error(final) from None
         except OSError as exc:
             if exc.errno not in (errno.EPERM, errno.EOPNOTSUPP, errno.ENOTSUP, errno.EMLINK):
                 raise OutputError(f"{display(final)}: cannot be written "
@@ -350,14 +348,17 @@ class Publication:
             try:
                 os.close(os.open(final, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644))
             except FileExistsError:
-                raise OutputError(f"{display(final)}: already exists (another command wrote "
-                                  f"it first), expected a new file name or "
-                                  f"{self.force_word}") from None
+                raise self._exists_error(final) from None
             os.replace(temp, final)
 
 
+def _owned(folder, final, token, kind):
+    """The name of a publication's temp, backup or journal beside ``final`` (see _OWNED)."""
+    return folder / f".{final}.{token}.{SUFFIX}-{kind}"
+
+
 def _names(folder, record, final, kind):
-    return folder / f".{final}.{record['token']}.{SUFFIX}-{kind}"
+    return _owned(folder, final, record["token"], kind)
 
 
 def _roll_back(folder, record):
@@ -369,14 +370,14 @@ def _roll_back(folder, record):
             if [st.st_dev, st.st_ino] == f["inode"]:
                 os.unlink(final)
         backup = _names(folder, record, f["final"], "bak")
-        if _lexists(backup) and not _lexists(final):
+        if os.path.lexists(backup) and not os.path.lexists(final):
             with contextlib.suppress(OSError):
                 os.rename(backup, final)
         with contextlib.suppress(OSError):
             os.unlink(_names(folder, record, f["final"], "tmp"))
     for name in record["removals"]:
         backup = _names(folder, record, name, "bak")
-        if _lexists(backup) and not _lexists(folder / name):
+        if os.path.lexists(backup) and not os.path.lexists(folder / name):
             with contextlib.suppress(OSError):
                 os.rename(backup, folder / name)
 
