@@ -7,6 +7,8 @@ import time
 from pathlib import Path
 
 from . import __version__
+from .archive import Archive
+from .archiving import prepare_entry
 from .checks import StabilityError, after_run, before_run
 from .engine.summary import summarize
 from .models import apply_model
@@ -67,8 +69,6 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
         check_output(sidecar, options.force, inputs=inputs, suffixes=(".parquet", ".csv"),
                      force_word=options.force_word)
     if options.archive is not None:
-        from .archive import Archive
-
         Archive(options.archive.root, create=True, dry_run=True)  # a foreign folder: now
     warn(shot.warnings)
     crit, findings = before_run(model_shot.params, options.integrator)
@@ -110,8 +110,6 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
                     pub.remove(stale)
         pending = None
         if options.archive is not None:
-            from .archiving import prepare_entry
-
             archive = Archive(options.archive.root, create=True)  # created once the run is done
             pending = prepare_entry(archive, options.archive, shot, workbook, filled, options,
                                     time.perf_counter() - started)
