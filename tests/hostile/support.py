@@ -10,9 +10,10 @@ import zipfile
 from pathlib import Path
 
 from airgun_xl.cli import main
+from airgun_xl.limits import READ_BUDGET_BYTES
 
 #: A command reading any input under 50 MB stays under this resident size (issue 9).
-MEMORY_CAP = 500 * 2**20
+MEMORY_CAP = READ_BUDGET_BYTES
 
 
 def snapshot(*folders):

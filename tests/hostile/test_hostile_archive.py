@@ -5,7 +5,7 @@ import sqlite3
 
 import builders as b
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from support import refused
 
@@ -127,9 +127,12 @@ def test_empty_and_odd_entry_names(tmp_path, capsys, archive):
             naming=["no such entry"])
 
 
-@settings(max_examples=30, deadline=None,
+@settings(max_examples=30, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(name=st.text(min_size=0, max_size=300))
+@example(name="-:")  # a name that starts with '-'
+@example(name="")  # no name: the file's
+@example(name="../../etc/passwd")
 def test_any_shot_name_stays_inside_the_archive(tmp_path, name):
     """Whatever --name holds, the entry is one folder down inside DIR, named safely."""
     safe = safe_name(name)
@@ -137,7 +140,7 @@ def test_any_shot_name_stays_inside_the_archive(tmp_path, name):
     assert len(safe) <= 100 and not safe.lower().startswith("index.sqlite")
     root = tmp_path / "names"
     argv = ["fill", str(SHOT), "-o", str(tmp_path / "o.xlsx"), "--force", "--only", "summary",
-            "--archive", str(root), "--name", name]
+            "--archive", str(root), f"--name={name}"]  # '=': a name may start with '-'
     assert main(argv) == 0
     expected = safe if name else "shot_a"  # no name: the input file's
     entry = max(Archive(root).entries(shot=expected), key=lambda e: e.version)

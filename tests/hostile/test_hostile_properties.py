@@ -1,11 +1,12 @@
 """Property tests: whatever a parameter cell holds (any text, number, error text or formula),
 ``fill`` either runs or refuses with one line; text copied from the sheet stays text."""
 import math
+from collections import Counter
 
 import builders as b
 import openpyxl
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from support import formulas_in
 
@@ -37,9 +38,12 @@ def short_template(tmp_path_factory):
     return path
 
 
-@settings(max_examples=80, deadline=None,
+# derandomize: CI sees the same 80 examples every run; @example keeps cases found before
+@settings(max_examples=80, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(cell=st.sampled_from([c.address for c in CELLS]), content=CONTENT, label=TEXT)
+@example(cell="A2", content=1.0, label="=E10")  # a label inside a real formula's text
+@example(cell="A2", content=1, label="")  # NaN figures: the error literal #NUM!
 def test_any_cell_content_runs_or_is_one_line(tmp_path, capsys, short_template, cell, content,
                                               label):
     wb = openpyxl.load_workbook(short_template)
@@ -69,7 +73,11 @@ def test_any_cell_content_runs_or_is_one_line(tmp_path, capsys, short_template, 
         assert result["G30"].value == label and result["G30"].data_type == "s"
     if isinstance(content, str):  # text ran: it must have been a blank-like text, kept as text
         assert result[cell].data_type == "s" and result[cell].value == content
-    assert all(label.lstrip("=+-@") not in f for f in formulas_in(out) if len(label) > 3)
+    # every formula in the output is one of the input's real formulas (charts aside, and the
+    # error literals #NUM! and #DIV/0! that nan_inf_to_errors writes for NaN and inf)
+    written = Counter(f for f in formulas_in(out)
+                      if "$" not in f and f not in ("#NUM!", "#DIV/0!"))
+    assert not written - Counter(formulas_in(shot))
 
 
 def test_the_property_strategies_reach_both_outcomes(tmp_path, capsys, short_template):
