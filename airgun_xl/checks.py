@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 from .cells import BY_ADDRESS
 from .engine.legacy_law import CRUSH_FIT_RANGE, crush_factor
-from .engine.stability import WARN_RATIO, critical_time_step
+from .engine.stability import WARN_RATIO, critical_time_step, full_length
 from .errors import AirgunXlError
 
 #: Bird masses differing by this factor or more make a stiff, badly scaled system.
@@ -35,10 +35,12 @@ def _fmt(dt):
 
 
 def stability(p, integrator="legacy"):
-    """The critical step of the chosen scheme and its finding (None when comfortably stable).
+    """The critical steps of the chosen scheme and its finding (None when comfortably stable).
 
     Newmark is implicit in the OBR chain; only the mitigator's unloading stiffness, which it
-    treats explicitly, bounds its step.
+    treats explicitly, bounds its step. Two tiers (:mod:`airgun_xl.engine.stability`): an
+    error above the step stable at the mitigator's full length; a warning, with the crush
+    past which the step is unstable, between that and the fully compacted one.
     """
     crit = critical_time_step(p, chain=integrator == "legacy")
     safe = f"the largest safe time step is {_fmt(crit.dt_crit)}"
@@ -46,11 +48,34 @@ def stability(p, integrator="legacy"):
         return crit, Finding("error", "E2", f"{_fmt(p.delta)} is {crit.ratio:.3g} x the "
                                             f"critical time step of the {integrator} scheme, "
                                             f"set by {crit.limiting}; {safe}")
+    if crit.unstable_crush is not None:
+        return crit, Finding("warning", "E2", unstable_crush_message(p, crit, integrator)
+                             + "; the run stops if it crushes that far")
     if crit.ratio > WARN_RATIO:
         return crit, Finding("warning", "E2", f"{_fmt(p.delta)} is {crit.ratio:.2f} x the "
                                               f"critical time step ({_fmt(crit.dt_crit)}) of "
                                               f"the {integrator} scheme: close to unstable")
     return crit, None
+
+
+def unstable_crush_message(p, crit, integrator="legacy"):
+    """The second tier in words: how far the shot may crush before its step is unstable."""
+    return (f"{_fmt(p.delta)} is stable for the {integrator} scheme until the mitigator is "
+            f"crushed by {crit.unstable_crush:.4g} m (remaining length "
+            f"{crit.unstable_length:.4g} m of E16 + E19 = {full_length(p):.4g} m): shorter, "
+            "its unloading stiffness needs a step below "
+            f"{_fmt(crit.dt_compacted)} (fully compacted)")
+
+
+def crush_reached(result, crit, integrator="legacy"):
+    """The error for a run whose largest crush passed the second tier's limit, or None."""
+    stats = result.history.stats
+    if crit.unstable_crush is None or stats is None or not (
+            stats.max_crush > crit.unstable_crush):
+        return None
+    return Finding("error", "E2", unstable_crush_message(result.params, crit, integrator)
+                   + f"; the run crushed it by {stats.max_crush:.4g} m, where the step is "
+                   "unstable and its numbers are not to be trusted")
 
 
 def impact_speed_finding(p):

@@ -9,7 +9,9 @@ from pathlib import Path
 from . import __version__
 from .archive import Archive
 from .archiving import prepare_entry
-from .checks import StabilityError, after_run, before_run
+from .checks import (StabilityError, after_run, before_run, crush_reached,
+                     unstable_crush_message)
+from .engine.integrators import DivergenceError
 from .engine.summary import summarize
 from .models import apply_model
 from .transaction import Publication, check_output
@@ -77,9 +79,21 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
         raise StabilityError(f"{error}; expected a smaller E2, --integrator newmark, or "
                              "--allow-unstable")
     warn(str(f) for f in findings if f.level != "note")
-    result = model_shot.run(integrator=options.integrator, host=options.host,
-                            track=outputs.tracked_series(sidecar is not None
-                                                         or options.track_all))
+    try:
+        result = model_shot.run(integrator=options.integrator, host=options.host,
+                                track=outputs.tracked_series(sidecar is not None
+                                                             or options.track_all))
+    except DivergenceError as error:
+        if crit.unstable_crush is None:
+            raise
+        limit = unstable_crush_message(model_shot.params, crit, options.integrator)
+        raise StabilityError(f"E2 (Timestep): {limit}; the run crushed past that and "
+                             f"{error}") from None
+    reached = crush_reached(result, crit, options.integrator)
+    if reached is not None and not options.allow_unstable:
+        raise StabilityError(f"{reached}; expected a smaller E2, --integrator newmark, or "
+                             "--allow-unstable")
+    warn([str(reached)] if reached is not None else [])
     warn(result.warnings[len(shot.warnings):])
     warn(str(f) for f in after_run(result))
     compared = None

@@ -1,6 +1,7 @@
 """``airgun-xl check SHOT.xlsx``: can this shot's run be trusted? (No run, no output.)"""
 from ..checks import before_run
 from ..engine.integrators import INTEGRATORS
+from ..engine.stability import compacted_length, full_length
 from ..shot import Shot
 
 
@@ -20,9 +21,15 @@ def run(args):
     p = shot.params
     crit, findings = before_run(p, args.integrator)
     print(f"{args.shot}: {p.model}, {args.integrator} integrator")
-    print(f"  time step E2 = {p.delta:.4g} s, critical {crit.dt_crit:.4g} s, ratio "
-          f"{crit.ratio:.3g}: {crit.verdict}")
+    print(f"  time step E2 = {p.delta:.4g} s, critical {crit.dt_crit:.4g} s from the first "
+          f"step (mitigator at full length {full_length(p):.4g} m), ratio {crit.ratio:.3g}: "
+          f"{crit.verdict}")
     print(f"  set by {crit.limiting}")
+    print(f"  critical {crit.dt_compacted:.4g} s once fully compacted (length "
+          f"{compacted_length(p):.4g} m, E37 = {p.ec:g})")
+    if crit.unstable_crush is not None:
+        print(f"  unstable once crushed by {crit.unstable_crush:.4g} m (length below "
+              f"{crit.unstable_length:.4g} m): the run stops if it gets there")
     for message in shot.warnings:
         print(f"  warning: {message}")
     for f in findings:

@@ -47,6 +47,7 @@ class DivergenceError(AirgunXlError):
             f"{names[worst]} = {values[worst]:.3g} m, beyond the {displacement_bound(p):.3g} m "
             "no physical run reaches; expected a smaller E2 (Timestep) or --integrator newmark")
         self.row, self.time = row, time_at
+        self.values = dict(zip(names, values))  # the displacements at that row [m]
 
 
 @dataclass

@@ -1,4 +1,4 @@
-"""Critical time step of the legacy scheme, predicted before a run.
+"""Critical time step of the legacy scheme, predicted before a run, in two tiers.
 
 ArtSim's update, for the linear part of the model, is
 
@@ -17,11 +17,20 @@ dampers it is (2 sqrt(1 + zeta^2) - 2 zeta)/omega.
 The matrices are the model's:
 - the OBR chain's springs k2, k3 and dampers c2, c3 (from the initial masses, as the macro
   computes them once);
-- the elastic unloading stiffness A E / L between MEM and front plate, at its stiffest, when
-  the remaining length L is the mitigator fully compacted, (E16 + E19)(1 - E37);
+- the elastic unloading stiffness A E / L between MEM and front plate, where L is the
+  mitigator's remaining length, E16 + E19 less the crush so far (the macro's ``L``);
 - the masses over the range the run passes through: m31 grows from B2 as crushed honeycomb
   joins it (at most E25 more), M1 shrinks by as much. The smallest critical step over that
   range is the prediction.
+
+The unloading stiffness grows as the mitigator is crushed, so there are two tiers:
+- ``dt_first``: the critical step at the full length E16 + E19. Above it the run is unstable
+  whatever it crushes (the chain, or the first unloading): refuse.
+- ``dt_compacted``: the critical step at the fully compacted length (E16 + E19)(1 - E37),
+  which no run goes past. Below it the run is stable throughout.
+Between the two, the step becomes unstable only once the crush passes
+``unstable_crush`` (remaining length ``unstable_length``): the run may go ahead and is
+stopped if its largest crush gets there.
 """
 import math
 from dataclasses import dataclass
@@ -38,37 +47,65 @@ WARN_RATIO = 0.5
 
 @dataclass(frozen=True)
 class CriticalStep:
-    """The prediction for a shot.
+    """The two-tier prediction for a shot.
 
     Attributes
     ----------
     dt_crit : float
-        Largest stable time step of the legacy scheme [s].
+        Largest step stable from the first step, the mitigator at its full length
+        E16 + E19 [s]. Above it the run is refused.
     ratio : float
         The shot's dt / dt_crit.
     limiting : str
-        What sets it, in words (the stiffest mode's frequency and the cells behind it).
+        What sets ``dt_crit``, in words (the stiffest mode's frequency and the cells behind
+        it).
+    dt_compacted : float
+        Largest step stable with the mitigator fully compacted, (E16 + E19)(1 - E37) [s]:
+        at or below it, stable throughout.
+    unstable_length : float or None
+        Remaining mitigator length [m] below which the shot's step is unstable; None when it
+        is stable at every length (or unstable from the first step).
+    unstable_crush : float or None
+        The crush [m] that leaves ``unstable_length``: E16 + E19 - unstable_length.
     """
 
     dt_crit: float
     ratio: float
     limiting: str
+    dt_compacted: float = None
+    unstable_length: float = None
+    unstable_crush: float = None
 
     @property
     def verdict(self):
+        """"unstable", "unstable past a crush", "marginal" or "stable"."""
         if self.ratio > 1:
             return "unstable"
+        if self.unstable_crush is not None:
+            return "unstable past a crush"
         return "marginal" if self.ratio > WARN_RATIO else "stable"
 
 
-def _matrices(p, m31, m1, chain=True):
-    """M, C, K of the 4-DOF linear model (MEM, m31, m32, m33) with unloading stiffness; with
-    ``chain=False``, without the OBR springs and dampers (what Newmark treats explicitly)."""
+def full_length(p):
+    """The mitigator's length before the shot, E16 + E19 [m]."""
+    return p.hcone + p.hcylinder
+
+
+def compacted_length(p):
+    """The mitigator's length fully compacted, (E16 + E19)(1 - E37) [m]; the wedge E16 when
+    that is 0 (E37 = 1)."""
+    return full_length(p) * (1 - p.ec) or p.hcone or full_length(p)
+
+
+def _matrices(p, m31, m1, chain=True, length=None):
+    """M, C, K of the 4-DOF linear model (MEM, m31, m32, m33) with the unloading stiffness
+    A E / ``length`` (fully compacted when None); with ``chain=False``, without the OBR
+    springs and dampers (what Newmark treats explicitly)."""
     kk2, kk3 = (-p.k2, -p.k3) if chain else (0.0, 0.0)
     c2 = 2 * p.zeta * math.sqrt(kk2 * (p.m31 + p.m32))
     c3 = 2 * p.zeta * math.sqrt(kk3 * (p.m32 + p.m33))
     area = math.pi * p.rcone ** 2
-    k_mit = area * p.E / ((p.hcone + p.hcylinder) * (1 - p.ec) or p.hcone)
+    k_mit = area * p.E / (compacted_length(p) if length is None else length)
     masses = [m1, m31, p.m32 or 1.0, p.m33 or 1.0]  # a left-out mass: its stand-in
     K = np.zeros((4, 4))
     C = np.zeros((4, 4))
@@ -89,25 +126,69 @@ def spectral_radius(dt, M, C, K):
     return float(np.max(np.abs(np.linalg.eigvals(G))))
 
 
+def _stable(dt, M, C, K):
+    return spectral_radius(dt, M, C, K) <= 1 + RADIUS_TOLERANCE
+
+
 def _critical(M, C, K):
     if not (np.isfinite(M).all() and np.isfinite(C).all() and np.isfinite(K).all()):
         return 0.0, math.inf  # the inputs overflow: no step is stable
     omega_max = math.sqrt(max(np.max(np.real(np.linalg.eigvals(np.linalg.solve(M, K)))),
                               1e-300))
     lo, hi = 0.0, 4.0 / omega_max  # the damped bound is below 2/omega, so hi is unstable
-    while spectral_radius(hi, M, C, K) <= 1 + RADIUS_TOLERANCE:
+    while _stable(hi, M, C, K):
         hi *= 2
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        if spectral_radius(mid, M, C, K) <= 1 + RADIUS_TOLERANCE:
+        if _stable(mid, M, C, K):
             lo = mid
         else:
             hi = mid
     return lo, omega_max
 
 
+def _mass_range(p, samples):
+    """(m31, M1) pairs over the range the run passes through."""
+    for m31 in np.linspace(p.m31, p.m31 + p.mmitigator, samples):
+        m1 = p.m1 + p.mmitigator - (m31 - p.m31)
+        yield float(m31), max(float(m1), 1e-9)
+
+
+def _worst(p, samples, chain, length):
+    """(dt_crit, omega, m31) at the mass where the step is smallest, for one length."""
+    best = None
+    for m31, m1 in _mass_range(p, samples):
+        dt, omega = _critical(*_matrices(p, m31, m1, chain, length))
+        if best is None or dt < best[0]:
+            best = (dt, omega, m31)
+    return best
+
+
+def _stable_at(p, dt, length, samples, chain):
+    return all(_stable(dt, *_matrices(p, m31, m1, chain, length))
+               for m31, m1 in _mass_range(p, samples))
+
+
+def unstable_length(p, dt, samples=5, chain=True):
+    """The remaining mitigator length [m] below which ``dt`` is unstable.
+
+    Bisection between the compacted and the full length (the unloading stiffness A E / L, and
+    so the stiffest mode, grows as L shrinks). Returns None when ``dt`` is stable at the
+    compacted length, and the full length when it is unstable from the start.
+    """
+    lo, hi = compacted_length(p), full_length(p)
+    if _stable_at(p, dt, lo, samples, chain):
+        return None
+    if not _stable_at(p, dt, hi, samples, chain):
+        return hi
+    for _ in range(50):  # 2^-50 of the length: far below any digit printed
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if _stable_at(p, dt, mid, samples, chain) else (mid, hi)
+    return hi
+
+
 def critical_time_step(p, samples=5, chain=True):
-    """Predict the legacy scheme's critical time step for a shot.
+    """Predict the legacy scheme's critical time steps for a shot (both tiers).
 
     Parameters
     ----------
@@ -121,20 +202,17 @@ def critical_time_step(p, samples=5, chain=True):
     -------
     CriticalStep
     """
-    best = None
-    for m31 in np.linspace(p.m31, p.m31 + p.mmitigator, samples):
-        m1 = p.m1 + p.mmitigator - (m31 - p.m31)
-        M, C, K = _matrices(p, float(m31), max(float(m1), 1e-9), chain)
-        dt, omega = _critical(M, C, K)
-        if best is None or dt < best[0]:
-            best = (dt, omega, float(m31))
-    dt, omega, m31 = best
+    dt, omega, m31 = _worst(p, samples, chain, full_length(p))
+    dt_compacted = _worst(p, samples, chain, compacted_length(p))[0]
     f = omega / (2 * math.pi)
     if chain:
         limiting = (f"the stiffest mode, {f:,.0f} Hz (springs B6, C6, masses B2..D2, and the "
-                    f"unloading stiffness from E13, E31, E16, E19, E37), with m31 = "
-                    f"{m31:.4g} kg")
+                    f"unloading stiffness from E13, E31, E16, E19), with m31 = {m31:.4g} kg")
     else:
-        limiting = (f"the mitigator's unloading stiffness (E13, E31, E16, E19, E37), "
+        limiting = (f"the mitigator's unloading stiffness (E13, E31, E16, E19), "
                     f"{f:,.0f} Hz with m31 = {m31:.4g} kg")
-    return CriticalStep(dt, p.delta / dt, limiting)
+    length = crush = None
+    if dt_compacted < p.delta <= dt:
+        length = unstable_length(p, p.delta, samples, chain)
+        crush = full_length(p) - length
+    return CriticalStep(dt, p.delta / dt, limiting, dt_compacted, length, crush)
