@@ -9,8 +9,7 @@ from pathlib import Path
 from . import __version__
 from .archive import Archive
 from .archiving import prepare_entry
-from .checks import (StabilityError, after_run, before_run, crush_reached,
-                     unstable_crush_message)
+from .checks import StabilityError, after_run, before_run, crush_reached, unstable_crush_message
 from .engine.integrators import DivergenceError
 from .engine.summary import summarize
 from .models import apply_model

@@ -8,18 +8,25 @@ import json
 
 import numpy as np
 import pytest
-from conftest import CASES, LEGACY_RTOL, MACRO_COLUMNS, REFERENCE, column, relative_error, \
-    sheet_values
+from conftest import (
+    CASES,
+    LEGACY_RTOL,
+    MACRO_COLUMNS,
+    REFERENCE,
+    column,
+    relative_error,
+    sheet_values,
+)
 
 import airgun_xl
 from airgun_xl.cli import main
 from airgun_xl.engine.integrators import DivergenceError, displacement_bound
 from airgun_xl.engine.stability import (
+    _matrices,
     compacted_length,
     critical_time_step,
     full_length,
     spectral_radius,
-    _matrices,
 )
 
 UNSTABLE = json.loads((REFERENCE / "unstable_cases.json").read_text())
