@@ -70,8 +70,16 @@ def _cell_args(args):
     return args
 
 
+#: Number format of a boolean cell: LibreOffice shows an .xlsx boolean as 1 or 0 without it;
+#: Excel shows TRUE/FALSE either way.
+BOOLEAN_FORMAT = '"TRUE";"TRUE";"FALSE"'
+
+
 class SafeWorksheet(Worksheet):
-    """A worksheet whose strings are always text: see the module docstring."""
+    """A worksheet whose strings are always text: see the module docstring. Booleans read
+    TRUE/FALSE in LibreOffice too (``boolean_format``, set by the workbook)."""
+
+    boolean_format = None
 
     def write_string(self, *args):
         row, col, string, *rest = _cell_args(args)
@@ -87,3 +95,6 @@ class SafeWorksheet(Worksheet):
     # rather than write_string(); cleaning text twice is harmless.
     def _write_string(self, row, col, string, cell_format=None):
         return super()._write_string(row, col, cell_text(string), cell_format)
+
+    def _write_boolean(self, row, col, boolean, cell_format=None):
+        return super()._write_boolean(row, col, boolean, cell_format or self.boolean_format)

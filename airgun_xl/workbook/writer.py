@@ -37,7 +37,13 @@ from ..outputs import SHEET_NAME, Outputs
 from ..transaction import atomic_path, check_output, display
 from .columns_sheet import ColumnsWorksheet, fast_deflate
 from .formula_eval import Evaluator, FormulaFailure
-from .safe_text import WORKBOOK_OPTIONS, SafeWorksheet, copyable_formula, sheet_title
+from .safe_text import (
+    BOOLEAN_FORMAT,
+    WORKBOOK_OPTIONS,
+    SafeWorksheet,
+    copyable_formula,
+    sheet_title,
+)
 from .sheets import (
     Ref,
     write_chart_data,
@@ -68,6 +74,13 @@ HEADERS = {
 
 class _Workbook(xlsxwriter.Workbook):
     worksheet_class = SafeWorksheet  # every sheet's strings are text (safe_text)
+
+    def add_worksheet(self, name=None, worksheet_class=None):
+        ws = super().add_worksheet(name, worksheet_class)
+        if getattr(self, "_boolean_format", None) is None:
+            self._boolean_format = self.add_format({"num_format": BOOLEAN_FORMAT})
+        ws.boolean_format = self._boolean_format
+        return ws
 
 
 def new_workbook(path):
