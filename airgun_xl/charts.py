@@ -10,7 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .engine.summary import KG, SPECTRUM_MAX_HZ
+from .engine.summary import KG, PEAK_MIN_HZ, SPECTRUM_MAX_HZ
+from .workbook.page_setup import one_page
 
 #: Most points a chart series references; spreadsheet apps slow down well before 100,000.
 POINT_BUDGET = 20_000
@@ -27,6 +28,8 @@ class Series:
     key: str
     name: str
     markers: bool = False
+    y2: bool = False  # on the secondary (right) axis
+    dash: bool = False  # dashed, drawn over the others (a comparison or a mark)
 
 
 @dataclass(frozen=True)
@@ -37,15 +40,24 @@ class ChartSpec:
     y_title: str
     series: tuple
     x_range: tuple = None  # (min, max); None: the run's time span
+    y2_title: str = None
 
+
+#: Lowest frequency the spectrum chart shows: below it the pulse's own content (4.2 kG at 0 Hz
+#: for shot A) would swamp the OBR modes that Figs. 14-15 show.
+SPECTRUM_MIN_HZ = PEAK_MIN_HZ
 
 CHARTS = (
     ChartSpec("accel", "Test-item acceleration (Fig. 12)", "Time (s)", "Acceleration (kG's)",
               (Series("accel_kg", "Acceleration"),
                Series("filtered_kg", "Filtered samples", markers=True),
-               Series("compared_kg", "Other model (--compare-models)"))),
-    ChartSpec("spectrum", "FFT of the test-item acceleration (Figs. 14-15)", "Frequency (Hz)",
-              "Amplitude (kG)", (Series("spectrum", "Amplitude"),), (0.0, SPECTRUM_MAX_HZ)),
+               Series("compared_kg", "Other model (--compare-models)", dash=True))),
+    ChartSpec("spectrum", "FFT of the test-item acceleration (Figs. 14-15), from "
+              f"{SPECTRUM_MIN_HZ / 1000:g} kHz", "Frequency (Hz)", "Amplitude (kG)",
+              (Series("spectrum", "Amplitude"),
+               Series("natural", "OBR chain natural frequencies (initial masses)",
+                      dash=True)),
+              (SPECTRUM_MIN_HZ, SPECTRUM_MAX_HZ)),
     ChartSpec("force", "Mitigator force (Fig. 16)", "Time (s)", "Force (N)",
               (Series("force", "Mitigator force"),)),
     ChartSpec("crush", "Mitigator deflection and plastic wave front (Fig. 17)", "Time (s)",
@@ -53,14 +65,30 @@ CHARTS = (
                                  Series("x_plastic", "Plastic wave front"))),
     ChartSpec("velocity", "OBR velocity (Fig. 19)", "Time (s)", "Velocity (m/s)",
               (Series("v31", "OBR front plate"), Series("v1", "MEM"))),
-    ChartSpec("displacements", "Displacements", "Time (s)", "Displacement (m)",
+    ChartSpec("displacements", "Displacements; Y32, Y33 relative to Y31 (right axis)",
+              "Time (s)", "Displacement (m)",
               (Series("y1", "Y1 (MEM)"), Series("y31", "Y31 (OBR Front Plate)"),
-               Series("y32", "Y32 (OBR Back Plate)"), Series("y33", "Y33 (Test Item)"))),
+               Series("y32_rel", "Y32 - Y31 (mm)", y2=True),
+               Series("y33_rel", "Y33 - Y31 (mm)", y2=True)),
+              y2_title="Relative to Y31 (mm)"),
 )
 
 
-def series_data(result, spectrum, compared=None):
-    """Full-resolution ``(x, y)`` arrays of every chart series key."""
+def natural_marks(frequencies, top):
+    """(x, y) of vertical marks from 0 to ``top`` at each frequency, NaN between them (empty
+    cells: the chart's line breaks there)."""
+    x, y = [], []
+    for f in frequencies:
+        x += [f, f, np.nan]
+        y += [0.0, top, np.nan]
+    return np.array(x[:-1], dtype=float), np.array(y[:-1], dtype=float)
+
+
+def series_data(result, spectrum, compared=None, natural=()):
+    """Full-resolution ``(x, y)`` arrays of every chart series key.
+
+    ``natural`` are the OBR chain's natural frequencies [Hz], marked on the spectrum chart.
+    """
     h = result.history
     t = h.time
     f_rows = result.filtered.rows[result.filtered.rows < len(t)]
@@ -69,8 +97,13 @@ def series_data(result, spectrum, compared=None):
         "accel_kg": (t, result.accel_kg),
         "filtered_kg": (t[f_rows], f_vals / KG),
         "spectrum": (spectrum.frequency, spectrum.amplitude),
-        "y1": (t, h.y1), "y31": (t, h.y31), "y32": (t, h.y32), "y33": (t, h.y33),
+        "y1": (t, h.y1), "y31": (t, h.y31),
+        "y32_rel": (t, (h.y32 - h.y31) * 1e3), "y33_rel": (t, (h.y33 - h.y31) * 1e3),
     }
+    shown = (spectrum.frequency >= SPECTRUM_MIN_HZ) & (spectrum.frequency <= SPECTRUM_MAX_HZ)
+    marks = [f for f in natural if SPECTRUM_MIN_HZ <= f <= SPECTRUM_MAX_HZ]
+    if marks and shown.any():
+        data["natural"] = natural_marks(marks, float(np.max(spectrum.amplitude[shown])))
     if compared is not None:
         data["compared_kg"] = (compared.history.time, compared.accel_kg)
     for key in ("force", "deflection", "x_plastic", "v31", "v1"):
@@ -96,11 +129,30 @@ def nice_range(values, include_zero=False):
         if span / (factor * step) <= 8:
             step *= factor
             break
-    return math.floor(lo / step) * step, math.ceil(hi / step) * step
+    # 12 digits drop the binary noise of k * step (0.6000000000000001 -> 0.6)
+    return (float(f"{math.floor(lo / step) * step:.12g}"),
+            float(f"{math.ceil(hi / step) * step:.12g}"))
+
+
+def _axis(title, lo, hi, gridlines=True):
+    return {"name": title, "min": lo, "max": hi,
+            "major_gridlines": {"visible": gridlines, "line": {"color": "#d9d9d9"}},
+            "num_format": "0.0E+0" if max(abs(lo), abs(hi)) >= 1e5 else "General"}
+
+
+def _in_range(x, y, x_range):
+    """The y values whose x lies in ``x_range`` (all of them for None)."""
+    if x_range is None:
+        return y
+    return y[(x >= x_range[0]) & (x <= x_range[1])]
+
+
+#: Charts on the Charts sheet: two a row, each this many rows tall.
+CHART_ROWS, CHART_COLS = 19, 10
 
 
 def add_charts(workbook, sheet, refs, data, max_time, labels=None):
-    """Insert the charts on ``sheet``, two a row.
+    """Insert the charts on ``sheet``, two a row; the sheet prints as one landscape page.
 
     Parameters
     ----------
@@ -114,10 +166,13 @@ def add_charts(workbook, sheet, refs, data, max_time, labels=None):
         End of the time axis [s].
     labels : dict, optional
         Series key -> legend name, overriding the chart's own.
+
+    Returns
+    -------
+    int
+        Charts placed.
     """
     sheet.write_string(0, 0, "Charts of this shot; the figure numbers are those of ARL-TR-3559.")
-    sheet.set_landscape()
-    sheet.fit_to_pages(1, 0)  # printed (and rendered to PDF) one page wide
     placed = 0
     for spec in CHARTS:
         present = [s for s in spec.series if s.key in refs]
@@ -125,17 +180,20 @@ def add_charts(workbook, sheet, refs, data, max_time, labels=None):
             continue
         chart = workbook.add_chart(LINE)
         decimated = []
-        for i, s in enumerate(present):
+        # dashed series (a comparison, marks) last, so they are drawn over the others
+        for i, s in enumerate(sorted(present, key=lambda s: s.dash)):
             ref = refs[s.key]
             name = (labels or {}).get(s.key, s.name)
-            options = {"name": name, "categories": ref.x_range(), "values": ref.y_range()}
+            options = {"name": name, "categories": ref.x_range(), "values": ref.y_range(),
+                       "y2_axis": s.y2}
             color = COLORS[i % len(COLORS)]
             if s.markers:
                 options["marker"] = {"type": "circle", "size": 5,
                                      "border": {"color": color}, "fill": {"color": color}}
                 options["line"] = {"none": True}
             else:
-                options["line"] = {"color": color, "width": 1.25}
+                options["line"] = {"color": color, "width": 2.0 if s.dash else 1.25,
+                                   "dash_type": "dash" if s.dash else "solid"}
                 options["marker"] = {"type": "none"}
             chart.add_series(options)
             if ref.points < ref.total:
@@ -144,19 +202,23 @@ def add_charts(workbook, sheet, refs, data, max_time, labels=None):
         if decimated:
             title += f"\n(decimated to {decimated[0]}, peaks kept)"
         chart.set_title({"name": title, "name_font": {"size": 11}})
-        ys = np.concatenate([data[s.key][1] for s in present])
         xlo, xhi = spec.x_range or (0.0, max_time)
-        ylo, yhi = nice_range(ys, include_zero=True)
-        chart.set_x_axis({"name": spec.x_title, "min": xlo, "max": xhi,
-                          "major_gridlines": {"visible": True, "line": {"color": "#d9d9d9"}},
-                          "num_format": "General"})
-        chart.set_y_axis({"name": spec.y_title, "min": ylo, "max": yhi,
-                          "major_gridlines": {"visible": True, "line": {"color": "#d9d9d9"}},
-                          "num_format": "0.0E+0" if max(abs(ylo), abs(yhi)) >= 1e5
-                          else "General"})
+        chart.set_x_axis(_axis(spec.x_title, xlo, xhi))
+        for secondary in (False, True):
+            on_axis = [s for s in present if s.y2 == secondary]
+            if not on_axis:
+                continue
+            ys = np.concatenate([_in_range(*data[s.key], spec.x_range) for s in on_axis])
+            ylo, yhi = nice_range(ys, include_zero=True)
+            if secondary:
+                chart.set_y2_axis(_axis(spec.y2_title, ylo, yhi, gridlines=False))
+            else:
+                chart.set_y_axis(_axis(spec.y_title, ylo, yhi))
         chart.set_legend({"position": "bottom"} if len(present) > 1 else {"none": True})
         chart.set_size({"width": 640, "height": 360})
-        row, col = 2 + (placed // 2) * 19, (placed % 2) * 10
+        row, col = 2 + (placed // 2) * CHART_ROWS, (placed % 2) * CHART_COLS
         sheet.insert_chart(row, col, chart)
         placed += 1
+    last_row = 2 + -(-placed // 2) * CHART_ROWS
+    one_page(sheet, last_row, 2 * CHART_COLS - 1)
     return placed

@@ -105,7 +105,8 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
     needs_summary = outputs.groups & {"summary", "spectrum", "charts"}
     summary = summarize(result) if needs_summary else None
     info = {"version": __version__, "command": " ".join(options.command),
-            "dt_crit": crit.dt_crit, "dt_ratio": crit.ratio, "compared": compared}
+            "dt_crit": crit.dt_crit, "dt_compacted": crit.dt_compacted,
+            "dt_ratio": crit.ratio, "compared": compared}
     if shot.source is not None:
         info.update(input=str(shot.source.path), sha256=shot.source.sha256)
     if not options.reproducible:

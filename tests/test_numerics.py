@@ -179,7 +179,7 @@ def test_newmark_is_stated_in_the_summary(tmp_path):
     ws = openpyxl.load_workbook(out)["Summary"]
     rows = {r[0].value: r[1].value for r in ws.iter_rows(min_row=2)}
     assert rows["Integrator"] == "newmark"
-    assert rows["Critical time step"] > 1e-4  # only the mitigator bounds Newmark
+    assert rows["Critical time step"] > 100  # µs: only the mitigator bounds Newmark
 
 
 def test_damped_relative_motion_against_the_closed_form():

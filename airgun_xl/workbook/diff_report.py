@@ -2,9 +2,11 @@
 curves with their difference."""
 import numpy as np
 
+from ..charts import nice_range
 from ..engine.decimate import minmax_indices
 from ..transaction import atomic_path, check_output
 from .columns_sheet import ColumnsWorksheet
+from .page_setup import one_page
 from .sheets import write_number_columns
 from .writer import close_workbook, new_workbook
 
@@ -33,7 +35,7 @@ def write_diff_report(report, path, force=False):
         ws.write_row(row, 0, headers, bold)
         ws.set_column(0, 0, 12)
         ws.set_column(1, 1, 28)
-        ws.set_column(2, 10, 14)
+        ws.set_column(2, 10, 18)  # wide enough for each header in print
         for c in report.columns:
             row += 1
             ws.write_row(row, 0, [c.column, c.header, c.rows_legacy, c.rows_new])
@@ -51,6 +53,7 @@ def write_diff_report(report, path, force=False):
                 row += 2
                 ws.write_string(row, 0, label, bold)
                 ws.write_string(row, 1, "; ".join(names))
+        one_page(ws, row, len(headers) - 1)
         if report.worst is not None:
             _write_worst(wb, *report.worst)
         close_workbook(wb, path)
@@ -72,18 +75,19 @@ def _write_worst(wb, name, time, x, y):
                       "line": {"color": "#548235", "dash_type": "dash"},
                       "categories": ["Worst column", 1, 0, n, 0],
                       "values": ["Worst column", 1, 3, n, 3]})
-    lo, hi = float(np.nanmin(np.r_[x, y])), float(np.nanmax(np.r_[x, y]))
-    dlo, dhi = float(np.nanmin(diff)), float(np.nanmax(diff))
-    pad = (hi - lo) * 0.05 or 1.0
-    dpad = (dhi - dlo) * 0.05 or abs(dhi) * 0.05 or 1e-300
+    lo, hi = nice_range(np.r_[x, y])
+    dlo, dhi = nice_range(diff)
+    tlo, thi = nice_range(time)
     # Titles that hold a workbook's own header text point at its cell: xlsxwriter would read
     # a chart name such as "x!A1" or "=..." as a formula.
     ws.write_string(n + 2, 0, f"Worst column: {name}, both curves and their difference")
     chart.set_title({"name": ["Worst column", n + 2, 0]})
-    chart.set_x_axis({"name": "Time (s)", "min": float(time[0]), "max": float(time[-1])})
-    chart.set_y_axis({"name": ["Worst column", 0, 1], "min": lo - pad, "max": hi + pad})
-    chart.set_y2_axis({"name": "new - legacy", "min": dlo - dpad, "max": dhi + dpad,
+    chart.set_x_axis({"name": "Time (s)", "min": tlo, "max": thi})
+    chart.set_y_axis({"name": ["Worst column", 0, 1], "min": lo, "max": hi,
+                      "num_format": "0.00E+00"})
+    chart.set_y2_axis({"name": "new - legacy", "min": dlo, "max": dhi,
                        "num_format": "0.0E+00"})
     chart.set_legend({"position": "bottom"})
     chart.set_size({"width": 760, "height": 420})
     ws.insert_chart(1, 5, chart)
+    one_page(ws, 23, 17, first_col=5)  # the chart alone (21 rows by 12 default columns)

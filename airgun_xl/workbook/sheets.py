@@ -12,6 +12,7 @@ from ..charts import COPY_POINTS, POINT_BUDGET
 from ..engine.decimate import minmax_indices
 from ..engine.summary import PEAK_MIN_HZ, PULSE_FRACTION, SPECTRUM_MAX_HZ
 from ..errors import OutputError
+from .page_setup import not_printed, one_page
 
 
 @dataclass(frozen=True)
@@ -69,6 +70,7 @@ def write_tracked(wb, result, keep, sheet_class, name="Tracked"):
         if values is not None:
             columns[col] = values[keep]
     write_number_columns(ws, 1, columns)
+    not_printed(ws)
     full = len(keep) == result.rows
     refs = {}
     for col, (_, key) in enumerate(TRACKED_COLUMNS[1:], start=1):
@@ -85,27 +87,32 @@ def write_spectrum(wb, spectrum, sheet_class, name="Spectrum"):
     ws.write_string(0, 3, f"Single-sided amplitude spectrum 2|FFT|/N (numpy.fft.rfft) of the "
                           f"test-item acceleration in kG, 0-{SPECTRUM_MAX_HZ:,.0f} Hz")
     write_number_columns(ws, 1, {0: spectrum.frequency, 1: spectrum.amplitude})
+    not_printed(ws)
     n = len(spectrum.frequency)
     return {"spectrum": Ref(ws.get_name(), 0, 1, 1, n, n)} if n else {}
 
 
-def write_chart_data(wb, data, refs, sheet_class, name="ChartData"):
+def write_chart_data(wb, data, refs, sheet_class, name="ChartData", budget=POINT_BUDGET):
     """Copies on ChartData of the series that have no usable home; decimated past the budget.
 
-    Returns the refs of all chart series, homes and copies.
+    ``budget`` lowers the budget (the rows a ``--every N`` run keeps on its sheets): a longer
+    series is cut to that many points, the min and max of each bucket. Returns the refs of all
+    chart series, homes and copies.
     """
     ws = wb.add_worksheet(name, worksheet_class=sheet_class)
+    not_printed(ws)
+    limit = max(2, min(budget, POINT_BUDGET))
     ws.write_string(0, 0, f"Chart series not on another sheet at full resolution; a series "
-                          f"longer than {POINT_BUDGET:,} points is cut to {COPY_POINTS:,}, "
+                          f"longer than {limit:,} points is cut to {min(COPY_POINTS, limit):,}, "
                           "the min and max of each bucket of consecutive points.")
     out = {}
     col = 0
     for key, (x, y) in data.items():
         home = refs.get(key)
-        if home is not None and home.points <= POINT_BUDGET:
+        if home is not None and home.points <= limit:
             out[key] = home
             continue
-        index = minmax_indices(y, COPY_POINTS if len(y) > POINT_BUDGET else POINT_BUDGET)
+        index = minmax_indices(y, min(COPY_POINTS, limit) if len(y) > limit else limit)
         ws.write_string(1, col, f"{key} x")
         ws.write_string(1, col + 1, key)
         write_number_columns(ws, 2, {col: x[index], col + 1: y[index]})
@@ -114,7 +121,25 @@ def write_chart_data(wb, data, refs, sheet_class, name="ChartData"):
     return out
 
 
+#: How the Summary shows a quantity, by the unit code of its row: (shown unit, factor from SI,
+#: number format). Values are stored in the shown unit, so what a cell shows is what it holds.
+DISPLAY = {
+    "kG": ("kG", 1.0, "0.000"),
+    "s": ("ms", 1e3, "0.0000"),
+    "Hz": ("kHz", 1e-3, "0.00"),
+    "m": ("m", 1.0, "0.0000"),
+    "kg": ("kg", 1.0, "0.000"),
+    "m/s": ("m/s", 1.0, "0.00"),
+    "step": ("µs", 1e6, "0.000"),
+    "runtime": ("s", 1.0, "0.00"),
+    "ratio": ("", 1.0, "0.000"),
+    "count": ("", 1.0, "#,##0"),
+    "": ("", 1.0, None),
+}
+
+
 def _summary_rows(result, summary, timings):
+    """(label, value in SI, unit code of :data:`DISPLAY`, definition) per Summary row."""
     p = result.params
     s = summary
     rows = [
@@ -155,45 +180,57 @@ def _summary_rows(result, summary, timings):
         ("Model", p.model + (" - the rigid-body model" if result.model == "rigid" else ""),
          "", ""),
         ("Integrator", result.integrator, "", ""),
-        ("Time step", p.delta, "s", "E2"),
-        ("Critical time step", timings.get("dt_crit"), "s",
-         "largest stable time step of the integrator (airgun-xl check)"),
-        ("Time step / critical", timings.get("dt_ratio"), "", "above 1 the run diverges"),
-        ("Rows", result.rows, "", "time rows of the run"),
-        ("Rows on the sheets", timings.get("sheet_rows"), "", ""),
-        ("Every N-th row", timings.get("every"), "", "1: every row is on the sheets"),
+        ("Time step", p.delta, "step", "E2"),
+        ("Critical time step", timings.get("dt_crit"), "step",
+         "largest step stable from the first step, mitigator at full length (airgun-xl "
+         "check)"),
+        ("Critical time step, compacted", timings.get("dt_compacted"), "step",
+         "largest step stable with the mitigator fully compacted"),
+        ("Time step / critical", timings.get("dt_ratio"), "ratio", "above 1 the run diverges"),
+        ("Rows", result.rows, "count", "time rows of the run"),
+        ("Rows on the sheets", timings.get("sheet_rows"), "count", ""),
+        ("Every N-th row", timings.get("every"), "count", "1: every row is on the sheets"),
         ("Engine version", timings.get("version"), "", "airgun-xl"),
         ("Input file", timings.get("input"), "", ""),
         ("Input SHA-256", timings.get("sha256"), "", ""),
     ]
     if "kernel_seconds" in timings:
-        rows += [("Kernel run time", timings["kernel_seconds"], "s", "time stepping alone"),
-                 ("Run time", timings["run_seconds"], "s",
+        rows += [("Kernel run time", timings["kernel_seconds"], "runtime",
+                  "time stepping alone"),
+                 ("Run time", timings["run_seconds"], "runtime",
                   "reading, stepping and post-processing, before writing")]
     return rows
 
 
 def write_summary(wb, result, summary, timings, name="Summary"):
-    """The Summary sheet: one labelled cell per figure (label A, value B, unit C, note D)."""
+    """The Summary sheet: one labelled cell per figure (label A, value B in the unit of C, with
+    a number format fit for it, definition D); printed as one landscape page."""
     ws = wb.add_worksheet(name)
     ws.set_column(0, 0, 44)
-    ws.set_column(1, 1, 24)
-    ws.set_column(2, 2, 8)
-    ws.set_column(3, 3, 70)
+    ws.set_column(1, 1, 16)
+    ws.set_column(2, 2, 6)
+    ws.set_column(3, 3, 80)
     bold = wb.add_format({"bold": True})
-    for col, text in enumerate(("Quantity", "Value", "Unit", "Definition")):
-        ws.write_string(0, col, text, bold)
-    for row, (label, value, unit, note) in enumerate(_summary_rows(result, summary, timings), 1):
+    formats = {code: wb.add_format({"num_format": fmt, "align": "right"})
+               for code, (_, _, fmt) in DISPLAY.items() if fmt}
+    text = wb.add_format({"align": "left"})
+    for col, heading in enumerate(("Quantity", "Value", "Unit", "Definition")):
+        ws.write_string(0, col, heading, bold)
+    rows = _summary_rows(result, summary, timings)
+    for row, (label, value, code, note) in enumerate(rows, 1):
+        unit, factor, _ = DISPLAY[code]
         ws.write_string(row, 0, label)
         if isinstance(value, (float, int, np.floating, np.integer)) and not isinstance(value,
                                                                                          bool):
-            ws.write_number(row, 1, float(value))
+            ws.write_number(row, 1, float(value) * factor, formats.get(code))
         elif isinstance(value, datetime.datetime):
-            ws.write_string(row, 1, value.isoformat())
+            ws.write_string(row, 1, value.isoformat(), text)
         elif value is not None:
-            ws.write_string(row, 1, str(value))
+            ws.write_string(row, 1, str(value), text)
         if unit:
             ws.write_string(row, 2, unit)
         if note:
             ws.write_string(row, 3, note)
+    one_page(ws, len(rows), 3)
+    ws.freeze_panes(1, 0)
     return ws

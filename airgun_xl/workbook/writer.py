@@ -37,6 +37,7 @@ from ..outputs import SHEET_NAME, Outputs
 from ..transaction import atomic_path, check_output, display
 from .columns_sheet import ColumnsWorksheet, fast_deflate
 from .formula_eval import Evaluator, FormulaFailure
+from .page_setup import not_printed, one_page
 from .safe_text import (
     BOOLEAN_FORMAT,
     WORKBOOK_OPTIONS,
@@ -224,7 +225,7 @@ def _write_sheet1(wb, result, outputs, keep, stride, title):
     finals = None
     if "positions" in outputs:
         finals = (result.history.final_m1, result.history.final_m31)
-    warnings = []
+    warnings, block = [], {}
     if source is not None:
         block = {k: v for k, v in source.block.items() if k[1] <= PARAMETER_COLUMNS}
         values, warnings = _block_values(source, columns, rows, finals)
@@ -238,6 +239,10 @@ def _write_sheet1(wb, result, outputs, keep, stride, title):
     if "filtered" in outputs:
         for row, value in _filtered_cells(result, stride):
             ws.write_number(row, 27, value)
+    if block:
+        one_page(ws, max(r for r, _ in block) - 1, PARAMETER_COLUMNS - 1, landscape=False)
+    else:
+        not_printed(ws)  # no parameter block: only data
     refs = {}
     if rows == result.rows:
         title = ws.get_name()
@@ -331,14 +336,19 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
     if "spectrum" in outputs:
         refs.update(write_spectrum(wb, summary.spectrum, ColumnsWorksheet, names["Spectrum"]))
     if charts_ws is not None:
-        data = series_data(result, summary.spectrum, info.get("compared"))
-        placed = write_chart_data(wb, data, refs, ColumnsWorksheet, names["ChartData"])
         compared = info.get("compared")
-        labels = {"compared_kg": f"{compared.model} model"} if compared is not None else None
+        data = series_data(result, summary.spectrum, compared, summary.natural_initial)
+        placed = write_chart_data(wb, data, refs, ColumnsWorksheet, names["ChartData"],
+                                  budget=len(keep))  # --every N thins the copies too
+        labels = None
+        if compared is not None:
+            labels = {"compared_kg": f"Acceleration, {compared.model} model",
+                      "accel_kg": f"Acceleration, {result.model} model"}
         add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]), labels)
     if source is not None and source.outputs_block:
-        warnings += write_cells(wb.add_worksheet(names[SHEET_NAME],
-                                                 worksheet_class=ColumnsWorksheet),
-                                source.outputs_block)
+        outputs_ws = wb.add_worksheet(names[SHEET_NAME], worksheet_class=ColumnsWorksheet)
+        warnings += write_cells(outputs_ws, source.outputs_block)
+        one_page(outputs_ws, max(r for r, _ in source.outputs_block) - 1,
+                 max(c for _, c in source.outputs_block) - 1)
     close_workbook(wb, shown if shown is not None else tmp)
     return warnings

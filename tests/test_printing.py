@@ -1,0 +1,122 @@
+"""Issue 10: output a test engineer reads and prints.
+
+The page counts come from LibreOffice's PDF export, which prints every sheet: report sheets on
+one page each, data sheets not at all (airgun_xl/workbook/page_setup.py).
+"""
+import re
+import shutil
+import subprocess
+import zipfile
+
+import numpy as np
+import openpyxl
+import pytest
+from conftest import CASES, REFERENCE, TEMPLATE
+
+import airgun_xl
+from airgun_xl.cli import main
+from airgun_xl.engine.summary import summarize
+
+needs_lo = pytest.mark.skipif(not (shutil.which("soffice") and shutil.which("pdftotext")),
+                              reason="needs LibreOffice and poppler-utils")
+
+
+def _pdf_pages(path, tmp_path):
+    """The text of each page of LibreOffice's PDF of ``path``."""
+    done = subprocess.run(["soffice", f"-env:UserInstallation=file://{tmp_path}/lo",
+                           "--headless", "--convert-to", "pdf", "--outdir", str(tmp_path),
+                           str(path)], capture_output=True, text=True, timeout=600, check=False)
+    assert done.returncode == 0, done.stderr
+    pdf = tmp_path / (path.stem + ".pdf")
+    text = subprocess.run(["pdftotext", "-layout", str(pdf), "-"], capture_output=True,
+                          text=True, check=True).stdout
+    return text.split("\f")[:-1]  # pdftotext ends every page with a form feed
+
+
+@needs_lo
+def test_fill_prints_four_pages(tmp_path):
+    """Parameters, Summary, Charts, Outputs: one page each (the workbook printed 1,303 pages
+    before); the Tracked, Spectrum and ChartData sheets and the result columns not at all."""
+    out = tmp_path / "shot.xlsx"
+    assert main(["fill", str(TEMPLATE), "-o", str(out), "--compare-models"]) == 0
+    pages = _pdf_pages(out, tmp_path)
+    assert len(pages) == 4
+    assert "Damping Factor (Zeta)" in pages[0] and "Y33 (Test Item)" not in pages[0]
+    assert re.search(r"Peak acceleration \(raw\)\s+11\.994 kG", pages[1])
+    assert re.search(r"Time of peak\s+0\.2885 ms", pages[1])
+    assert re.search(r"Time step\s+0\.500 µs", pages[1])
+    assert "Charts of this shot" in pages[2] and "Acceleration, rigid model" in pages[2]
+    assert re.search(r"positions\s+TRUE", pages[3]) and not re.search(r"positions\s+1 ", pages[3])
+
+
+@needs_lo
+def test_diff_report_prints_its_table_and_whole_chart(tmp_path):
+    case = CASES["low_velocity_60"]
+    new = tmp_path / "new.xlsx"
+    assert main(["fill", str(REFERENCE / case["input"]), "-o", str(new), "--only",
+                 "positions,crush,accel,filtered"]) == 0
+    report = tmp_path / "report.xlsx"
+    main(["diff", str(REFERENCE / case["legacy_output"]), str(new), "--report", str(report)])
+    pages = _pdf_pages(report, tmp_path)
+    assert len(pages) == 2
+    assert "Max relative error" in pages[0]
+    assert "Worst column" in pages[1]
+
+
+def test_summary_values_are_in_their_shown_units_with_fitting_formats(tmp_path):
+    out = tmp_path / "o.xlsx"
+    assert main(["fill", str(TEMPLATE), "-o", str(out), "--only", "summary"]) == 0
+    ws = openpyxl.load_workbook(out)["Summary"]
+    rows = {r[0].value: r for r in ws.iter_rows(min_row=2)}
+    result = airgun_xl.load(TEMPLATE).run()
+    s = summarize(result)
+    expected = {  # label: (value in the shown unit, unit, number format)
+        "Peak acceleration (raw)": (s.peak_kg, "kG", "0.000"),
+        "Time of peak": (s.time_of_peak * 1e3, "ms", "0.0000"),
+        "Dominant frequency 1": (s.spectrum.peaks[0] * 1e-3, "kHz", "0.00"),
+        "Maximum crush": (s.max_crush, "m", "0.0000"),
+        "Rows": (12_002, None, "#,##0"),
+    }
+    for label, (value, unit, fmt) in expected.items():
+        cell, unit_cell = rows[label][1], rows[label][2]
+        # xlsxwriter writes a lone number with 16 significant digits: 1e-15 covers it
+        assert cell.value == pytest.approx(value, rel=1e-15)
+        assert unit_cell.value == unit and cell.number_format == fmt
+    assert ws.print_area == "'Summary'!$A$1:$D$" + str(ws.max_row)
+    assert ws.page_setup.orientation == "landscape" and ws.sheet_properties.pageSetUpPr.fitToPage
+
+
+def _chartdata_bytes(path):
+    with zipfile.ZipFile(path) as z:
+        sheets = openpyxl.load_workbook(path, read_only=True).sheetnames
+        return z.getinfo(f"xl/worksheets/sheet{sheets.index('ChartData') + 1}.xml").file_size
+
+
+def test_every_shrinks_chartdata_and_keeps_the_peak(tmp_path):
+    """--every 10 thins ChartData's copies to the rows kept on the sheets (min and max of each
+    bucket), so the peak survives exactly."""
+    full, tenth = tmp_path / "a.xlsx", tmp_path / "b.xlsx"
+    assert main(["fill", str(TEMPLATE), "-o", str(full)]) == 0
+    assert main(["fill", str(TEMPLATE), "-o", str(tenth), "--every", "10"]) == 0
+    assert _chartdata_bytes(tenth) < 0.5 * _chartdata_bytes(full)
+    ws = openpyxl.load_workbook(tenth, read_only=True)["ChartData"]
+    rows = list(ws.iter_rows(min_row=2, values_only=True))
+    col = rows[0].index("accel_kg")
+    values = [r[col] for r in rows[1:] if r[col] is not None]
+    assert len(values) <= 1_201 and max(values) == airgun_xl.load(TEMPLATE).run().peak_kg
+
+
+def test_spectrum_chart_from_1_khz_with_natural_frequency_marks(tmp_path):
+    out = tmp_path / "o.xlsx"
+    assert main(["fill", str(TEMPLATE), "-o", str(out)]) == 0
+    with zipfile.ZipFile(out) as z:
+        xml = next(z.read(n).decode() for n in z.namelist()
+                   if n.startswith("xl/charts/chart") and b"FFT" in z.read(n))
+    assert '<c:min val="1000.0"/>' in xml and '<c:max val="15000.0"/>' in xml
+    assert "OBR chain natural frequencies (initial masses)" in xml
+    ws = openpyxl.load_workbook(out, read_only=True)["ChartData"]
+    rows = list(ws.iter_rows(min_row=2, values_only=True))
+    col = rows[0].index("natural")
+    marks = sorted({r[col - 1] for r in rows[1:] if r[col - 1] is not None})
+    natural = summarize(airgun_xl.load(TEMPLATE).run()).natural_initial
+    np.testing.assert_array_equal(marks, sorted(natural))
