@@ -12,8 +12,9 @@ from .archiving import prepare_entry
 from .checks import StabilityError, after_run, before_run, crush_reached, unstable_crush_message
 from .engine.integrators import DivergenceError
 from .engine.summary import summarize
+from .limits import fill_bytes
 from .models import apply_model
-from .transaction import Publication, check_output
+from .transaction import Publication, check_output, display
 from .workbook.sidecar import SIDECAR_SUFFIXES, render_history, sidecar_path
 from .workbook.writer import render_workbook
 
@@ -50,8 +51,42 @@ class Filled:
     entry: object = None  # the archive Entry, when the run was archived
 
 
-def fill_workbook(shot, output, outputs, options, warn, started=None):
+#: Runs that need more memory than this, or write a larger sidecar, say so before they start.
+NOTICE_MEMORY_BYTES = 1e9
+NOTICE_SIDECAR_BYTES = 100e6
+
+
+def _size(n):
+    return f"{n / 1e9:.1f} GB" if n >= 1e9 else f"{n / 1e6:.0f} MB"
+
+
+def notices(rows, track, sidecar):
+    """What a run should say before it starts: memory past 1 GB, a sidecar past 100 MB."""
+    found = []
+    memory = fill_bytes(rows, len(track))
+    if memory > NOTICE_MEMORY_BYTES:
+        found.append(f"{rows:,} rows: this run needs about {_size(memory)} of memory")
+    if sidecar is not None:
+        size = sidecar_bytes(rows, len(track))
+        if size > NOTICE_SIDECAR_BYTES:
+            found.append(f"the full history goes to {display(sidecar)}, up to {_size(size)}")
+    return found
+
+
+def sidecar_bytes(rows, tracked):
+    """Largest size of a Parquet sidecar [bytes]: time, four displacements, four derived columns
+    and the tracked ones, 8 bytes a value (shot A at 5 ns: 163 MB estimated, 125 MB written,
+    as the slowly changing columns compress)."""
+    return rows * 8 * (9 + tracked)
+
+
+def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
+                  progress=None):
     """Run ``shot`` and write ``output`` (and its sidecar) as ``outputs`` selects.
+
+    ``warn`` and ``note`` take lists of messages (warnings; notices such as a large run's
+    memory); ``progress(stage)`` is told each stage as it starts (see
+    :mod:`airgun_xl.cli.progress`).
 
     Raises
     ------
@@ -78,10 +113,12 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
         raise StabilityError(f"{error}; expected a smaller E2, --integrator newmark, or "
                              "--allow-unstable")
     warn(str(f) for f in findings if f.level != "note")
+    note, progress = note or (lambda messages: None), progress or (lambda stage: None)
+    track = outputs.tracked_series(sidecar is not None or options.track_all)
+    note(notices(rows, track, sidecar))
+    progress("running")
     try:
-        result = model_shot.run(integrator=options.integrator, host=options.host,
-                                track=outputs.tracked_series(sidecar is not None
-                                                             or options.track_all))
+        result = model_shot.run(integrator=options.integrator, host=options.host, track=track)
     except DivergenceError as error:
         if crit.unstable_crush is None:
             raise
@@ -103,6 +140,7 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
         compared = dataclasses.replace(compared, model=other)
     result = dataclasses.replace(result, model=options.model)
     needs_summary = outputs.groups & {"summary", "spectrum", "charts"}
+    progress("summarizing")
     summary = summarize(result) if needs_summary else None
     info = {"version": __version__, "command": " ".join(options.command),
             "dt_crit": crit.dt_crit, "dt_compacted": crit.dt_compacted,
@@ -114,9 +152,11 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
                     run_seconds=time.perf_counter() - started)
     filled = Filled(result, summary, outputs.stride(rows), sidecar, compared)
     with Publication(options.force, options.force_word) as pub:
+        progress("writing the workbook")
         warn(render_workbook(result, pub.stage(output), outputs, summary, info, shown=output))
         workbook = pub.files[0][0]
         if sidecar is not None:
+            progress("writing the sidecar")
             render_history(result, pub.stage(sidecar), shown=sidecar)
         if options.force:  # a sidecar left by an earlier run must not pair with this workbook
             for stale in (output.with_name(output.stem + s) for s in SIDECAR_SUFFIXES):
@@ -124,10 +164,12 @@ def fill_workbook(shot, output, outputs, options, warn, started=None):
                     pub.remove(stale)
         pending = None
         if options.archive is not None:
+            progress("archiving")
             archive = Archive(options.archive.root, create=True)  # created once the run is done
             pending = prepare_entry(archive, options.archive, shot, workbook, filled, options,
                                     time.perf_counter() - started)
             pub.join(pending)
+        progress("publishing")
         pub.commit()
     filled.entry = pending.entry if pending is not None else None
     return filled

@@ -50,7 +50,10 @@ def _signals(restore=True):
 
 def _say(text):
     """One line to stderr, whatever the file names in it hold."""
+    from .progress import clear_line
+
     stream = sys.stderr
+    clear_line(stream)  # a progress bar's line
     encoding = getattr(stream, "encoding", None) or "utf-8"
     print(text.encode(encoding, "backslashreplace").decode(encoding, "replace"), file=stream)
 
@@ -91,6 +94,12 @@ def main(argv=None):
 
 
 _WARNED = set()
+
+
+def note(messages):
+    """Print notices (what a run will cost, before it starts), one line each, to stderr."""
+    for message in messages:
+        _say(f"airgun-xl: note: {message}")
 
 
 def warn(messages):

@@ -96,7 +96,8 @@ def print_summary(output, filled):
 
 
 def run(args):
-    from . import warn
+    from . import note, warn
+    from .progress import Progress
 
     started = time.perf_counter()
     output = Path(args.output) if args.output else default_output(args.shot)
@@ -110,7 +111,11 @@ def run(args):
         outputs = dataclasses.replace(outputs, sidecar="never")  # the entry holds the history
         options.track_all = True
         options.archive = ArchiveRequest(root, shot_name(shot, args.name), now())
-    filled = fill_workbook(shot, output, outputs, options, warn, started)
+    progress = Progress.for_rows(shot.params.rows)
+    try:
+        filled = fill_workbook(shot, output, outputs, options, warn, started, note, progress)
+    finally:
+        progress.close()
     print_summary(output, filled)
     if filled.entry is not None:
         print(f"  archived as {filled.entry.ref} in {display(root)}")
