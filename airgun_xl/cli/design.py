@@ -51,7 +51,8 @@ def _range(text):
 
 
 def run(args):
-    from . import warn
+    from . import note, warn
+    from .progress import Progress
 
     target = parse_peak(args.target_peak)
     duration = parse_duration(args.target_duration) if args.target_duration else None
@@ -87,7 +88,11 @@ def run(args):
     outputs = from_sheet(shot.source.outputs_block)
     options = Options(args.integrator, "excel", args.model, False, args.force,
                       command=tuple(args.argv))
-    filled = fill_workbook(designed, output, outputs, options, warn)
+    progress = Progress.for_rows(designed.params.rows)
+    try:
+        filled = fill_workbook(designed, output, outputs, options, warn, None, note, progress)
+    finally:
+        progress.close()
     print_summary(output, filled)
     return 0
 
