@@ -1,10 +1,21 @@
-"""Build the compiled ArtSim kernel; everything else is in pyproject.toml."""
+"""Build the compiled ArtSim kernel; everything else is in pyproject.toml.
+
+The extension is optional: where it cannot be built (no C compiler), the install goes on and
+the package uses its pure-Python reference stepper, which gives the same numbers bit for bit
+(airgun_xl/engine/kernel.py). It uses Python 3.11's limited API, so one abi3 wheel serves
+every later Python on a platform (cibuildwheel: see README, "Building wheels").
+"""
 import sys
 
 from setuptools import Extension, setup
 
 # No fused multiply-add: the port must round exactly where the macro rounds.
-FLAGS = [] if sys.platform == "win32" else ["-O2", "-ffp-contract=off", "-fno-fast-math"]
+FLAGS = ["/fp:precise"] if sys.platform == "win32" else ["-O2", "-ffp-contract=off",
+                                                          "-fno-fast-math"]
 
-setup(ext_modules=[Extension("airgun_xl.engine._artsim", ["airgun_xl/engine/_artsim.c"],
-                             extra_compile_args=FLAGS)])
+setup(
+    ext_modules=[Extension("airgun_xl.engine._artsim", ["airgun_xl/engine/_artsim.c"],
+                           extra_compile_args=FLAGS, optional=True, py_limited_api=True,
+                           define_macros=[("Py_LIMITED_API", "0x030B0000")])],
+    options={"bdist_wheel": {"py_limited_api": "cp311"}},
+)

@@ -23,8 +23,15 @@
  *     first_row (1-based), numbers with 17 significant digits (exact round trip).
  */
 #define PY_SSIZE_T_CLEAN
+/* The limited API of Python 3.11 (buffers joined it then): one abi3 wheel per platform. */
+#ifndef Py_LIMITED_API
+#define Py_LIMITED_API 0x030B0000
+#endif
 #include <Python.h>
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 /* The macro's value of pi (3.141592653, not M_PI). */
 #define PI_MACRO 3.141592653
@@ -307,21 +314,21 @@ static PyObject *run_kernel(PyObject *args, Stepper steps)
                           &objs[2], &objs[3], &objs[4], &objs[5], &objs[6], &objs[7], &objs[8],
                           &objs[9], &objs[10], &objs[11], &objs[12]))
         return NULL;
-    seq = PySequence_Fast(params, "params must be a sequence of floats");
-    if (seq == NULL)
+    seq = params;
+    if (PySequence_Size(seq) != P_COUNT) {
+        if (!PyErr_Occurred())
+            PyErr_Format(PyExc_ValueError, "params must hold %d values", P_COUNT);
         return NULL;
-    if (PySequence_Fast_GET_SIZE(seq) != P_COUNT) {
-        Py_DECREF(seq);
-        return PyErr_Format(PyExc_ValueError, "params must hold %d values", P_COUNT);
     }
     for (i = 0; i < P_COUNT; i++) {
-        p[i] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(seq, i));
-        if (p[i] == -1.0 && PyErr_Occurred()) {
-            Py_DECREF(seq);
+        PyObject *item = PySequence_GetItem(seq, i);
+        if (item == NULL)
             return NULL;
-        }
+        p[i] = PyFloat_AsDouble(item);
+        Py_DECREF(item);
+        if (p[i] == -1.0 && PyErr_Occurred())
+            return NULL;
     }
-    Py_DECREF(seq);
     if (rows < 0)
         return PyErr_Format(PyExc_ValueError, "rows must be >= 0");
     for (got = 0; got < N_COLUMNS; got++) {
@@ -406,7 +413,7 @@ static PyObject *py_batch_kernel(PyObject *self, PyObject *args)
                                           "n x 8)");
         goto fail;
     }
-    scratch = PyMem_RawMalloc((size_t)(rows > 0 ? rows : 1) * 4 * sizeof(double));
+    scratch = malloc((size_t)(rows > 0 ? rows : 1) * 4 * sizeof(double));
     if (scratch == NULL) {
         PyErr_NoMemory();
         goto fail;
@@ -428,7 +435,7 @@ static PyObject *py_batch_kernel(PyObject *self, PyObject *args)
                                                     c, (double *)views[3].buf + i * N_FINALS);
     }
     Py_END_ALLOW_THREADS
-    PyMem_RawFree(scratch);
+    free(scratch);
     for (i = 0; i < 4; i++)
         PyBuffer_Release(&views[i]);
     Py_RETURN_NONE;
@@ -463,11 +470,11 @@ static PyObject *py_render_cells(PyObject *self, PyObject *args)
         return NULL;
     }
     n = view.len / (Py_ssize_t)sizeof(double);
-    text = PyMem_RawMalloc((size_t)(n > 0 ? n : 1) * CELL_MAX);
-    lengths = PyMem_RawMalloc((size_t)(n > 0 ? n : 1) * sizeof(int));
+    text = malloc((size_t)(n > 0 ? n : 1) * CELL_MAX);
+    lengths = malloc((size_t)(n > 0 ? n : 1) * sizeof(int));
     if (text == NULL || lengths == NULL) {
-        PyMem_RawFree(text);
-        PyMem_RawFree(lengths);
+        free(text);
+        free(lengths);
         PyBuffer_Release(&view);
         return PyErr_NoMemory();
     }
@@ -499,11 +506,11 @@ static PyObject *py_render_cells(PyObject *self, PyObject *args)
                 Py_CLEAR(out);
                 break;
             }
-            PyList_SET_ITEM(out, i, cell);
+            PyList_SetItem(out, i, cell); /* steals the reference */
         }
     }
-    PyMem_RawFree(text);
-    PyMem_RawFree(lengths);
+    free(text);
+    free(lengths);
     return out;
 }
 

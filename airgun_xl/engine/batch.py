@@ -10,10 +10,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._artsim import batch_kernel
 from .derived import KG_DIVISOR
 from .filtered import filter_stencils, filtered_values
 from .integrators import displacement_bound, kernel_params
+from .kernel import batch_kernel
 from .summary import KG, PULSE_FRACTION
 
 #: The figures of each shot, in column order of :attr:`Batch.figures`.

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import AirgunXlError, CellError, OptionError
-from ._artsim import legacy_kernel, newmark_kernel
+from .kernel import legacy_kernel, newmark_kernel
 
 #: Order of the parameters the compiled kernel takes (``_artsim.c``, enum at its top).
 KERNEL_PARAMS = ("m1", "m31", "m32", "m33", "k2", "k3", "delta", "rho", "rcone", "hcone",

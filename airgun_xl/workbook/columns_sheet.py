@@ -18,10 +18,36 @@ from contextlib import contextmanager
 
 import numpy as np
 import xlsxwriter.workbook
+import xlsxwriter.worksheet
 from xlsxwriter.utility import xl_col_to_name
 
-from ..engine._artsim import render_cells
+from ..engine.kernel import render_cells
 from .safe_text import SafeWorksheet
+
+#: The xlsxwriter internals the fast path overrides or calls. They are there in every version
+#: pyproject.toml allows (3.1.9 .. 3.x; CI runs the lowest and the newest); where one is
+#: missing, :class:`ColumnsWorksheet` writes through xlsxwriter's public ``write_number``
+#: instead, to the same cell values (see :class:`Exact`), only slower.
+FAST = all(hasattr(xlsxwriter.worksheet.Worksheet, name) for name in (
+    "_write_rows", "_write_row", "_write_empty_row", "_write_cell", "_check_dimensions",
+    "_get_range_data")) and hasattr(xlsxwriter.workbook, "ZipFile")
+
+
+class Exact(float):
+    """A float that formats with 17 significant digits: xlsxwriter's public path writes
+    numbers with ``f"{number:.16G}"``, which does not always read back as the same double.
+    (Before 3.2 it formatted with ``%``, which no subclass can change; those versions have the
+    internals, so the fallback is not used there.)"""
+
+    def __format__(self, spec):
+        return format(float(self), ".17g") if spec.upper().endswith("G") else format(
+            float(self), spec)
+
+
+def _row_properties(ws):
+    """Row heights and formats by row: ``row_info`` from xlsxwriter 3.3, ``set_rows`` before."""
+    return ws.row_info if hasattr(ws, "row_info") else ws.set_rows
+
 
 #: Rows in a worksheet (Excel's limit; xlsxwriter refuses beyond it).
 SHEET_ROWS = 1_048_576
@@ -61,6 +87,10 @@ class ColumnsWorksheet(SafeWorksheet):
             return -1
         if not np.isfinite(values).all():
             raise ValueError("write_number_column takes finite numbers only")
+        if not FAST:  # xlsxwriter's public path, to the same values
+            for row, value in enumerate(values.tolist(), start=first_row):
+                self.write_number(row, col, Exact(value))
+            return 0
         self._check_dimensions(first_row, col)
         self._check_dimensions(last, col)
         self._bulk.append((col, first_row, np.ascontiguousarray(values)))
@@ -103,6 +133,7 @@ class ColumnsWorksheet(SafeWorksheet):
         if not self._bulk:
             return super()._write_rows()
         write = self.fh.write
+        row_info = _row_properties(self)
         for lo in range(self.dim_rowmin, self.dim_rowmax + 1, CHUNK_ROWS):
             hi = min(lo + CHUNK_ROWS, self.dim_rowmax + 1)
             bulk = self._bulk_rows(lo, hi)
@@ -110,11 +141,11 @@ class ColumnsWorksheet(SafeWorksheet):
                 table = self.table.get(row)  # .get: the defaultdict must not grow
                 cols, parts = bulk.get(row, ((), ()))
                 if not parts and not table:
-                    if row in self.row_info:
-                        self._write_empty_row(row, None, self.row_info[row])
+                    if row in row_info:
+                        self._write_empty_row(row, None, row_info[row])
                     continue
-                if row in self.row_info:
-                    self._write_row(row, None, self.row_info[row])
+                if row in row_info:
+                    self._write_row(row, None, row_info[row])
                 else:
                     write(f'<row r="{row + 1}">')
                 if table:  # merge xlsxwriter's own cells in column order
@@ -147,6 +178,9 @@ def fast_deflate():
     xlsxwriter has no compression option; its module-level ``ZipFile`` name is swapped for the
     duration of the block only, under a lock.
     """
+    if not FAST:
+        yield
+        return
     with _ZIP_LOCK:
         saved = xlsxwriter.workbook.ZipFile
         xlsxwriter.workbook.ZipFile = _FastZipFile

@@ -1,0 +1,107 @@
+"""Issue 11: the pure-Python reference stepper gives the compiled kernel's numbers bit for bit,
+so an install without a C compiler runs the same shots (AIRGUN_XL_PURE=1 forces it)."""
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from conftest import (
+    CASES,
+    LEGACY_RTOL,
+    MACRO_COLUMNS,
+    REFERENCE,
+    column,
+    relative_error,
+    sheet_values,
+)
+
+import airgun_xl
+from airgun_xl.engine import _reference as ref
+from airgun_xl.engine.integrators import displacement_bound, kernel_params
+
+compiled = pytest.importorskip("airgun_xl.engine._artsim")
+
+UNSTABLE = json.loads((REFERENCE / "unstable_cases.json").read_text())
+INPUTS = sorted({c["input"] for c in CASES.values()} | {c["input"] for c in UNSTABLE.values()})
+
+
+def _buffers(rows):
+    return [np.zeros(rows) for _ in range(5)] + [np.full(rows, np.nan) for _ in range(8)]
+
+
+def _both(kernel_name, p):
+    values = kernel_params(p) + [displacement_bound(p)]
+    out = []
+    for module in (compiled, ref):
+        arrays = _buffers(p.rows)
+        finals = getattr(module, kernel_name)(values, p.rows, *arrays)
+        out.append((finals, arrays))
+    return out
+
+
+def _same(a, b):
+    """Bit for bit: equal, NaN where the other is NaN (array_equal with equal_nan)."""
+    return np.array_equal(np.asarray(a), np.asarray(b), equal_nan=True)
+
+
+@pytest.mark.parametrize("name", INPUTS)
+def test_legacy_scheme_bit_for_bit_on_every_legacy_case(name):
+    p = airgun_xl.load(REFERENCE / name).params
+    (fc, ac), (fr, ar) = _both("legacy_kernel", p)
+    assert _same(fc, fr)
+    for i, (x, y) in enumerate(zip(ac, ar)):
+        assert _same(x, y), (name, i)
+
+
+@pytest.mark.parametrize("changes", [{}, {"k3": -5e11}, {"zeta": 0.0}, {"hcone": 0.0}])
+def test_newmark_bit_for_bit(changes):
+    p = airgun_xl.load(REFERENCE / CASES["shot_a_appendix_5us"]["input"]).params
+    (fc, ac), (fr, ar) = _both("newmark_kernel", p.replace(**changes))
+    assert _same(fc, fr) and all(_same(x, y) for x, y in zip(ac, ar))
+
+
+@pytest.mark.parametrize("integrator", [0, 1])
+def test_batch_bit_for_bit(integrator):
+    base = airgun_xl.load(REFERENCE / CASES["low_velocity_60"]["input"]).params
+    shots = [base.replace(v31=v, v32=v, v33=v) for v in (20.0, 60.0, 150.0)]
+    matrix = np.array([kernel_params(p) + [displacement_bound(p)] for p in shots])
+    results = []
+    for module in (compiled, ref):
+        t, y, finals = np.empty(base.rows), np.empty((3, base.rows)), np.empty((3, 8))
+        module.batch_kernel(matrix, base.rows, integrator, 3, t, y, finals)
+        results.append((t, y, finals))
+    for x, z in zip(*results):
+        assert _same(x, z)
+
+
+def test_render_cells_bit_for_bit():
+    rng = np.random.default_rng(5)
+    values = np.concatenate([rng.normal(size=200) * 10.0 ** rng.integers(-300, 300, 200),
+                             [0.0, -0.0, 5e-324, 1.7976931348623157e308, 0.1, 1e-5, 123456.0]])
+    assert compiled.render_cells("AB", 7, values) == ref.render_cells("AB", 7, values)
+    with pytest.raises(ValueError):
+        ref.render_cells("A", 1, np.array([1.0, np.nan]))
+
+
+def test_pure_fill_matches_the_macro(tmp_path):
+    """AIRGUN_XL_PURE=1, a fresh process: the kernel in use is the reference one, and a fill of
+    two legacy cases equals the macro's output to the legacy rule (1e-12 of each column)."""
+    env = dict(os.environ, AIRGUN_XL_PURE="1")
+    probe = subprocess.run([sys.executable, "-c", "from airgun_xl.engine import kernel; "
+                            "print(kernel.COMPILED)"], env=env, capture_output=True, text=True,
+                           check=True)
+    assert probe.stdout.strip() == "False"
+    for name in ("shot_a_appendix_5us", "mem_faster_clamp"):
+        case = CASES[name]
+        out = tmp_path / f"{name}.xlsx"
+        subprocess.run([sys.executable, "-m", "airgun_xl", "fill", str(REFERENCE / case["input"]),
+                        "-o", str(out)], env=env, check=True, capture_output=True)
+        legacy, new = sheet_values(REFERENCE / case["legacy_output"]), sheet_values(out)
+        rows = max(r for (r, c) in legacy if c == "H") - 1
+        for letter in MACRO_COLUMNS:
+            expected, got = column(legacy, letter, rows + 3), column(new, letter, rows + 3)
+            if letter == "I":
+                expected, got = expected[:rows], got[:rows]
+            assert relative_error(got, expected) <= LEGACY_RTOL, (name, letter)
