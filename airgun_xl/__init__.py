@@ -11,10 +11,14 @@ __version__ = "0.1.0"
 
 from .errors import (
     AirgunXlError,
+    ArchiveError,
     CellError,
+    DesignError,
+    DivergenceError,
     OptionError,
     OutputError,
     ResourceError,
+    StabilityError,
     WorkbookError,
 )
 
@@ -42,10 +46,14 @@ def load(path):
 
 __all__ = [
     "AirgunXlError",
+    "ArchiveError",
     "CellError",
+    "DesignError",
+    "DivergenceError",
     "OptionError",
     "OutputError",
     "ResourceError",
+    "StabilityError",
     "Result",
     "Shot",
     "ShotParams",

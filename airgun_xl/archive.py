@@ -35,7 +35,7 @@ import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
-from .errors import AirgunXlError, OptionError
+from .errors import ArchiveError, OptionError
 from .transaction import display, owner_alive, owner_token
 
 ENV = "AIRGUN_XL_ARCHIVE"
@@ -58,10 +58,6 @@ CREATE TABLE IF NOT EXISTS entries (
     peak_kg REAL, integrator TEXT, model TEXT, engine TEXT,
     UNIQUE (shot, version)
 )"""
-
-
-class ArchiveError(AirgunXlError):
-    """The archive cannot be used or does not hold what was asked for."""
 
 
 def archive_dir(given=None, required=True):

@@ -51,7 +51,7 @@ CHARTS = (
     ChartSpec("accel", "Test-item acceleration (Fig. 12)", "Time (s)", "Acceleration (kG's)",
               (Series("accel_kg", "Acceleration"),
                Series("filtered_kg", "Filtered samples", markers=True),
-               Series("compared_kg", "Other model (--compare-models)", dash=True))),
+               Series("compared_kg", "Other model", dash=True))),
     ChartSpec("spectrum", "FFT of the test-item acceleration (Figs. 14-15), from "
               f"{SPECTRUM_MIN_HZ / 1000:g} kHz", "Frequency (Hz)", "Amplitude (kG)",
               (Series("spectrum", "Amplitude"),

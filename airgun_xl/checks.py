@@ -6,14 +6,9 @@ from dataclasses import dataclass
 from .cells import BY_ADDRESS
 from .engine.legacy_law import CRUSH_FIT_RANGE, crush_factor
 from .engine.stability import WARN_RATIO, critical_time_step, full_length
-from .errors import AirgunXlError
 
 #: Bird masses differing by this factor or more make a stiff, badly scaled system.
 MASS_RATIO_WARNING = 1e6
-
-
-class StabilityError(AirgunXlError):
-    """The time step is above the scheme's critical step: the run would diverge."""
 
 
 @dataclass(frozen=True)

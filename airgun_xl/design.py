@@ -11,12 +11,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .engine.batch import run_batch
-from .errors import AirgunXlError, OptionError
+from .errors import DesignError, OptionError
 from .models import apply_model
-
-
-class DesignError(AirgunXlError):
-    """The target cannot be met: it lies outside what the varied parameter can reach."""
 
 
 @dataclass(frozen=True)

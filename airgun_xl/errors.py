@@ -2,6 +2,8 @@
 
 Every error a user can cause derives from :class:`AirgunXlError`. The CLI maps the whole tree to
 exit code 2 and prints the message as one line; anything else is a bug and keeps its traceback.
+All of them live here and are exported from :mod:`airgun_xl`. Library messages name the
+argument (``force=True``); only the CLI names its flags.
 """
 
 
@@ -48,3 +50,34 @@ class OptionError(AirgunXlError):
 
 class ResourceError(AirgunXlError):
     """A run would need more memory than the machine has (estimated before it starts)."""
+
+
+class StabilityError(AirgunXlError):
+    """The time step is above the scheme's critical step, or the run crushed past the length
+    where it becomes unstable: the run would diverge or cannot be trusted."""
+
+
+class DivergenceError(AirgunXlError):
+    """The scheme diverged: a displacement became non-finite or passed the physical bound.
+
+    Attributes
+    ----------
+    row : int
+        The kernel's row index where it stopped (sheet row ``row + 2``).
+    time : float
+        Its time [s].
+    values : dict
+        The displacements Y1, Y31, Y32, Y33 at that row [m].
+    """
+
+    def __init__(self, message, row, time, values):
+        super().__init__(message)
+        self.row, self.time, self.values = row, time, values
+
+
+class DesignError(AirgunXlError):
+    """The target cannot be met: it lies outside what the varied parameter can reach."""
+
+
+class ArchiveError(AirgunXlError):
+    """The archive cannot be used or does not hold what was asked for."""

@@ -16,4 +16,4 @@ def apply_model(p, model="4-mass"):
     if model == "rigid":
         return p.replace(m31=p.m31 + p.m32 + p.m33, m32=0.0, m33=0.0, k2=0.0, k3=0.0,
                          v32=p.v31, v33=p.v31)
-    raise OptionError(f"--model: found {model!r}, expected one of {', '.join(MODELS)}")
+    raise OptionError(f"model: found {model!r}, expected one of {', '.join(MODELS)}")

@@ -173,7 +173,10 @@ class ShotParams:
                 raw[velocity] = raw.get(previous)  # a left-out mass moves with its neighbour
         values = {c.name: 0.0 if c.address in reduced else check_value(c, raw.get(c.address))
                   for c in CELLS}
-        return cls(**values).check()
+        return cls(**values)
+
+    def __post_init__(self):
+        self.check()  # a ShotParams is always checked: built, replaced or read
 
     def check(self):
         """Check each field and the relations between fields; return self.
@@ -235,8 +238,8 @@ class ShotParams:
         return 1 / (self.delta * self.filter_frequency)
 
     def replace(self, **changes):
-        """A copy with some fields changed, checked again."""
-        return replace(self, **changes).check()
+        """A copy with some fields changed, checked again (on construction)."""
+        return replace(self, **changes)
 
     def as_dict(self):
         return asdict(self)

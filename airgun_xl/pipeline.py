@@ -9,10 +9,10 @@ from pathlib import Path
 from . import __version__
 from .archive import Archive
 from .archiving import prepare_entry
-from .checks import StabilityError, after_run, before_run, crush_reached, unstable_crush_message
-from .engine.integrators import DivergenceError
+from .checks import after_run, before_run, crush_reached, unstable_crush_message
 from .engine.summary import summarize
-from .limits import fill_bytes
+from .errors import DivergenceError, StabilityError
+from .limits import check_memory, fill_bytes
 from .models import apply_model
 from .transaction import Publication, check_output, display
 from .workbook.sidecar import SIDECAR_SUFFIXES, render_history, sidecar_path
@@ -116,6 +116,10 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
     note, progress = note or (lambda messages: None), progress or (lambda stage: None)
     track = outputs.tracked_series(sidecar is not None or options.track_all)
     note(notices(rows, track, sidecar))
+    check_memory(fill_bytes(rows, len(track)),  # Shot.run checks too, in the API's words
+                 f"a run of {rows:,} rows ({len(track)} step values tracked)",
+                 "fewer rows (a larger E2 or a shorter E6) or fewer outputs (--only summary; "
+                 "an archived run tracks every step value)")
     progress("running")
     try:
         result = model_shot.run(integrator=options.integrator, host=options.host, track=track)

@@ -5,6 +5,7 @@ from dataclasses import dataclass, field
 
 from .engine import filtered_acceleration, get_integrator, test_item_derivatives
 from .engine.integrators import TRACKED
+from .errors import OptionError
 from .limits import check_memory, fill_bytes
 from .params import ShotParams
 
@@ -12,6 +13,28 @@ from .params import ShotParams
 def last_mass(history, p):
     """Displacement of the bird's last mass: Y33, or Y32 / Y31 for a reduced model."""
     return (history.y31, history.y32, history.y33)[p.bird_masses - 1]
+
+
+#: Whose Offset rounding the filtered column reproduces (Shot.run's ``host``).
+HOSTS = ("excel", "calc")
+
+
+def check_run_options(host, track):
+    """``host`` is one of :data:`HOSTS` and ``track`` holds names of ``TRACKED`` only.
+
+    Raises
+    ------
+    airgun_xl.errors.OptionError
+    """
+    if host not in HOSTS:
+        raise OptionError(f"host: found {host!r}, expected one of {', '.join(HOSTS)}")
+    if isinstance(track, str):
+        raise OptionError(f"track: found the string {track!r}, expected a collection of names "
+                          f"from {', '.join(TRACKED)}")
+    unknown = sorted(set(track) - set(TRACKED), key=str)
+    if unknown:
+        raise OptionError(f"track: found {unknown[0]!r}, expected names from "
+                          f"{', '.join(TRACKED)}")
 
 
 @dataclass
@@ -70,6 +93,8 @@ class Shot:
 
         Raises
         ------
+        airgun_xl.errors.OptionError
+            For an unknown integrator, host or tracked name.
         airgun_xl.errors.ResourceError
             Before stepping, when the run's estimated memory passes what is available
             (:func:`airgun_xl.limits.check_memory`).
@@ -77,10 +102,10 @@ class Shot:
         from .result import Result
 
         p = self.params
+        check_run_options(host, track)
         check_memory(fill_bytes(p.rows, len(track)),
                      f"a run of {p.rows:,} rows ({len(track)} step values tracked)",
-                     "fewer rows (a larger E2 or a shorter E6) or fewer outputs (--only "
-                     "summary; an archived run tracks every step value)")
+                     "fewer rows (a larger E2 or a shorter E6) or fewer step values in track")
         started = time.perf_counter()
         history = get_integrator(integrator)(p, track)
         last = last_mass(history, p)  # the test item, or the last mass of a reduced model

@@ -9,10 +9,10 @@ from conftest import TEMPLATE
 import airgun_xl
 from airgun_xl import Shot
 from airgun_xl.cli import main
-from airgun_xl.design import VARIABLES, DesignError, solve_peak
+from airgun_xl.design import VARIABLES, solve_peak
 from airgun_xl.engine.batch import FIGURES, run_batch
 from airgun_xl.engine.summary import summarize
-from airgun_xl.errors import OptionError
+from airgun_xl.errors import DesignError, OptionError
 from airgun_xl.models import apply_model
 from airgun_xl.stiffness import (
     LB_PER_IN,

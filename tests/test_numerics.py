@@ -12,9 +12,9 @@ import airgun_xl
 from airgun_xl import Shot, ShotParams
 from airgun_xl.cli import main
 from airgun_xl.engine.convergence import default_ladder, ladder, parse_duration
-from airgun_xl.engine.integrators import DivergenceError, run_legacy
+from airgun_xl.engine.integrators import run_legacy
 from airgun_xl.engine.stability import critical_time_step
-from airgun_xl.errors import OptionError
+from airgun_xl.errors import DivergenceError, OptionError
 
 SHOT_A = airgun_xl.load(TEMPLATE).params
 

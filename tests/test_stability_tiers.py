@@ -20,7 +20,7 @@ from conftest import (
 
 import airgun_xl
 from airgun_xl.cli import main
-from airgun_xl.engine.integrators import DivergenceError, displacement_bound
+from airgun_xl.engine.integrators import displacement_bound
 from airgun_xl.engine.stability import (
     _matrices,
     compacted_length,
@@ -28,6 +28,7 @@ from airgun_xl.engine.stability import (
     full_length,
     spectral_radius,
 )
+from airgun_xl.errors import DivergenceError
 
 UNSTABLE = json.loads((REFERENCE / "unstable_cases.json").read_text())
 

@@ -126,7 +126,7 @@ def _history(entry):
     """The entry's full time history, column -> array."""
     import pandas as pd
 
-    from ..archive import ArchiveError
+    from ..errors import ArchiveError
 
     path = next((p for p in (entry.path / "history.parquet", entry.path / "history.csv")
                  if p.exists()), None)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import AirgunXlError, CellError, OptionError
+from ..errors import CellError, DivergenceError, OptionError
 from .kernel import legacy_kernel, newmark_kernel
 
 #: Order of the parameters the compiled kernel takes (``_artsim.c``, enum at its top).
@@ -33,21 +33,18 @@ class KernelStats:
     max_crush: float
 
 
-class DivergenceError(AirgunXlError):
-    """The scheme diverged: a displacement became non-finite or passed the physical bound."""
-
-    def __init__(self, integrator, p, row, arrays):
-        names = ("Y1", "Y31", "Y32", "Y33")
-        values = [a[row] for a in arrays[1:5]]
-        worst = max(range(4), key=lambda i: abs(values[i]) if values[i] == values[i] else
-                    float("inf"))
-        time_at = arrays[0][row]
-        super().__init__(
-            f"the {integrator} scheme diverged at step {row - 1:,} (t = {time_at:.6g} s): "
-            f"{names[worst]} = {values[worst]:.3g} m, beyond the {displacement_bound(p):.3g} m "
-            "no physical run reaches; expected a smaller E2 (Timestep) or --integrator newmark")
-        self.row, self.time = row, time_at
-        self.values = dict(zip(names, values))  # the displacements at that row [m]
+def divergence_error(integrator, p, row, arrays):
+    """The :class:`~airgun_xl.errors.DivergenceError` for a run stopped at ``row``."""
+    names = ("Y1", "Y31", "Y32", "Y33")
+    values = [a[row] for a in arrays[1:5]]
+    worst = max(range(4), key=lambda i: abs(values[i]) if values[i] == values[i] else
+                float("inf"))
+    time_at = arrays[0][row]
+    return DivergenceError(
+        f"the {integrator} scheme diverged at step {row - 1:,} (t = {time_at:.6g} s): "
+        f"{names[worst]} = {values[worst]:.3g} m, beyond the {displacement_bound(p):.3g} m "
+        "no physical run reaches; expected a smaller E2 (Timestep) or the newmark integrator",
+        row, time_at, dict(zip(names, values)))
 
 
 @dataclass
@@ -134,7 +131,7 @@ def _run(kernel, name, p, track):
     if bad >= 0 and p.hcone == 0 and not x_plastic > 0:
         raise no_wedge_error(p, bad)
     if bad >= 0:
-        raise DivergenceError(name, p, bad, arrays)
+        raise divergence_error(name, p, bad, arrays)
     history = History(*arrays, final_m1, final_m31, elapsed)
     history.stats = KernelStats(x_plastic, max_v, min_v, max_crushed, max_crush)
     return blank_left_out(history, p)
@@ -208,5 +205,5 @@ def get_integrator(name):
     try:
         return INTEGRATORS[name]
     except KeyError:
-        raise OptionError(f"--integrator: found {name!r}, expected one of "
+        raise OptionError(f"integrator: found {name!r}, expected one of "
                           f"{', '.join(sorted(INTEGRATORS))}") from None

@@ -47,7 +47,7 @@ def write_number_columns(ws, first_row, columns):
             if ws.write_number_column(first_row + start, col, values[start:stop]) == -1:
                 raise OutputError(f"{ws.get_name()}: {stop - start:,} rows from row "
                                   f"{first_row + start + 1:,} pass the sheet's last row; "
-                                  "expected fewer rows (use --every)")
+                                  "expected fewer rows on the sheet (a larger row stride: every)")
 
 
 TRACKED_COLUMNS = (
@@ -174,7 +174,7 @@ def _summary_rows(result, summary, timings):
     compared = timings.get("compared")
     if compared is not None:
         rows += [(f"Peak acceleration, {compared.model} model", compared.peak_kg, "kG",
-                  "the same shot with the other model (--compare-models)"),
+                  "the same shot with the other model"),
                  (f"Time of peak, {compared.model} model", compared.time_of_peak, "s", "")]
     rows += [
         ("Model", p.model + (" - the rigid-body model" if result.model == "rigid" else ""),
