@@ -35,10 +35,11 @@ import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
+from .choices import ARCHIVE_ENV
 from .errors import ArchiveError, OptionError
 from .transaction import display, owner_alive, owner_token
 
-ENV = "AIRGUN_XL_ARCHIVE"
+ENV = ARCHIVE_ENV
 INDEX = "index.sqlite"
 MARKER = ".airgun-xl-archive"
 SCRATCH = ".airgun-xl-scratch"

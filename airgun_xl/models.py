@@ -4,9 +4,10 @@
 m31 + m32 + m33, against the same mitigator force law and mass transfer, with no internal
 springs, so it shows no high-frequency content. It runs as the one-mass reduced model.
 """
+from . import choices
 from .errors import OptionError
 
-MODELS = ("4-mass", "rigid")
+MODELS = choices.MODELS
 
 
 def apply_model(p, model="4-mass"):

@@ -7,7 +7,8 @@ computed beyond what the selected outputs need.
 """
 from dataclasses import dataclass, field, replace
 
-from .engine.integrators import TRACKED
+from . import choices
+from .choices import TRACKED
 from .errors import OptionError
 from .limits import MAX_EVERY
 
@@ -39,7 +40,7 @@ SHEET_DATA_ROWS = 1_048_576 - 4
 #: than its users have seen; `max sheet rows` raises it up to the sheet's limit.
 DEFAULT_MAX_SHEET_ROWS = 32_767
 
-SIDECAR_MODES = ("auto", "always", "never")
+SIDECAR_MODES = choices.SIDECAR_MODES
 SHEET_NAME = "Outputs"
 
 

@@ -3,8 +3,8 @@
 import time
 from dataclasses import dataclass, field
 
+from .choices import HOSTS, TRACKED
 from .engine import filtered_acceleration, get_integrator, test_item_derivatives
-from .engine.integrators import TRACKED
 from .errors import OptionError
 from .limits import check_memory, fill_bytes
 from .params import ShotParams
@@ -13,10 +13,6 @@ from .params import ShotParams
 def last_mass(history, p):
     """Displacement of the bird's last mass: Y33, or Y32 / Y31 for a reduced model."""
     return (history.y31, history.y32, history.y33)[p.bird_masses - 1]
-
-
-#: Whose Offset rounding the filtered column reproduces (Shot.run's ``host``).
-HOSTS = ("excel", "calc")
 
 
 def check_run_options(host, track):

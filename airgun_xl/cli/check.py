@@ -1,8 +1,5 @@
 """``airgun-xl check SHOT.xlsx``: can this shot's run be trusted? (No run, no output.)"""
-from ..checks import before_run
-from ..engine.integrators import INTEGRATORS
-from ..engine.stability import compacted_length, full_length
-from ..shot import Shot
+from ..choices import INTEGRATORS
 
 
 def add_parser(sub):
@@ -17,6 +14,10 @@ def add_parser(sub):
 
 
 def run(args):
+    from ..checks import before_run
+    from ..engine.stability import compacted_length, full_length
+    from ..shot import Shot
+
     shot = Shot.from_workbook(args.shot)
     p = shot.params
     crit, findings = before_run(p, args.integrator)

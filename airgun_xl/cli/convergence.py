@@ -2,12 +2,9 @@
 import math
 from pathlib import Path
 
-from ..engine.convergence import default_ladder, ladder, parse_duration
-from ..engine.integrators import INTEGRATORS
+from ..choices import INTEGRATORS
 from ..errors import OptionError
-from ..shot import Shot
 from ..transaction import check_output
-from ..workbook.convergence import write_convergence
 
 
 def add_parser(sub):
@@ -30,6 +27,9 @@ def add_parser(sub):
 
 
 def run(args):
+    from ..engine.convergence import default_ladder, ladder, parse_duration
+    from ..shot import Shot
+    from ..workbook.convergence import write_convergence
     from . import warn
 
     shot = Shot.from_workbook(args.shot)

@@ -3,13 +3,9 @@ import dataclasses
 import time
 from pathlib import Path
 
-from ..design import VARIABLES, solve_peak, solve_peak_and_duration, variable
-from ..engine.integrators import INTEGRATORS
+from ..choices import DESIGN_VARIABLES, INTEGRATORS, MODELS
 from ..errors import OptionError
-from ..models import MODELS
 from ..outputs import from_sheet
-from ..pipeline import Options, fill_workbook
-from ..shot import Shot
 from ..units import parse_duration, parse_peak
 from .fill import print_summary
 
@@ -27,7 +23,7 @@ def add_parser(sub):
                    help="requested pulse duration (>= 10%% of peak): 5ms, 4500us; needs two "
                         "--vary")
     p.add_argument("--vary", action="append", metavar="CELL",
-                   help=f"parameter to solve for: {', '.join(VARIABLES)} (A28: A28..A30 "
+                   help=f"parameter to solve for: {', '.join(DESIGN_VARIABLES)} (A28: A28..A30 "
                         "together, the default)")
     p.add_argument("--range", metavar="LO:HI",
                    help="search range of the (first) varied parameter, in its unit")
@@ -51,6 +47,9 @@ def _range(text):
 
 
 def run(args):
+    from ..design import solve_peak, solve_peak_and_duration, variable
+    from ..pipeline import Options, fill_workbook
+    from ..shot import Shot
     from . import note, warn
     from .progress import Progress
 

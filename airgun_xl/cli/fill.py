@@ -4,14 +4,8 @@ import time
 from pathlib import Path
 
 from ..archive import ENV, archive_dir
-from ..archiving import now, shot_name
-from ..engine.filtered import HOSTS
-from ..engine.integrators import INTEGRATORS
-from ..engine.summary import PULSE_FRACTION
-from ..models import MODELS
-from ..outputs import GROUPS, SIDECAR_MODES, from_sheet
-from ..pipeline import ArchiveRequest, Options, fill_workbook
-from ..shot import Shot
+from ..choices import HOSTS, INTEGRATORS, MODELS, SIDECAR_MODES
+from ..outputs import GROUPS, from_sheet
 from ..transaction import display
 
 
@@ -69,6 +63,8 @@ def _ms(seconds):
 
 
 def print_summary(output, filled):
+    from ..engine.summary import PULSE_FRACTION
+
     result, s, stride, sidecar = filled.result, filled.summary, filled.stride, filled.sidecar
     lines = [f"wrote {output}: {result.rows:,} rows"
              + (f", 1 in {stride} on the sheets" if stride > 1 else "")
@@ -96,6 +92,9 @@ def print_summary(output, filled):
 
 
 def run(args):
+    from ..archiving import now, shot_name
+    from ..pipeline import ArchiveRequest, Options, fill_workbook
+    from ..shot import Shot
     from . import note, warn
     from .progress import Progress
 

@@ -4,13 +4,9 @@ import time
 from pathlib import Path
 
 from .. import limits
-from ..engine.integrators import INTEGRATORS
+from ..choices import INTEGRATORS, MODELS
 from ..errors import OptionError
-from ..models import MODELS
-from ..shot import Shot
-from ..sweeps import grid, monte_carlo, parse_sd, parse_vary, spread
 from ..transaction import check_output
-from ..workbook.sweep import write_sweep
 
 
 def add_parser(sub):
@@ -45,6 +41,10 @@ def _progress_bar(total):
 
 
 def run(args):
+    from ..shot import Shot
+    from ..sweeps import grid, monte_carlo, parse_sd, parse_vary, spread
+    from ..workbook.sweep import write_sweep
+
     shot = Shot.from_workbook(args.shot)
     varies = [parse_vary(v) for v in args.vary]
     sds = [parse_sd(s) for s in args.sd]

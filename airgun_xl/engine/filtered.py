@@ -14,7 +14,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-HOSTS = ("excel", "calc")
+from .. import choices
+
+HOSTS = choices.HOSTS
 
 
 @dataclass

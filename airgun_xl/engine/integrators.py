@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import choices
 from ..errors import CellError, DivergenceError, OptionError
 from .kernel import legacy_kernel, newmark_kernel
 
@@ -95,7 +96,7 @@ class History:
 
 
 #: The step values an integrator can record, in :class:`History` order.
-TRACKED = ("crush_factor", "m31", "deflection", "x_plastic", "force", "m1", "v1", "v31")
+TRACKED = choices.TRACKED
 
 
 def displacement_bound(p):

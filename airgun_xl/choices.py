@@ -1,0 +1,27 @@
+"""The names a user can choose, in one light module (no numpy, no workbook libraries).
+
+The CLI builds its parser from these before anything heavy loads, so ``airgun-xl history``
+or ``--help`` starts without the engine and the workbook libraries. The modules that implement
+each choice import their names from here (and a test checks that they implement all of them).
+"""
+
+#: Integrators (``airgun_xl.engine.integrators.INTEGRATORS``).
+INTEGRATORS = ("legacy", "newmark")
+
+#: Models (``airgun_xl.models``).
+MODELS = ("4-mass", "rigid")
+
+#: Whose Offset rounding the filtered column reproduces (``airgun_xl.engine.filtered``).
+HOSTS = ("excel", "calc")
+
+#: Step values an integrator can record, in ``History`` order.
+TRACKED = ("crush_factor", "m31", "deflection", "x_plastic", "force", "m1", "v1", "v31")
+
+#: When a fill writes the full history beside the workbook.
+SIDECAR_MODES = ("auto", "always", "never")
+
+#: Parameters ``design`` can solve for (``airgun_xl.design.VARIABLES``).
+DESIGN_VARIABLES = ("A28", "E13", "E16", "E40", "A2")
+
+#: The environment variable that names the default archive folder.
+ARCHIVE_ENV = "AIRGUN_XL_ARCHIVE"
