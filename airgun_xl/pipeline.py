@@ -8,7 +8,7 @@ from pathlib import Path
 
 from . import __version__
 from .archive import Archive
-from .archiving import prepare_entry
+from .archive.entry import prepare_entry
 from .checks import after_run, before_run, crush_reached, unstable_crush_message
 from .engine.summary import summarize
 from .errors import DivergenceError, StabilityError

@@ -92,7 +92,7 @@ def print_summary(output, filled):
 
 
 def run(args):
-    from ..archiving import now, shot_name
+    from ..archive.entry import now, shot_name
     from ..pipeline import ArchiveRequest, Options, fill_workbook
     from ..shot import Shot
     from . import note, warn

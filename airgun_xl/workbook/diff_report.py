@@ -2,9 +2,9 @@
 curves with their difference."""
 import numpy as np
 
-from ..charts import nice_range
 from ..engine.decimate import minmax_indices
 from ..transaction import atomic_path, check_output
+from .charts import nice_range
 from .columns_sheet import ColumnsWorksheet
 from .page_setup import one_page
 from .sheets import write_number_columns

@@ -30,11 +30,11 @@ import xlsxwriter
 from xlsxwriter.utility import xl_rowcol_to_cell
 
 from ..cells import PARAMETER_COLUMNS
-from ..charts import add_charts, series_data
 from ..engine.summary import summarize
 from ..errors import OutputError
 from ..outputs import SHEET_NAME, Outputs
 from ..transaction import atomic_path, check_output, display
+from .charts import add_charts, series_data
 from .columns_sheet import ColumnsWorksheet, fast_deflate
 from .formula_eval import Evaluator, FormulaFailure
 from .page_setup import not_printed, one_page

@@ -1,4 +1,4 @@
-"""An archive of shots: every run kept with its inputs, outputs and provenance.
+"""The archive's store: folders, index, entries, and their transactions.
 
 Layout of an archive folder::
 
@@ -35,9 +35,9 @@ import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
-from .choices import ARCHIVE_ENV
-from .errors import ArchiveError, OptionError
-from .transaction import display, owner_alive, owner_token
+from ..choices import ARCHIVE_ENV
+from ..errors import ArchiveError, OptionError
+from ..transaction import display, owner_alive, owner_token
 
 ENV = ARCHIVE_ENV
 INDEX = "index.sqlite"

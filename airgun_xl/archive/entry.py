@@ -7,11 +7,11 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
-from .archive import safe_name
-from .cells import CELLS
-from .transaction import display
-from .workbook.sidecar import have_parquet, render_history
+from .. import __version__
+from ..cells import CELLS
+from ..transaction import display
+from ..workbook.sidecar import have_parquet, render_history
+from .store import safe_name
 
 LIBRARIES = ("numpy", "pandas", "openpyxl", "xlsxwriter", "formulas", "python-calamine",
              "scipy", "pyarrow", "matplotlib")

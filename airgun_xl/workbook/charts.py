@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .engine.summary import KG, PEAK_MIN_HZ, SPECTRUM_MAX_HZ
-from .workbook.page_setup import one_page
+from ..engine.summary import KG, PEAK_MIN_HZ, SPECTRUM_MAX_HZ
+from .page_setup import one_page
 
 #: Most points a chart series references; spreadsheet apps slow down well before 100,000.
 POINT_BUDGET = 20_000

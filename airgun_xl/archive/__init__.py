@@ -1,0 +1,23 @@
+"""The archive of shots: every run kept with its inputs, outputs and provenance.
+
+- :mod:`.store`: the folder, its SQLite index, entries and how they are committed (light: the
+  standard library only, so ``history`` and ``show`` start fast);
+- :mod:`.entry`: what a fill puts in an entry (imported by the fill when it archives).
+"""
+from .store import (
+    ENV,
+    FORMAT,
+    INDEX,
+    MANIFEST,
+    MARKER,
+    SCRATCH,
+    Archive,
+    Entry,
+    PendingEntry,
+    archive_dir,
+    safe_name,
+    sha256,
+)
+
+__all__ = ["ENV", "FORMAT", "INDEX", "MANIFEST", "MARKER", "SCRATCH", "Archive", "Entry",
+           "PendingEntry", "archive_dir", "safe_name", "sha256"]
