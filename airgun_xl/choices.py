@@ -20,7 +20,7 @@ TRACKED = ("crush_factor", "m31", "deflection", "x_plastic", "force", "m1", "v1"
 #: When a fill writes the full history beside the workbook.
 SIDECAR_MODES = ("auto", "always", "never")
 
-#: Parameters ``design`` can solve for (``airgun_xl.design.VARIABLES``).
+#: Parameters ``design`` can solve for (``airgun_xl.studies.design.VARIABLES``).
 DESIGN_VARIABLES = ("A28", "E13", "E16", "E40", "A2")
 
 #: The environment variable that names the default archive folder.

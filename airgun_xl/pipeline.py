@@ -9,11 +9,11 @@ from pathlib import Path
 from . import __version__
 from .archive import Archive
 from .archive.entry import prepare_entry
-from .checks import after_run, before_run, crush_reached, unstable_crush_message
 from .engine.summary import summarize
 from .errors import DivergenceError, StabilityError
 from .limits import check_memory, fill_bytes
 from .models import apply_model
+from .studies.check import after_run, before_run, crush_reached, unstable_crush_message
 from .transaction import Publication, check_output, display
 from .workbook.sidecar import SIDECAR_SUFFIXES, render_history, sidecar_path
 from .workbook.writer import render_workbook

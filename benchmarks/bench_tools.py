@@ -24,7 +24,7 @@ def bench_convergence(repeat, tmp):
 
 def bench_design(repeat, tmp):
     import airgun_xl
-    from airgun_xl.design import VARIABLES, solve_peak
+    from airgun_xl.studies.design import VARIABLES, solve_peak
 
     p = airgun_xl.load(TEMPLATE).params
     solve_peak(p, 8.0, VARIABLES["A28"])  # imports scipy, warms caches

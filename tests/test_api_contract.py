@@ -82,8 +82,8 @@ def test_the_parser_loads_nothing_heavy():
 
 def test_choices_name_what_the_modules_implement():
     from airgun_xl import choices
-    from airgun_xl.design import VARIABLES
     from airgun_xl.engine.integrators import INTEGRATORS
+    from airgun_xl.studies.design import VARIABLES
 
     assert tuple(INTEGRATORS) == choices.INTEGRATORS
     assert tuple(VARIABLES) == choices.DESIGN_VARIABLES

@@ -9,7 +9,6 @@ from conftest import TEMPLATE
 import airgun_xl
 from airgun_xl import Shot
 from airgun_xl.cli import main
-from airgun_xl.design import VARIABLES, solve_peak
 from airgun_xl.engine.batch import FIGURES, run_batch
 from airgun_xl.engine.summary import summarize
 from airgun_xl.errors import DesignError, OptionError
@@ -20,6 +19,7 @@ from airgun_xl.stiffness import (
     damping_coefficient,
     stiffness_from_frequency,
 )
+from airgun_xl.studies.design import VARIABLES, solve_peak
 from airgun_xl.units import parse_duration, parse_peak
 
 SHOT_A = airgun_xl.load(TEMPLATE).params  # dt = 0.5 us, as the acceptance asks

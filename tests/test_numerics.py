@@ -11,10 +11,10 @@ from conftest import TEMPLATE
 import airgun_xl
 from airgun_xl import Shot, ShotParams
 from airgun_xl.cli import main
-from airgun_xl.engine.convergence import default_ladder, ladder, parse_duration
 from airgun_xl.engine.integrators import run_legacy
 from airgun_xl.engine.stability import critical_time_step
 from airgun_xl.errors import DivergenceError, OptionError
+from airgun_xl.studies.convergence import default_ladder, ladder, parse_duration
 
 SHOT_A = airgun_xl.load(TEMPLATE).params
 

@@ -14,9 +14,9 @@ def add_parser(sub):
 
 
 def run(args):
-    from ..checks import before_run
     from ..engine.stability import compacted_length, full_length
     from ..shot import Shot
+    from ..studies.check import before_run
 
     shot = Shot.from_workbook(args.shot)
     p = shot.params

@@ -27,8 +27,8 @@ def add_parser(sub):
 
 
 def run(args):
-    from ..engine.convergence import default_ladder, ladder, parse_duration
     from ..shot import Shot
+    from ..studies.convergence import default_ladder, ladder, parse_duration
     from ..workbook.convergence import write_convergence
     from . import warn
 

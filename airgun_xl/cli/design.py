@@ -47,9 +47,9 @@ def _range(text):
 
 
 def run(args):
-    from ..design import solve_peak, solve_peak_and_duration, variable
     from ..pipeline import Options, fill_workbook
     from ..shot import Shot
+    from ..studies.design import solve_peak, solve_peak_and_duration, variable
     from . import note, warn
     from .progress import Progress
 

@@ -42,7 +42,7 @@ def _progress_bar(total):
 
 def run(args):
     from ..shot import Shot
-    from ..sweeps import grid, monte_carlo, parse_sd, parse_vary, spread
+    from ..studies.sweep import grid, monte_carlo, parse_sd, parse_vary, spread
     from ..workbook.sweep import write_sweep
 
     shot = Shot.from_workbook(args.shot)

@@ -1,8 +1,8 @@
 """The convergence workbook (table and a log-log chart) and its PNG."""
 import math
 
-from ..engine.convergence import QUANTITIES
 from ..errors import OutputError
+from ..studies.convergence import QUANTITIES
 from ..transaction import Publication, display
 from .writer import close_workbook, new_workbook
 

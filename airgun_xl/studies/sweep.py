@@ -6,11 +6,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import limits
-from .cells import BY_ADDRESS, CELLS
-from .engine.batch import FIGURES, run_batch
-from .errors import AirgunXlError, OptionError
-from .models import apply_model
+from .. import limits
+from ..cells import BY_ADDRESS, CELLS
+from ..engine.batch import FIGURES, run_batch
+from ..errors import AirgunXlError, OptionError
+from ..models import apply_model
 
 #: Cells whose value moves several fields: the bird's velocity goes to A28..A30 together.
 GROUPED = {"A28": ("v31", "v32", "v33")}

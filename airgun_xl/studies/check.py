@@ -3,9 +3,9 @@ stretched past what it was built for. Each finding names the cell that causes it
 import math
 from dataclasses import dataclass
 
-from .cells import BY_ADDRESS
-from .engine.legacy_law import CRUSH_FIT_RANGE, crush_factor
-from .engine.stability import WARN_RATIO, critical_time_step, full_length
+from ..cells import BY_ADDRESS
+from ..engine.legacy_law import CRUSH_FIT_RANGE, crush_factor
+from ..engine.stability import WARN_RATIO, critical_time_step, full_length
 
 #: Bird masses differing by this factor or more make a stiff, badly scaled system.
 MASS_RATIO_WARNING = 1e6

@@ -10,8 +10,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..engine.summary import summarize
 from ..units import parse_duration as _parse
-from .summary import summarize
 
 #: Figures compared across levels: (attribute of the level, label, unit).
 QUANTITIES = (

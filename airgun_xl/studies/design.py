@@ -10,9 +10,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .engine.batch import run_batch
-from .errors import DesignError, OptionError
-from .models import apply_model
+from ..engine.batch import run_batch
+from ..errors import DesignError, OptionError
+from ..models import apply_model
 
 
 @dataclass(frozen=True)
@@ -34,8 +34,6 @@ class Variable:
     def bounds(self, p):
         lo, hi = self.range
         if self.relative and self.value(p) == 0:
-            from .errors import OptionError
-
             raise OptionError(f"--range: {self.cell} is 0 on the sheet, so the default range "
                               f"(x{lo:g} to x{hi:g} of it) is empty; expected --range LO:HI")
         return (lo * self.value(p), hi * self.value(p)) if self.relative else (lo, hi)
@@ -204,7 +202,7 @@ def design_warnings(p, target_kg, achieved):
     if abs(achieved - target_kg) > 1e-3 * abs(target_kg):
         out.append(f"the peak jumps across the target here: {achieved:.5g} kG is the closest "
                    "this parameter reaches")
-    from .checks import impact_speed_finding
+    from .check import impact_speed_finding
 
     speed = impact_speed_finding(p)
     if speed is not None:  # the words the fill of the designed shot uses too
