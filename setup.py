@@ -13,9 +13,14 @@ from setuptools import Extension, setup
 FLAGS = ["/fp:precise"] if sys.platform == "win32" else ["-O2", "-ffp-contract=off",
                                                           "-fno-fast-math"]
 
+
+def extension(name, source):
+    return Extension(name, [source], extra_compile_args=FLAGS, optional=True,
+                     py_limited_api=True, define_macros=[("Py_LIMITED_API", "0x030B0000")])
+
+
 setup(
-    ext_modules=[Extension("airgun_xl.engine._artsim", ["airgun_xl/engine/_artsim.c"],
-                           extra_compile_args=FLAGS, optional=True, py_limited_api=True,
-                           define_macros=[("Py_LIMITED_API", "0x030B0000")])],
+    ext_modules=[extension("airgun_xl.engine._artsim", "airgun_xl/engine/_artsim.c"),
+                 extension("airgun_xl.workbook._sheet_xml", "airgun_xl/workbook/_sheet_xml.c")],
     options={"bdist_wheel": {"py_limited_api": "cp311"}},
 )

@@ -76,13 +76,17 @@ def test_batch_bit_for_bit(integrator):
         assert _same(x, z)
 
 
-def test_render_cells_bit_for_bit():
+def test_sheet_xml_python_twin_writes_the_same_text():
+    from airgun_xl.workbook import sheet_xml
+
+    compiled_xml = pytest.importorskip("airgun_xl.workbook._sheet_xml")
     rng = np.random.default_rng(5)
     values = np.concatenate([rng.normal(size=200) * 10.0 ** rng.integers(-300, 300, 200),
                              [0.0, -0.0, 5e-324, 1.7976931348623157e308, 0.1, 1e-5, 123456.0]])
-    assert compiled.render_cells("AB", 7, values) == ref.render_cells("AB", 7, values)
+    assert compiled_xml.render_cells("AB", 7, values) == sheet_xml.render_cells_python(
+        "AB", 7, values)
     with pytest.raises(ValueError):
-        ref.render_cells("A", 1, np.array([1.0, np.nan]))
+        sheet_xml.render_cells_python("A", 1, np.array([1.0, np.nan]))
 
 
 def test_pure_fill_matches_the_macro(tmp_path):
@@ -90,9 +94,10 @@ def test_pure_fill_matches_the_macro(tmp_path):
     two legacy cases equals the macro's output to the legacy rule (1e-12 of each column)."""
     env = dict(os.environ, AIRGUN_XL_PURE="1")
     probe = subprocess.run([sys.executable, "-c", "from airgun_xl.engine import kernel; "
-                            "print(kernel.COMPILED)"], env=env, capture_output=True, text=True,
-                           check=True)
-    assert probe.stdout.strip() == "False"
+                            "from airgun_xl.workbook import sheet_xml; "
+                            "print(kernel.COMPILED, sheet_xml.COMPILED)"], env=env,
+                           capture_output=True, text=True, check=True)
+    assert probe.stdout.strip() == "False False"
     for name in ("shot_a_appendix_5us", "mem_faster_clamp"):
         case = CASES[name]
         out = tmp_path / f"{name}.xlsx"

@@ -298,13 +298,3 @@ def batch_kernel(params, rows, integrator, last, t, y, finals):
         y[i, :] = 0.0
         n = cols.written
         y[i, :n] = cols.y[last][:n]
-
-
-def render_cells(column, first_row, values):
-    """As ``_artsim.render_cells``: '<c r="I5"><v>...</v></c>' per value, 17 digits."""
-    out = []
-    for i, x in enumerate(values.tolist() if hasattr(values, "tolist") else values):
-        if not math.isfinite(x):
-            raise ValueError(f"values must be finite (index {i})")
-        out.append(f'<c r="{column}{first_row + i}"><v>{x:.17g}</v></c>')
-    return out

@@ -12,11 +12,10 @@ PURE = os.environ.get("AIRGUN_XL_PURE", "").strip() not in ("", "0")
 try:
     if PURE:
         raise ImportError("AIRGUN_XL_PURE is set")
-    from ._artsim import batch_kernel, legacy_kernel, newmark_kernel, render_cells
+    from ._artsim import batch_kernel, legacy_kernel, newmark_kernel
     COMPILED = True
 except ImportError:
-    from ._reference import batch_kernel, legacy_kernel, newmark_kernel, render_cells
+    from ._reference import batch_kernel, legacy_kernel, newmark_kernel
     COMPILED = False
 
-__all__ = ["COMPILED", "PURE", "batch_kernel", "legacy_kernel", "newmark_kernel",
-           "render_cells"]
+__all__ = ["COMPILED", "PURE", "batch_kernel", "legacy_kernel", "newmark_kernel"]

@@ -5,7 +5,7 @@ xlsxwriter stores every cell as an object and writes it through a generic per-ce
 fill. :class:`ColumnsWorksheet` keeps numeric columns as arrays and renders them straight into
 the ``<row>`` elements when xlsxwriter writes the sheet; everything else (labels, formulas,
 sparse cells) still goes through xlsxwriter. Numbers are rendered in C
-(``_artsim.render_cells``) with 17 significant digits, so every double reads back exactly
+(``sheet_xml.render_cells``) with 17 significant digits, so every double reads back exactly
 (xlsxwriter itself keeps 16).
 
 It hooks ``Worksheet._write_rows``, an xlsxwriter internal; the legacy comparison tests read
@@ -21,8 +21,8 @@ import xlsxwriter.workbook
 import xlsxwriter.worksheet
 from xlsxwriter.utility import xl_col_to_name
 
-from ..engine.kernel import render_cells
 from .safe_text import SafeWorksheet
+from .sheet_xml import render_cells
 
 #: The xlsxwriter internals the fast path overrides or calls. They are there in every version
 #: pyproject.toml allows (3.1.9 .. 3.x; CI runs the lowest and the newest); where one is
