@@ -7,6 +7,11 @@ Load a shot from a workbook in the report's layout, run it, and get the result::
     result = shot.run()
     frame = result.to_frame()
 """
+from __future__ import annotations
+
+import os
+from typing import TYPE_CHECKING
+
 __version__ = "0.1.0"
 
 from .errors import (
@@ -22,12 +27,17 @@ from .errors import (
     WorkbookError,
 )
 
+if TYPE_CHECKING:
+    from .params import ShotParams
+    from .result import Result
+    from .shot import Shot
+
 #: Loaded on first use (PEP 562), so that ``airgun-xl`` can set up its signal handling before
 #: numpy and the engine load.
 _LAZY = {"ShotParams": "params", "Result": "result", "Shot": "shot"}
 
 
-def __getattr__(name):
+def __getattr__(name: str) -> object:
     if name in _LAZY:
         import importlib
 
@@ -37,7 +47,7 @@ def __getattr__(name):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-def load(path):
+def load(path: str | os.PathLike[str]) -> Shot:
     """Read a :class:`Shot` from a workbook (see :meth:`Shot.from_workbook`)."""
     from .shot import Shot
 

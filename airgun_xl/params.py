@@ -4,7 +4,10 @@
 with the sign conventions of the legacy sheet. :func:`check_value` and :meth:`ShotParams.check`
 are the only input checks; readers and the API call them, the kernel trusts them.
 """
+from __future__ import annotations
+
 import math
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields, replace
 
 from .cells import BY_NAME, CELLS, MAX_STEPS, expectation
@@ -155,7 +158,7 @@ class ShotParams:
     v33: float
 
     @classmethod
-    def from_cells(cls, raw_by_address):
+    def from_cells(cls, raw_by_address: Mapping[str, object]) -> ShotParams:
         """Build from raw cell values keyed by address; every value is checked.
 
         Raises
@@ -175,10 +178,10 @@ class ShotParams:
                   for c in CELLS}
         return cls(**values)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         self.check()  # a ShotParams is always checked: built, replaced or read
 
-    def check(self):
+    def check(self) -> ShotParams:
         """Check each field and the relations between fields; return self.
 
         Raises
@@ -207,7 +210,7 @@ class ShotParams:
         return self
 
     @property
-    def bird_masses(self):
+    def bird_masses(self) -> int:
         """Masses in the bird's chain: 3 (ArtSim), 2 (no test item) or 1 (OBR as one mass).
 
         A left-out mass and its spring are 0; any other zero is caught by :meth:`check`.
@@ -217,14 +220,14 @@ class ShotParams:
         return 3
 
     @property
-    def model(self):
+    def model(self) -> str:
         """Which model runs, in words."""
         return {3: "4-mass (ArtSim: MEM, OBR front plate, OBR back plate, test item)",
                 2: "3-mass (no test item: MEM, OBR front plate, OBR back plate)",
                 1: "2-mass (OBR as one mass: MEM, OBR)"}[self.bird_masses]
 
     @property
-    def rows(self):
+    def rows(self) -> int:
         """Number of time rows the macro writes (t = -delta first).
 
         The macro's ``For i = 1 To delCounter + 2`` compares the counter with the double
@@ -233,13 +236,13 @@ class ShotParams:
         return math.floor(self.max_time / self.delta + 2)
 
     @property
-    def samplerate(self):
+    def samplerate(self) -> float:
         """Rows between filtered samples, ``1/(E2*E34)``, a double as in the macro."""
         return 1 / (self.delta * self.filter_frequency)
 
-    def replace(self, **changes):
+    def replace(self, **changes: float) -> ShotParams:
         """A copy with some fields changed, checked again (on construction)."""
         return replace(self, **changes)
 
-    def as_dict(self):
+    def as_dict(self) -> dict[str, float]:
         return asdict(self)

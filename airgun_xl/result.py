@@ -1,7 +1,20 @@
 """The result of a run: the macro's columns and the step values, as arrays and DataFrames."""
+from __future__ import annotations
+
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    import os
+
+    import pandas as pd
+
+    from .engine.filtered import Filtered
+    from .engine.integrators import History
+    from .params import ShotParams
+    from .shot import Shot
 
 #: DataFrame column -> unit, in the order of :meth:`Result.to_frame`.
 FRAME_UNITS = {
@@ -33,28 +46,28 @@ class Result:
         The model variant that produced it (``4-mass`` or ``rigid``).
     """
 
-    shot: object
+    shot: Shot
     integrator: str
-    history: object
+    history: History
     accel: np.ndarray
     velocity: np.ndarray
     accel_kg: np.ndarray
-    filtered: object
-    warnings: list
+    filtered: Filtered
+    warnings: list[str]
     run_seconds: float = float("nan")
     model: str = "4-mass"  # which model variant produced it (airgun_xl.models)
 
     @property
-    def params(self):
+    def params(self) -> ShotParams:
         return self.shot.params
 
     @property
-    def rows(self):
+    def rows(self) -> int:
         """Number of time rows (the sheet's rows 2..rows+1)."""
         return len(self.history.time)
 
     @property
-    def filtered_column(self):
+    def filtered_column(self) -> np.ndarray:
         """Filtered acceleration per row [m/s^2], NaN where the macro leaves AB empty."""
         out = np.full(self.rows, np.nan)
         inside = self.filtered.rows < self.rows
@@ -62,18 +75,18 @@ class Result:
         return out
 
     @property
-    def peak_kg(self):
+    def peak_kg(self) -> float:
         """Largest value of the Acceleration (kG's) column."""
         return float(np.nanmax(self.accel_kg)) if np.isfinite(self.accel_kg).any() else np.nan
 
     @property
-    def time_of_peak(self):
+    def time_of_peak(self) -> float:
         """Time of :attr:`peak_kg` [s] (first row if it repeats)."""
         if not np.isfinite(self.accel_kg).any():
             return np.nan
         return float(self.history.time[int(np.nanargmax(self.accel_kg))])
 
-    def frame_columns(self):
+    def frame_columns(self) -> dict[str, np.ndarray | None]:
         """Per-row arrays by :data:`FRAME_UNITS` name (None for series not tracked)."""
         h = self.history
         return {
@@ -84,7 +97,7 @@ class Result:
             "filtered_accel": self.filtered_column,
         }
 
-    def to_frame(self):
+    def to_frame(self) -> pd.DataFrame:
         """All per-row values as a pandas DataFrame indexed by time [s].
 
         Columns are those of :data:`FRAME_UNITS` (``v1``, ``v31``: MEM and OBR front plate
@@ -99,7 +112,8 @@ class Result:
         frame.attrs["integrator"] = self.integrator
         return frame
 
-    def write(self, path, force=False, **options):
+    def write(self, path: str | os.PathLike[str], force: bool = False,
+              **options: Any) -> list[str]:
         """Write the workbook (see :func:`airgun_xl.workbook.writer.write_workbook`)."""
         from .workbook.writer import write_workbook
 

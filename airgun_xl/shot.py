@@ -1,7 +1,12 @@
 """The hub objects: a :class:`Shot` (parameters and where they came from) runs into a
 :class:`airgun_xl.result.Result`, which the writers turn into files."""
+from __future__ import annotations
+
+import os
 import time
+from collections.abc import Collection
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 from .choices import HOSTS, TRACKED
 from .engine import filtered_acceleration, get_integrator, test_item_derivatives
@@ -9,13 +14,19 @@ from .errors import OptionError
 from .limits import check_memory, fill_bytes
 from .params import ShotParams
 
+if TYPE_CHECKING:
+    import numpy as np
 
-def last_mass(history, p):
+    from .engine.integrators import History
+    from .result import Result
+
+
+def last_mass(history: History, p: ShotParams) -> np.ndarray:
     """Displacement of the bird's last mass: Y33, or Y32 / Y31 for a reduced model."""
     return (history.y31, history.y32, history.y33)[p.bird_masses - 1]
 
 
-def check_run_options(host, track):
+def check_run_options(host: str, track: Collection[str]) -> None:
     """``host`` is one of :data:`HOSTS` and ``track`` holds names of ``TRACKED`` only.
 
     Raises
@@ -47,11 +58,11 @@ class Shot:
     """
 
     params: ShotParams
-    source: object = None
-    warnings: list = field(default_factory=list)
+    source: Any = None
+    warnings: list[str] = field(default_factory=list)
 
     @classmethod
-    def from_workbook(cls, path):
+    def from_workbook(cls, path: str | os.PathLike[str]) -> Shot:
         """Read a shot from a workbook in the report's layout.
 
         Raises
@@ -65,11 +76,12 @@ class Shot:
         params, source, warnings = read_params(path)
         return cls(params, source, warnings)
 
-    def with_params(self, **changes):
+    def with_params(self, **changes: float) -> Shot:
         """The same shot with some parameters changed (checked again)."""
         return Shot(self.params.replace(**changes), self.source, list(self.warnings))
 
-    def run(self, integrator="legacy", host="excel", track=TRACKED):
+    def run(self, integrator: str = "legacy", host: str = "excel",
+            track: Collection[str] = TRACKED) -> Result:
         """Time-step the shot and derive the macro's columns.
 
         Parameters

@@ -1,0 +1,26 @@
+"""Issue 11: the public API's type hints hold (mypy, configured in pyproject.toml)."""
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_mypy_passes_on_the_public_api():
+    done = subprocess.run([sys.executable, "-m", "mypy"], cwd=ROOT, capture_output=True,
+                          text=True, timeout=600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "Success: no issues found in 6 source files" in done.stdout
+
+
+def test_mypy_catches_a_wrong_call(tmp_path):
+    """The check can fail: a script passing a number as the workbook path is an error."""
+    script = tmp_path / "use.py"
+    script.write_text("import airgun_xl\n"
+                      "shot = airgun_xl.load(42)\n"
+                      "peak: float = shot.run(track=()).peak_kg\n")
+    done = subprocess.run([sys.executable, "-m", "mypy", "--follow-imports=silent",
+                           "--ignore-missing-imports", str(script)], cwd=ROOT,
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 1 and 'Argument 1 to "load" has incompatible type "int"' in \
+        done.stdout, done.stdout
