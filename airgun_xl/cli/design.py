@@ -7,6 +7,7 @@ from ..choices import DESIGN_VARIABLES, INTEGRATORS, MODELS
 from ..errors import OptionError
 from ..outputs import from_sheet
 from ..units import parse_duration, parse_peak
+from .cluster_options import add_cluster_options, cluster_runner
 from .fill import print_summary
 
 
@@ -33,6 +34,7 @@ def add_parser(sub):
     p.add_argument("-o", "--output", metavar="OUT.xlsx",
                    help="designed shot, filled (default: SHOT.design.xlsx)")
     p.add_argument("--force", action="store_true")
+    add_cluster_options(p)
     p.set_defaults(run=run)
 
 
@@ -69,12 +71,14 @@ def run(args):
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".design.xlsx")
     started = time.perf_counter()
-    if duration is None:
-        design = solve_peak(shot.params, target, variables[0], args.filtered, args.integrator,
-                            args.model, bounds)
-    else:
-        design = solve_peak_and_duration(shot.params, target, duration, *variables,
-                                         args.filtered, args.integrator, args.model)
+    with cluster_runner(args) as runner:
+        if duration is None:
+            design = solve_peak(shot.params, target, variables[0], args.filtered,
+                                args.integrator, args.model, bounds, runner=runner)
+        else:
+            design = solve_peak_and_duration(shot.params, target, duration, *variables,
+                                             args.filtered, args.integrator, args.model,
+                                             runner=runner)
     solve_seconds = time.perf_counter() - started
     for var, value in zip(design.variables, design.values):
         print(f"{var.cell}{'..A30' if var.cell == 'A28' else ''} = {value:.6g} {var.unit}")

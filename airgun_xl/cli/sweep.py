@@ -7,6 +7,7 @@ from .. import limits
 from ..choices import INTEGRATORS, MODELS
 from ..errors import OptionError
 from ..transaction import check_output
+from .cluster_options import add_cluster_options, cluster_runner
 
 
 def add_parser(sub):
@@ -21,12 +22,16 @@ def add_parser(sub):
     p.add_argument("--mc", metavar="N", help="Monte Carlo: this many shots")
     p.add_argument("--sd", action="append", metavar="CELL=SD[%]", default=[],
                    help="spread of an uncertain input, e.g. E40=3%% (Monte Carlo)")
-    p.add_argument("--seed", type=int, default=None, help="random seed (Monte Carlo)")
+    p.add_argument("--sobol", metavar="N",
+                   help="Sobol indices of the peak, pulse and crush to the --sd inputs "
+                        "(SALib): N (a power of 2) x (inputs + 2) shots")
+    p.add_argument("--seed", type=int, default=None, help="random seed (Monte Carlo, Sobol)")
     p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
     p.add_argument("--model", choices=MODELS, default="4-mass")
     p.add_argument("-o", "--output", metavar="OUT.xlsx",
                    help="table and charts (default: SHOT.sweep.xlsx)")
     p.add_argument("--force", action="store_true")
+    add_cluster_options(p)
     p.set_defaults(run=run)
 
 
@@ -42,33 +47,38 @@ def _progress_bar(total):
 
 def run(args):
     from ..shot import Shot
+    from ..studies.sensitivity import sobol
     from ..studies.sweep import grid, monte_carlo, parse_sd, parse_vary, spread
     from ..workbook.sweep import write_sweep
 
     shot = Shot.from_workbook(args.shot)
     varies = [parse_vary(v) for v in args.vary]
     sds = [parse_sd(s) for s in args.sd]
-    if args.mc is not None:
+    if args.mc is not None and args.sobol is not None:
+        raise OptionError("--sobol: found it with --mc, expected one or the other")
+    random = "--mc" if args.mc is not None else "--sobol" if args.sobol is not None else None
+    if random is not None:
+        text = args.mc if args.mc is not None else args.sobol
         try:
-            n = int(args.mc)
+            n = int(text)
         except ValueError:
             n = 0
         if n < 2 or n > limits.MAX_SHOTS or not sds:
-            raise OptionError(f"--mc: found {args.mc!r}{'' if sds else ' without --sd'}, "
+            raise OptionError(f"{random}: found {text!r}{'' if sds else ' without --sd'}, "
                               f"expected a number of shots from 2 to {limits.MAX_SHOTS:,}, "
                               "with --sd")
         if args.seed is not None and not 0 <= args.seed < 2**128:
             raise OptionError(f"--seed: found {args.seed}, expected a whole number from 0 "
                               "to 2**128 - 1")
         if varies:
-            raise OptionError("--vary: found a grid with --mc, expected one or the other")
+            raise OptionError(f"--vary: found a grid with {random}, expected one or the other")
     elif not varies:
         raise OptionError("--vary: found none, expected CELL=LO:HI:N (or --mc N with --sd)")
     shot_path = Path(args.shot)
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".sweep.xlsx")
     check_output(output, args.force, inputs=[args.shot])
-    total = n if args.mc is not None else 1
+    total = n if args.mc is not None else n * (len(sds) + 2) if args.sobol is not None else 1
     for _, _, values in varies:
         total *= len(values)
     if total > limits.MAX_SHOTS:
@@ -77,24 +87,37 @@ def run(args):
     limits.check_memory(limits.sweep_bytes(total, shot.params.rows),
                         f"a sweep of {total:,} shots of {shot.params.rows:,} rows",
                         "fewer shots (--mc, or fewer points per --vary) or fewer rows")
-    bar, progress = _progress_bar(total)
     started = time.perf_counter()
-    try:
-        if args.mc is not None:
-            result = monte_carlo(shot.params, sds, n, args.seed, args.integrator, args.model,
-                                 progress)
-        else:
-            result = grid(shot.params, varies, args.integrator, args.model, progress)
-    finally:
-        if bar is not None:
-            bar.close()
+    with cluster_runner(args) as runner:
+        bar, progress = _progress_bar(total)
+        try:
+            sensitivity = None
+            if args.mc is not None:
+                result = monte_carlo(shot.params, sds, n, args.seed, args.integrator,
+                                     args.model, progress, runner)
+            elif args.sobol is not None:
+                sensitivity = sobol(shot.params, sds, n, args.seed, args.integrator,
+                                    args.model, progress, runner)
+                result = sensitivity.shots
+            else:
+                result = grid(shot.params, varies, args.integrator, args.model, progress,
+                              runner)
+        finally:
+            if bar is not None:
+                bar.close()
     seconds = time.perf_counter() - started
     stats = spread(result.figures[:, 0])
-    write_sweep(result, output, args.force, stats if args.mc is not None else None)
+    write_sweep(result, output, args.force, stats if args.mc is not None else None,
+                sensitivity)
     steps = total * (shot.params.rows - 2)
     print(f"wrote {output}: {total:,} shots in {seconds:.2f} s ({steps / seconds:.3g} "
           f"shot-steps/s); {int(result.diverged.sum())} diverged, "
           f"{int(result.invalid.sum())} invalid")
     print(f"  peak {stats['mean']:.4f} kG mean, sd {stats['sd']:.4f}, 5-95% "
           f"{stats['p5']:.4f}-{stats['p95']:.4f} kG")
+    if sensitivity is not None:
+        found = sensitivity.indices["peak_kg"]
+        print("  Sobol indices of the peak: " + ", ".join(
+            f"{cell} S1 {s1:.3f} ST {st:.3f}" for cell, s1, st in
+            zip(sensitivity.cells, found["S1"], found["ST"])))
     return 0

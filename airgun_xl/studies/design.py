@@ -80,14 +80,15 @@ class Design:
 class _Objective:
     """Figures of the shot at parameter values, counting simulations."""
 
-    def __init__(self, p, integrator, model, filtered):
+    def __init__(self, p, integrator, model, filtered, runner=None):
         self.p, self.integrator, self.model = p, integrator, model
+        self.runner = runner or run_batch
         self.column = 2 if filtered else 0
         self.evaluations = 0
 
     def figures(self, params_list):
         self.evaluations += len(params_list)
-        batch = run_batch([apply_model(q, self.model) for q in params_list], self.integrator)
+        batch = self.runner([apply_model(q, self.model) for q in params_list], self.integrator)
         return batch.figures
 
     def peak(self, params):
@@ -114,7 +115,7 @@ def _span_message(var, p, xs, ys, what):
 
 
 def solve_peak(p, target_kg, var, filtered=False, integrator="legacy", model="4-mass",
-               bounds=None, objective=None):
+               bounds=None, objective=None, runner=None):
     """The value of ``var`` that gives a peak of ``target_kg``.
 
     Parameters
@@ -127,6 +128,8 @@ def solve_peak(p, target_kg, var, filtered=False, integrator="legacy", model="4-
         Match the filtered peak instead of the raw one.
     bounds : (float, float), optional
         Search range; :attr:`Variable.range` by default.
+    runner : callable, optional
+        Runs batches of shots: ``run_batch`` here, or a ``ClusterRunner``.
 
     Returns
     -------
@@ -139,7 +142,7 @@ def solve_peak(p, target_kg, var, filtered=False, integrator="legacy", model="4-
     """
     from scipy.optimize import brentq
 
-    obj = objective or _Objective(p, integrator, model, filtered)
+    obj = objective or _Objective(p, integrator, model, filtered, runner)
     lo, hi = bounds or var.bounds(p)
     xs = np.linspace(lo, hi, SCAN_POINTS)
     ys = obj.figures([var.apply(p, x) for x in xs])[:, obj.column]
@@ -159,12 +162,12 @@ def solve_peak(p, target_kg, var, filtered=False, integrator="legacy", model="4-
 
 
 def solve_peak_and_duration(p, target_kg, target_s, var1, var2, filtered=False,
-                            integrator="legacy", model="4-mass"):
+                            integrator="legacy", model="4-mass", runner=None):
     """Two parameters for a peak and a pulse duration: ``var1`` meets the peak for each
     value of ``var2``, and brentq on ``var2`` meets the duration."""
     from scipy.optimize import brentq
 
-    obj = _Objective(p, integrator, model, filtered)
+    obj = _Objective(p, integrator, model, filtered, runner)
 
     def duration_at(v2):
         design = solve_peak(var2.apply(p, v2), target_kg, var1, filtered, integrator, model,

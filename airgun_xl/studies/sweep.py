@@ -66,7 +66,7 @@ def _set(p, fields, value):
     return p.replace(**{f: float(value) for f in fields})
 
 
-def _evaluate(p, varied, rows_values, integrator, model, progress):
+def _evaluate(p, varied, rows_values, integrator, model, progress, runner=None):
     params, invalid = [], np.zeros(len(rows_values), dtype=bool)
     for i, row in enumerate(rows_values):
         q = p
@@ -76,7 +76,7 @@ def _evaluate(p, varied, rows_values, integrator, model, progress):
             params.append(apply_model(q, model))
         except AirgunXlError:
             invalid[i] = True
-    batch = run_batch(params, integrator, progress=progress)
+    batch = (runner or run_batch)(params, integrator, progress=progress)
     figures = np.full((len(rows_values), len(FIGURES)), np.nan)
     diverged = np.zeros(len(rows_values), dtype=bool)
     figures[~invalid] = batch.figures
@@ -84,15 +84,20 @@ def _evaluate(p, varied, rows_values, integrator, model, progress):
     return figures, diverged, invalid
 
 
-def grid(p, varies, integrator="legacy", model="4-mass", progress=None):
-    """Every combination of the ``varies`` values (from :func:`parse_vary`)."""
+def grid(p, varies, integrator="legacy", model="4-mass", progress=None, runner=None):
+    """Every combination of the ``varies`` values (from :func:`parse_vary`).
+
+    ``runner`` runs the shots: :func:`~airgun_xl.engine.batch.run_batch` on this machine by
+    default, or a :class:`~airgun_xl.studies.cluster.ClusterRunner`."""
     varied = [(cell, fields) for cell, fields, _ in varies]
     combos = np.array(list(itertools.product(*(v for _, _, v in varies))))
-    figures, diverged, invalid = _evaluate(p, varied, combos, integrator, model, progress)
+    figures, diverged, invalid = _evaluate(p, varied, combos, integrator, model, progress,
+                                           runner)
     return SweepResult([c for c, _ in varied], combos, figures, diverged, invalid)
 
 
-def monte_carlo(p, sds, n, seed=None, integrator="legacy", model="4-mass", progress=None):
+def monte_carlo(p, sds, n, seed=None, integrator="legacy", model="4-mass", progress=None,
+                runner=None):
     """``n`` shots with the ``sds`` cells drawn from normal distributions around the sheet's
     values (a draw that is not a valid shot, e.g. a negative mass, is counted as invalid)."""
     rng = np.random.default_rng(seed)
@@ -102,7 +107,8 @@ def monte_carlo(p, sds, n, seed=None, integrator="legacy", model="4-mass", progr
         columns.append(rng.normal(mean, sd * abs(mean) if relative else sd, n))
     samples = np.column_stack(columns) if columns else np.zeros((n, 0))
     varied = [(cell, fields) for cell, fields, _, _ in sds]
-    figures, diverged, invalid = _evaluate(p, varied, samples, integrator, model, progress)
+    figures, diverged, invalid = _evaluate(p, varied, samples, integrator, model, progress,
+                                           runner)
     return SweepResult([c for c, _ in varied], samples, figures, diverged, invalid)
 
 

@@ -5,7 +5,9 @@ import numpy as np
 from ..cells import BY_ADDRESS
 from ..engine.batch import FIGURES
 from ..transaction import atomic_path, check_output
+from .charts import nice_range
 from .columns_sheet import ColumnsWorksheet
+from .page_setup import not_printed, one_page
 from .sheets import write_number_columns
 from .writer import close_workbook, new_workbook
 
@@ -19,7 +21,10 @@ def _label(cell):
     return f"{cell} {c.label} ({c.unit})" if c and c.unit else cell
 
 
-def write_sweep(result, path, force, stats=None):
+def write_sweep(result, path, force, stats=None, sensitivity=None):
+    """The sweep's workbook at ``path``: the Sweep table and Charts; with ``stats`` (a Monte
+    Carlo) the Spread sheet and the band's convergence; with ``sensitivity`` (Sobol) the
+    Sensitivity sheet and its bar charts."""
     check_output(path, force)
     with atomic_path(path, force) as tmp:
         wb = new_workbook(tmp)
@@ -35,6 +40,7 @@ def write_sweep(result, path, force, stats=None):
         columns[k + len(FIGURES)] = result.diverged.astype(float)
         columns[k + len(FIGURES) + 1] = result.invalid.astype(float)
         write_number_columns(ws, 1, columns)
+        not_printed(ws)
         n = len(result.values)
         charts = wb.add_worksheet("Charts")
         for i, cell in enumerate(result.cells):
@@ -52,8 +58,12 @@ def write_sweep(result, path, force, stats=None):
                               "max": float(np.ceil(peaks.max())) if len(peaks) else 1.0})
             chart.set_legend({"none": True})
             charts.insert_chart(1 + 20 * i, 1, chart)
+        one_page(charts, 20 * len(result.cells) + 1, 9, landscape=False)
         if stats is not None:
             _write_spread(wb, result, stats, bold)
+            _write_band(wb, result, bold)
+        if sensitivity is not None:
+            _write_sensitivity(wb, sensitivity, bold)
         close_workbook(wb, path)
 
 
@@ -82,3 +92,70 @@ def _write_spread(wb, result, stats, bold):
     chart.set_y_axis({"name": "Shots", "min": 0, "max": int(counts.max()) + 1})
     chart.set_legend({"none": True})
     ws.insert_chart(1, 4, chart)
+    one_page(ws, max(8 + len(counts), 18), 12)
+
+
+SENSITIVITY_TITLES = {"peak_kg": "Peak acceleration", "pulse_duration": "Pulse duration",
+                      "max_crush": "Maximum crush"}
+
+
+def _write_sensitivity(wb, sensitivity, bold):
+    """One block of rows a figure (input, S1, S1 +/-, ST, ST +/-) and a bar chart of S1 and ST
+    with their 95 % confidence half-widths as error bars."""
+    ws = wb.add_worksheet("Sensitivity")
+    ws.set_column(0, 0, 34)
+    ws.set_column(1, 4, 12)
+    ws.write_string(0, 0, "Sobol indices (SALib; Saltelli sample, first and total order): S1 is "
+                          "an input's share of the variance alone, ST with its interactions; "
+                          "+/- is the 95 % confidence half-width.")
+    row, k = 2, len(sensitivity.cells)
+    for n, (name, found) in enumerate(sensitivity.indices.items()):
+        ws.write_row(row, 0, [SENSITIVITY_TITLES[name], "S1", "S1 +/-", "ST", "ST +/-"], bold)
+        for i, cell in enumerate(sensitivity.cells):
+            ws.write_string(row + 1 + i, 0, _label(cell))
+            for j, key in enumerate(("S1", "S1_conf", "ST", "ST_conf")):
+                ws.write_number(row + 1 + i, 1 + j, float(found[key][i]))
+        chart = wb.add_chart({"type": "column"})
+        for col, key, color in ((1, "S1", "#1f4e79"), (3, "ST", "#c00000")):
+            chart.add_series({
+                "name": key, "categories": ["Sensitivity", row + 1, 0, row + k, 0],
+                "values": ["Sensitivity", row + 1, col, row + k, col],
+                "fill": {"color": color},
+                "y_error_bars": {"type": "custom",
+                                 "plus_values": ["Sensitivity", row + 1, col + 1, row + k,
+                                                 col + 1],
+                                 "minus_values": ["Sensitivity", row + 1, col + 1, row + k,
+                                                  col + 1]}})
+        chart.set_title({"name": f"Sobol indices: {SENSITIVITY_TITLES[name]}"})
+        chart.set_x_axis({"name": "Uncertain input"})
+        chart.set_y_axis({"name": "Index", "min": 0.0, "max": 1.2})
+        chart.set_legend({"position": "bottom"})
+        ws.insert_chart(2 + 18 * n, 6, chart)
+        row += k + 3
+    one_page(ws, max(row, 2 + 18 * len(sensitivity.indices)), 14)
+
+
+def _write_band(wb, result, bold):
+    """The Monte Carlo's mean and 5-95 % band of the peak over its first n shots."""
+    from ..studies.sensitivity import band_convergence
+
+    rows = band_convergence(result.figures[:, 0])
+    if not len(rows):
+        return
+    ws = wb.add_worksheet("Band convergence", worksheet_class=ColumnsWorksheet)
+    ws.set_column(0, 3, 21)
+    ws.write_row(0, 0, ["Shots", "Mean peak (kG)", "5th percentile (kG)",
+                        "95th percentile (kG)"], bold)
+    write_number_columns(ws, 1, {j: rows[:, j] for j in range(4)})
+    n = len(rows)
+    chart = wb.add_chart({"type": "scatter", "subtype": "straight_with_markers"})
+    for col, name in ((1, "Mean"), (2, "5th percentile"), (3, "95th percentile")):
+        chart.add_series({"name": name, "categories": ["Band convergence", 1, 0, n, 0],
+                          "values": ["Band convergence", 1, col, n, col]})
+    lo, hi = nice_range(rows[:, 1:4])
+    chart.set_title({"name": "Monte Carlo: the peak's 5-95 % band against the number of shots"})
+    chart.set_x_axis({"name": "Shots", "log_base": 10, "min": 10, "max": float(rows[-1, 0])})
+    chart.set_y_axis({"name": "Peak (kG)", "min": lo, "max": hi, "num_format": "0.00"})
+    chart.set_legend({"position": "bottom"})
+    ws.insert_chart(1, 5, chart)
+    one_page(ws, max(n, 16), 13)
