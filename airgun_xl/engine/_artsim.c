@@ -373,21 +373,196 @@ static PyObject *py_newmark_kernel(PyObject *self, PyObject *args)
     return run_kernel(args, newmark_steps);
 }
 
+
+/* The legacy scheme for LANES shots at once, for the batch: structure of arrays, every branch
+ * of the step (loading or unloading, wedge or cylinder, first unloading step, clamps,
+ * statistics) as a select between both sides, so the lane loop has no branch and the compiler
+ * runs it in SIMD registers (an AVX2 clone where the CPU has it). Each lane computes exactly
+ * the scalar step's expressions in the same order, and -ffp-contract=off forbids fused
+ * multiply-adds, so every lane equals legacy_steps on its shot bit for bit. A lane that leaves
+ * the bound stops writing and keeps its finals from that row, as the scalar kernel breaks
+ * there; the others go on. */
+#define LANES 8
+
+#if defined(_MSC_VER) && !defined(restrict)
+#define restrict __restrict
+#endif
+
+#if defined(__GNUC__) && !defined(__clang__) && (defined(__x86_64__) || defined(__i386__))
+#define LANE_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define LANE_CLONES
+#endif
+
+typedef struct {
+    double m1[LANES], mmit[LANES], m31p[LANES], m32[LANES], m33[LANES], k2[LANES], k3[LANES];
+    double rho[LANES], rcone[LANES], hcone[LANES], hcyl[LANES], E[LANES], ec[LANES];
+    double sigmay[LANES], c2[LANES], c3[LANES], delta[LANES], dd[LANES];
+} LaneParams;
+
+typedef struct {
+    double y1[LANES], yn1[LANES], y31[LANES], yn31[LANES], y32[LANES], yn32[LANES];
+    double y33[LANES], yn33[LANES];
+    double M1[LANES], m31[LANES], vcone[LANES], xP[LANES], maxdef[LANES], defl[LANES];
+    double fcount[LANES], dforce[LANES], maxV[LANES], minV[LANES], maxT[LANES];
+    double ny1[LANES], ny31[LANES], ny32[LANES], ny33[LANES];
+} LaneState;
+
+/* One step of every lane: the mitigator force law and the four central-difference lines. */
+LANE_CLONES static void lane_step(const LaneParams *restrict q, LaneState *restrict s)
+{
+    int i;
+#pragma GCC ivdep
+    for (i = 0; i < LANES; i++) {
+        double y1 = s->y1[i], yn1 = s->yn1[i], y31 = s->y31[i], yn31 = s->yn31[i];
+        double y32 = s->y32[i], yn32 = s->yn32[i], y33 = s->y33[i], yn33 = s->yn33[i];
+        double delta = q->delta[i], hcone = q->hcone[i];
+        double L = hcone + q->hcyl[i] - s->defl[i];
+        double cPlastic = (y31 - yn31 - y1 + yn1) / (q->ec[i] * delta);
+        /* every side computed first, then selected: no FP operation is conditional, so the
+         * compiler may if-convert (it keeps branches around ops that could trap) */
+        double xPadv = s->xP[i] + (cPlastic * delta);
+        double xPn = cPlastic >= 0 ? xPadv : s->xP[i];
+        double d = y31 - y1;
+        int unload = d < s->maxdef[i];
+        double AreaFull = PI_MACRO * q->rcone[i] * q->rcone[i];
+        double k1 = -((AreaFull * q->E[i]) / (L));
+        int first = unload & (s->fcount[i] == 0);
+        double Ffirst = -k1 * (d - hcone);
+        double dfFirst = Ffirst - s->dforce[i];
+        double dfu = first ? dfFirst : s->dforce[i];
+        double Fu = -k1 * (d - hcone) - dfu;
+        int wedge = xPn <= hcone;
+        double Aw = (PI_MACRO * q->rcone[i] * q->rcone[i]) * (xPn / hcone);
+        double tw = ((q->rho[i] * Aw * xPn) / 3.0);
+        double tc = s->vcone[i] + (q->rho[i] * AreaFull * (xPn - hcone));
+        double Al = wedge ? Aw : AreaFull;
+        double temp = wedge ? tw : tc;
+        double V = (((y31 - yn31) - (y1 - yn1)) / delta);
+        double cf = crush_factor_poly(V);
+        double Fl, F, M1n, m31n, M1l, m31l, yP2, yP3, sv, dd = q->dd[i], k2 = q->k2[i];
+        double k3 = q->k3[i];
+        double c2 = q->c2[i], c3 = q->c3[i];
+        int loading = !unload;
+        cf = cf < 1 ? 1 : cf;
+        Fl = q->sigmay[i] * Al * cf;
+        M1l = q->m1[i] + q->mmit[i] - temp;
+        m31l = q->m31p[i] + temp;
+        M1n = unload ? s->M1[i] : M1l;
+        m31n = unload ? s->m31[i] : m31l;
+        F = unload ? Fu : Fl;
+        F = F < 0 ? 0 : F;
+        /* statistics (not in the macro), while the law acts */
+        s->maxV[i] = (loading & (Al > 0) & (V > s->maxV[i])) ? V : s->maxV[i];
+        s->minV[i] = (loading & (Al > 0) & (V < s->minV[i])) ? V : s->minV[i];
+        s->maxT[i] = (loading & (temp > s->maxT[i])) ? temp : s->maxT[i];
+        s->xP[i] = xPn;
+        s->defl[i] = d;
+        s->fcount[i] = first ? 0 + 1 : s->fcount[i];
+        s->dforce[i] = unload ? dfu : Fl;
+        s->maxdef[i] = unload ? s->maxdef[i] : d;
+        s->vcone[i] = (loading & wedge) ? tw : s->vcone[i];
+        s->M1[i] = M1n;
+        s->m31[i] = m31n;
+        yP2 = ((y32 - yn32) - (y31 - yn31)) / delta;
+        yP3 = ((y33 - yn33) - (y32 - yn32)) / delta;
+        sv = ((dd) / M1n) * (F);
+        s->ny1[i] = 2 * y1 - yn1 + sv;
+        sv = ((dd) / m31n) * (-F + (k2 * (y31 - y32)) + (c2 * yP2));
+        s->ny31[i] = 2 * y31 - yn31 + sv;
+        sv = ((dd) / q->m32[i]) * ((-k2 * y31) + (y32 * (k2 + k3)) - (k3 * y33) - (c2 * yP2)
+                                   + (c3 * yP3));
+        s->ny32[i] = 2 * y32 - yn32 + sv;
+        sv = ((dd) / q->m33[i]) * ((k3 * y33) - (k3 * y32) - (c3 * yP3));
+        s->ny33[i] = 2 * y33 - yn33 + sv;
+    }
+}
+
+static void lane_finals(const LaneState *s, int i, Py_ssize_t bad, double *f)
+{
+    f[0] = s->M1[i]; f[1] = s->m31[i]; f[2] = (double)bad; f[3] = s->xP[i];
+    f[4] = s->maxV[i]; f[5] = s->minV[i]; f[6] = s->maxT[i]; f[7] = s->maxdef[i];
+}
+
+static void legacy_lanes(const double *params, int n, Py_ssize_t rows, double **out_rows,
+                         double *finals, int last)
+{
+    LaneParams q;
+    LaneState s;
+    double bound[LANES];
+    int alive[LANES], i;
+    Py_ssize_t k;
+    for (i = 0; i < LANES; i++) {
+        const double *p = params + (Py_ssize_t)(i < n ? i : 0) * P_COUNT; /* pad: shot 0 */
+        q.m1[i] = p[P_M1]; q.mmit[i] = p[P_MMIT]; q.m31p[i] = p[P_M31]; q.m32[i] = p[P_M32];
+        q.m33[i] = p[P_M33]; q.k2[i] = p[P_K2]; q.k3[i] = p[P_K3]; q.rho[i] = p[P_RHO];
+        q.rcone[i] = p[P_RCONE]; q.hcone[i] = p[P_HCONE]; q.hcyl[i] = p[P_HCYL];
+        q.E[i] = p[P_E]; q.ec[i] = p[P_EC]; q.sigmay[i] = p[P_SIGMAY];
+        q.delta[i] = p[P_DELTA]; q.dd[i] = p[P_DELTA] * p[P_DELTA];
+        bound[i] = p[P_BOUND];
+        s.M1[i] = p[P_M1] + p[P_MMIT];
+        s.m31[i] = p[P_M31];
+        s.vcone[i] = p[P_VCONE];
+        s.xP[i] = s.maxdef[i] = s.defl[i] = s.fcount[i] = s.dforce[i] = 0;
+        s.maxV[i] = -INFINITY; s.minV[i] = INFINITY; s.maxT[i] = 0;
+        q.c2[i] = 2 * p[P_ZETA] * sqrt(-p[P_K2] * (s.m31[i] + p[P_M32]));
+        q.c3[i] = 2 * p[P_ZETA] * sqrt(-p[P_K3] * (p[P_M32] + p[P_M33]));
+        s.yn1[i] = -p[P_DELTA] * p[P_V1]; s.yn31[i] = -p[P_DELTA] * p[P_V31];
+        s.yn32[i] = -p[P_DELTA] * p[P_V32]; s.yn33[i] = -p[P_DELTA] * p[P_V33];
+        s.y1[i] = s.y31[i] = s.y32[i] = s.y33[i] = 0;
+        alive[i] = i < n;
+    }
+    for (i = 0; i < n; i++) {
+        if (rows > 0) out_rows[i][0] = last == 1 ? s.yn31[i] : last == 2 ? s.yn32[i] : s.yn33[i];
+        if (rows > 1) out_rows[i][1] = 0;
+    }
+    for (k = 2; k < rows; k++) {
+        int any = 0;
+        lane_step(&q, &s);
+        for (i = 0; i < n; i++) {
+            double a, b, c, e;
+            if (!alive[i])
+                continue;
+            a = s.ny1[i]; b = s.ny31[i]; c = s.ny32[i]; e = s.ny33[i];
+            out_rows[i][k] = last == 1 ? b : last == 2 ? c : e;
+            if (!(fabs(a) <= bound[i] && fabs(b) <= bound[i] && fabs(c) <= bound[i]
+                  && fabs(e) <= bound[i])) {
+                alive[i] = 0; /* diverged: this lane stops, the batch goes on */
+                lane_finals(&s, i, k, finals + (Py_ssize_t)i * N_FINALS);
+                continue;
+            }
+            any = 1;
+        }
+        for (i = 0; i < LANES; i++) {
+            s.yn1[i] = s.y1[i]; s.y1[i] = s.ny1[i];
+            s.yn31[i] = s.y31[i]; s.y31[i] = s.ny31[i];
+            s.yn32[i] = s.y32[i]; s.y32[i] = s.ny32[i];
+            s.yn33[i] = s.y33[i]; s.y33[i] = s.ny33[i];
+        }
+        if (!any)
+            break;
+    }
+    for (i = 0; i < n; i++)
+        if (alive[i])
+            lane_finals(&s, i, -1, finals + (Py_ssize_t)i * N_FINALS);
+}
+
 /* Many shots of equal row count, for sweeps: params (n x P_COUNT), and for each shot its Y33
  * row (n x rows) and its finals (n x N_FINALS, as the single-shot kernel returns them). The
- * same stepping code as one shot, so the results are the same to the last bit. ``last``
- * picks the displacement returned (the bird's last mass, Y33 or Y32/Y31). The GIL is
- * released: two threads on two halves use both cores. */
+ * legacy scheme runs LANES shots at a time (legacy_lanes), newmark one shot after another;
+ * both give the single-shot results to the last bit. ``last`` picks the displacement
+ * returned (the bird's last mass, Y33 or Y32/Y31). The GIL is released: two threads on two
+ * halves use both cores. */
 static PyObject *py_batch_kernel(PyObject *self, PyObject *args)
 {
     PyObject *objs[4];
     Py_buffer views[4];
     Py_ssize_t rows, n, i, k;
-    int integrator, last, got;
+    int integrator, last, got, lanes = 1;
     double *scratch = NULL;
 
-    if (!PyArg_ParseTuple(args, "OniiOOO", &objs[0], &rows, &integrator, &last, &objs[1],
-                          &objs[2], &objs[3]))
+    if (!PyArg_ParseTuple(args, "OniiOOO|p", &objs[0], &rows, &integrator, &last, &objs[1],
+                          &objs[2], &objs[3], &lanes))
         return NULL;
     if (last < 1 || last > 3)
         return PyErr_Format(PyExc_ValueError, "last must be 1 (Y31), 2 (Y32) or 3 (Y33)");
@@ -416,6 +591,28 @@ static PyObject *py_batch_kernel(PyObject *self, PyObject *args)
         goto fail;
     }
     Py_BEGIN_ALLOW_THREADS
+    if (integrator == 0 && lanes) { /* the legacy scheme, LANES shots at a time */
+        const double *all = (const double *)views[0].buf;
+        double *t = (double *)views[1].buf, currentTime;
+        for (i = 0; i < n; i += LANES) {
+            double *out_rows[LANES];
+            int m = (int)(n - i < LANES ? n - i : LANES), j;
+            for (j = 0; j < m; j++) {
+                out_rows[j] = (double *)views[2].buf + (i + j) * rows;
+                for (k = 0; k < rows; k++)
+                    out_rows[j][k] = 0;
+            }
+            legacy_lanes(all + i * P_COUNT, m, rows, out_rows,
+                         (double *)views[3].buf + i * N_FINALS, last);
+        }
+        /* time as start_rows writes it, from the last shot's step (as the scalar loop) */
+        currentTime = n > 0 ? -all[(n - 1) * P_COUNT + P_DELTA] : 0;
+        for (k = 0; k < rows && n > 0; k++) {
+            t[k] = currentTime;
+            currentTime = currentTime + all[(n - 1) * P_COUNT + P_DELTA];
+        }
+        n = 0; /* done: skip the scalar loop below */
+    }
     for (i = 0; i < n; i++) {
         Columns c = {0};
         double *row = (double *)views[2].buf + i * rows, **mine;
@@ -449,8 +646,9 @@ static PyMethodDef methods[] = {
     {"newmark_kernel", py_newmark_kernel, METH_VARARGS,
      "newmark_kernel(...): as legacy_kernel, with the average-acceleration Newmark scheme."},
     {"batch_kernel", py_batch_kernel, METH_VARARGS,
-     "batch_kernel(params, rows, integrator, last, t, y, finals): many shots of equal rows "
-     "(integrator 0 legacy, 1 newmark; last 1..3: which of Y31..Y33 goes to y)."},
+     "batch_kernel(params, rows, integrator, last, t, y, finals, lanes=True): many shots of "
+     "equal rows (integrator 0 legacy, 1 newmark; last 1..3: which of Y31..Y33 goes to y; "
+     "lanes: the legacy scheme LANES shots at a time, else one shot after another)."},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_artsim",

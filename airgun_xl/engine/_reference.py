@@ -283,8 +283,9 @@ def newmark_kernel(params, rows, *arrays):
     return _run(_newmark_steps, params, rows, arrays)
 
 
-def batch_kernel(params, rows, integrator, last, t, y, finals):
-    """As ``_artsim.batch_kernel``: each row of ``params`` stepped alone."""
+def batch_kernel(params, rows, integrator, last, t, y, finals, lanes=True):
+    """As ``_artsim.batch_kernel``: each row of ``params`` stepped alone (``lanes`` changes
+    nothing here: the C lanes give the same numbers)."""
     import numpy as np
 
     if last not in (1, 2, 3):
