@@ -27,7 +27,7 @@ def benches(repeat, tmp):
     import airgun_xl
     from airgun_xl.engine import _artsim
     from airgun_xl.engine.batch import run_batch
-    from airgun_xl.engine.integrators import displacement_bound, kernel_params
+    from airgun_xl.engine.integrators import displacement_bound, kernel_params, run_legacy
 
     p = airgun_xl.load(TEMPLATE).params
     shots = [p.replace(v31=v, v32=v, v33=v) for v in np.linspace(100, 260, SHOTS)]
@@ -57,6 +57,10 @@ def benches(repeat, tmp):
                 f"{rates[True, 2] / rates[False, 2]:.2f}x"))
     out.append((f"  target (issue 13): >= {TARGET:.0e} shot-steps/s on 2 threads", "",
                 "met" if rates[True, 2] >= TARGET else "NOT met", ""))
+    single = statistics.median(run_legacy(p, track=()).kernel_seconds for _ in range(repeat))
+    out.append(("  one shot's kernel alone (positions only), for comparison",
+                f"{p.rows - 2:,} steps", f"{single * 1e3:.2f} ms",
+                f"{(p.rows - 2) / single:.3g} steps/s"))
     run_batch(shots[:64])
     med = statistics.median(_timed(lambda: run_batch(shots)) for _ in range(repeat))
     out.append(("run_batch (kernel + figures), 2 threads", "", f"{med:.3f} s",
