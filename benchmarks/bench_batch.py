@@ -10,12 +10,11 @@ shot-steps/s on the 2 cores.
 """
 import statistics
 import sys
-import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_fill import TEMPLATE, run_table  # noqa: E402
+from bench_fill import TEMPLATE, run_table, timed_once  # noqa: E402
 
 SHOTS = 1024
 TARGET = 1e8
@@ -48,7 +47,7 @@ def benches(repeat, tmp):
     for lanes in (False, True):
         for threads in (1, 2):
             run(lanes, threads)
-            med = statistics.median(_timed(lambda: run(lanes, threads)) for _ in range(repeat))
+            med = statistics.median(timed_once(lambda: run(lanes, threads)) for _ in range(repeat))
             rates[lanes, threads] = steps / med
             out.append((f"batch_kernel, {'lanes of 8' if lanes else 'scalar loop'}, "
                         f"{threads} thread{'s' if threads > 1 else ''}", f"{steps:.3g} steps",
@@ -62,16 +61,10 @@ def benches(repeat, tmp):
                 f"{p.rows - 2:,} steps", f"{single * 1e3:.2f} ms",
                 f"{(p.rows - 2) / single:.3g} steps/s"))
     run_batch(shots[:64])
-    med = statistics.median(_timed(lambda: run_batch(shots)) for _ in range(repeat))
+    med = statistics.median(timed_once(lambda: run_batch(shots)) for _ in range(repeat))
     out.append(("run_batch (kernel + figures), 2 threads", "", f"{med:.3f} s",
                 f"{steps / med:.3g} shot-steps/s"))
     return out
-
-
-def _timed(fn):
-    started = time.perf_counter()
-    fn()
-    return time.perf_counter() - started
 
 
 if __name__ == "__main__":

@@ -11,11 +11,10 @@
 """
 import statistics
 import sys
-import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_fill import TEMPLATE, run_table  # noqa: E402
+from bench_fill import TEMPLATE, run_table, timed_once  # noqa: E402
 
 SHOTS = 4096
 
@@ -35,12 +34,12 @@ def benches(repeat, tmp):
     shots = _shots(p)
     steps = SHOTS * (p.rows - 2)
     run_batch(shots[:256])
-    local = statistics.median(_timed(lambda: run_batch(shots)) for _ in range(repeat))
+    local = statistics.median(timed_once(lambda: run_batch(shots)) for _ in range(repeat))
     client, close = connect(workers=2)
     try:
         runner = ClusterRunner(client, 512)
         runner(shots[:1024])  # warm the workers (imports, the kernel)
-        remote = statistics.median(_timed(lambda: runner(shots)) for _ in range(repeat))
+        remote = statistics.median(timed_once(lambda: runner(shots)) for _ in range(repeat))
     finally:
         close()
     rows = [
@@ -55,12 +54,6 @@ def benches(repeat, tmp):
         rows.append((f"  estimate: 1e7 shots on {machines} such machines", "",
                      f"{seconds / 60:.1f} min", ""))
     return rows
-
-
-def _timed(fn):
-    started = time.perf_counter()
-    fn()
-    return time.perf_counter() - started
 
 
 if __name__ == "__main__":

@@ -51,6 +51,13 @@ def timed(cmd, repeat):
     return statistics.median(times), min(times)
 
 
+def timed_once(fn):
+    """Wall time of one call of ``fn`` [s]."""
+    started = time.perf_counter()
+    fn()
+    return time.perf_counter() - started
+
+
 def bench_kernel(repeat):
     import airgun_xl
     from airgun_xl.engine.integrators import run_legacy
