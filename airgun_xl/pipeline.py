@@ -51,6 +51,9 @@ class Filled:
     entry: object = None  # the archive Entry, when the run was archived
 
 
+#: What a refused or stopped unstable run can do instead (the pipeline serves the CLI).
+WAY_OUT = "expected a smaller E2, --integrator newmark, or --allow-unstable"
+
 #: Runs that need more memory than this, or write a larger sidecar, say so before they start.
 NOTICE_MEMORY_BYTES = 1e9
 NOTICE_SIDECAR_BYTES = 100e6
@@ -110,8 +113,7 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
     crit, findings = before_run(model_shot.params, options.integrator)
     if crit.ratio > 1 and not options.allow_unstable:
         error = next(f for f in findings if f.level == "error")
-        raise StabilityError(f"{error}; expected a smaller E2, --integrator newmark, or "
-                             "--allow-unstable")
+        raise StabilityError(f"{error}; {WAY_OUT}")
     warn(str(f) for f in findings if f.level != "note")
     note, progress = note or (lambda messages: None), progress or (lambda stage: None)
     track = outputs.tracked_series(sidecar is not None or options.track_all)
@@ -131,8 +133,7 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
                              f"{error}") from None
     reached = crush_reached(result, crit, options.integrator)
     if reached is not None and not options.allow_unstable:
-        raise StabilityError(f"{reached}; expected a smaller E2, --integrator newmark, or "
-                             "--allow-unstable")
+        raise StabilityError(f"{reached}; {WAY_OUT}")
     warn([str(reached)] if reached is not None else [])
     warn(result.warnings[len(shot.warnings):])
     warn(str(f) for f in after_run(result))
