@@ -3,9 +3,9 @@ import argparse
 
 from .. import __version__
 from ..errors import OptionError
-from . import archive, check, convergence, design, diff, fill, sweep, template
+from . import archive, check, convergence, design, diff, fill, srs, sweep, template
 
-COMMANDS = (fill, diff, archive, check, convergence, design, sweep, template)
+COMMANDS = (fill, diff, archive, check, convergence, design, sweep, srs, template)
 
 
 class _Parser(argparse.ArgumentParser):

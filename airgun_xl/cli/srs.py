@@ -1,0 +1,70 @@
+"""``airgun-xl srs SHOT.xlsx``: the shock response spectrum of the predicted pulse."""
+from pathlib import Path
+
+from ..choices import INTEGRATORS, MODELS
+from ..errors import OptionError
+
+
+def add_parser(sub):
+    p = sub.add_parser("srs", help="shock response spectrum of the shot's predicted pulse",
+                       description="Run the shot and write the maximax shock response "
+                                   "spectrum of the test item's acceleration (Smallwood's "
+                                   "ramp-invariant filter), as a table and a log-log chart.")
+    p.add_argument("shot", metavar="SHOT.xlsx")
+    p.add_argument("-o", "--output", metavar="OUT.xlsx",
+                   help="the SRS workbook (default: SHOT.srs.xlsx)")
+    p.add_argument("--force", action="store_true")
+    p.add_argument("--q", type=float, default=10.0, help="quality factor (default 10: 5 %% "
+                                                         "damping)")
+    p.add_argument("--cfc", type=int, help="filter the pulse first: SAE J211 class 60, 180, "
+                                           "600 or 1000")
+    p.add_argument("--from", dest="lo", type=float, default=100.0, metavar="HZ",
+                   help="lowest natural frequency (default 100)")
+    p.add_argument("--to", dest="hi", type=float, default=10_000.0, metavar="HZ",
+                   help="highest natural frequency (default 10000)")
+    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
+    p.add_argument("--model", choices=MODELS, default="4-mass")
+    p.set_defaults(run=run)
+
+
+def run(args):
+    import dataclasses
+
+    import numpy as np
+
+    from ..models import apply_model
+    from ..shot import Shot
+    from ..studies.shock import (
+        CFC_CLASSES,
+        cfc_coefficients,
+        cfc_filter,
+        default_frequencies,
+        srs,
+    )
+    from ..workbook.srs import write_srs
+
+    if args.cfc is not None and args.cfc not in CFC_CLASSES:
+        cfc_coefficients(args.cfc, 1.0)  # its one-line error, before the run
+    if not (0 < args.lo < args.hi):
+        raise OptionError(f"--from/--to: found {args.lo:g} and {args.hi:g} Hz, expected "
+                          "0 < FROM < TO")
+    shot = Shot.from_workbook(args.shot)
+    shot_path = Path(args.shot)
+    output = Path(args.output) if args.output else shot_path.with_name(
+        shot_path.stem + ".srs.xlsx")
+    result = dataclasses.replace(shot, params=apply_model(shot.params, args.model)).run(
+        integrator=args.integrator, track=())
+    pulse = result.accel_kg[np.isfinite(result.accel_kg)]
+    dt = shot.params.delta
+    if args.cfc is not None:
+        pulse = cfc_filter(pulse, dt, args.cfc)
+    freqs = default_frequencies(args.lo, args.hi)
+    spectrum = srs(pulse, dt, freqs, args.q)
+    about = [("Shot", str(args.shot)), ("Quality factor Q", f"{args.q:g}"),
+             ("Filter", f"CFC {args.cfc}" if args.cfc else "none"),
+             ("Model, integrator", f"{args.model}, {args.integrator}")]
+    write_srs(output, freqs, spectrum, about, args.force)
+    k = int(np.argmax(spectrum))
+    print(f"wrote {output}: SRS at {len(freqs)} frequencies, {args.lo:g}-{args.hi:g} Hz, "
+          f"Q = {args.q:g}; largest {spectrum[k]:.4f} kG at {freqs[k]:,.0f} Hz")
+    return 0

@@ -1,0 +1,49 @@
+"""The ``srs`` workbook: a shot's shock response spectrum as a table and a log-log chart."""
+import numpy as np
+
+from ..transaction import atomic_path, check_output
+from .charts import nice_range
+from .page_setup import one_page
+from .writer import close_workbook, new_workbook
+
+
+def write_srs(path, frequencies, spectrum, about, force=False):
+    """Write the SRS table (frequency [Hz], maximax response [kG]) and its log-log chart.
+
+    ``about`` is a list of (label, text) lines for the head of the sheet (shot, Q, filter).
+    """
+    check_output(path, force)
+    with atomic_path(path, force) as tmp:
+        wb = new_workbook(tmp)
+        ws = wb.add_worksheet("SRS")
+        bold = wb.add_format({"bold": True})
+        ws.set_column(0, 0, 22)
+        ws.set_column(1, 1, 18)
+        for r, (label, text) in enumerate(about):
+            ws.write_string(r, 0, label, bold)
+            ws.write_string(r, 1, text)
+        head = len(about) + 1
+        ws.write_row(head, 0, ["Frequency (Hz)", "SRS maximax (kG)"], bold)
+        for i, (f, s) in enumerate(zip(frequencies.tolist(), spectrum.tolist()), start=1):
+            ws.write_number(head + i, 0, f)
+            ws.write_number(head + i, 1, s)
+        n = len(frequencies)
+        chart = wb.add_chart({"type": "scatter", "subtype": "straight"})
+        chart.add_series({"name": "SRS", "categories": ["SRS", head + 1, 0, head + n, 0],
+                          "values": ["SRS", head + 1, 1, head + n, 1],
+                          "line": {"color": "#1f4e79", "width": 1.5},
+                          "marker": {"type": "none"}})
+        lo = 10.0 ** np.floor(np.log10(max(float(spectrum.min()), 1e-12)))
+        hi = 10.0 ** np.ceil(np.log10(max(float(spectrum.max()), 1e-12)))
+        xlo, xhi = nice_range(np.log10(frequencies))
+        chart.set_title({"name": "Shock response spectrum of the test-item acceleration"})
+        chart.set_x_axis({"name": "Natural frequency (Hz)", "log_base": 10,
+                          "min": 10.0 ** np.floor(xlo), "max": 10.0 ** np.ceil(xhi),
+                          "major_gridlines": {"visible": True}})
+        chart.set_y_axis({"name": "Peak response (kG)", "log_base": 10, "min": lo, "max": hi,
+                          "major_gridlines": {"visible": True}})
+        chart.set_legend({"none": True})
+        chart.set_size({"width": 720, "height": 440})
+        ws.insert_chart(1, 3, chart)
+        one_page(ws, max(head + n, 24), 13)
+        close_workbook(wb, path)
