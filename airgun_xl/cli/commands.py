@@ -3,9 +3,21 @@ import argparse
 
 from .. import __version__
 from ..errors import OptionError
-from . import archive, check, convergence, design, diff, fill, srs, sweep, template
+from . import (
+    archive,
+    check,
+    compare_measured,
+    convergence,
+    design,
+    diff,
+    fill,
+    srs,
+    sweep,
+    template,
+)
 
-COMMANDS = (fill, diff, archive, check, convergence, design, sweep, srs, template)
+COMMANDS = (fill, diff, archive, check, convergence, design, sweep, srs, compare_measured,
+            template)
 
 
 class _Parser(argparse.ArgumentParser):

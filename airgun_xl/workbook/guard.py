@@ -39,6 +39,47 @@ def _mib(n):
     return f"{n / 2**20:,.1f} MB"
 
 
+def read_bytes(path, expected=EXPECTED, what="workbook"):
+    """The bytes of a regular file, read without blocking and capped at MAX_INPUT_BYTES.
+
+    Raises
+    ------
+    WorkbookError
+        When the path is missing, not a regular file (a FIFO, a device, a folder), larger
+        than the cap, or unreadable; ``expected`` ends each message.
+    """
+    path = Path(path)
+    shown = display(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
+    except FileNotFoundError:
+        raise WorkbookError(f"{shown}: no such file, {expected}") from None
+    except IsADirectoryError:
+        raise WorkbookError(f"{shown}: is a folder, {expected}") from None
+    except OSError as exc:
+        raise WorkbookError(f"{shown}: cannot be read ({exc.strerror}), {expected}") from None
+    try:
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            raise WorkbookError(f"{shown}: is a folder, {expected}")
+        kind = special_kind(st.st_mode)
+        if kind is not None:
+            raise WorkbookError(f"{shown}: is {kind}, expected a regular {what} file")
+        if st.st_size > limits.MAX_INPUT_BYTES:
+            raise WorkbookError(f"{shown}: is {_mib(st.st_size)}, expected a {what} of at most "
+                                f"{_mib(limits.MAX_INPUT_BYTES)}")
+        with os.fdopen(os.dup(fd), "rb") as fh:
+            data = fh.read(limits.MAX_INPUT_BYTES + 1)
+    except OSError as exc:
+        raise WorkbookError(f"{shown}: cannot be read ({exc.strerror}), {expected}") from None
+    finally:
+        os.close(fd)
+    if len(data) > limits.MAX_INPUT_BYTES:  # it grew while being read
+        raise WorkbookError(f"{shown}: is larger than {_mib(limits.MAX_INPUT_BYTES)}, expected "
+                            f"a smaller {what}")
+    return data
+
+
 def read_input(path):
     """The bytes of a workbook file and its kind, ``"zip"`` or ``"xls"``.
 
@@ -48,35 +89,8 @@ def read_input(path):
         When the path is missing, not a regular file, larger than the cap, unreadable, not a
         workbook, or password-protected.
     """
-    path = Path(path)
-    shown = display(path)
-    try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
-    except FileNotFoundError:
-        raise WorkbookError(f"{shown}: no such file, {EXPECTED}") from None
-    except IsADirectoryError:
-        raise WorkbookError(f"{shown}: is a folder, {EXPECTED}") from None
-    except OSError as exc:
-        raise WorkbookError(f"{shown}: cannot be read ({exc.strerror}), {EXPECTED}") from None
-    try:
-        st = os.fstat(fd)
-        if stat.S_ISDIR(st.st_mode):
-            raise WorkbookError(f"{shown}: is a folder, {EXPECTED}")
-        kind = special_kind(st.st_mode)
-        if kind is not None:
-            raise WorkbookError(f"{shown}: is {kind}, expected a regular workbook file")
-        if st.st_size > limits.MAX_INPUT_BYTES:
-            raise WorkbookError(f"{shown}: is {_mib(st.st_size)}, expected a workbook of at most "
-                                f"{_mib(limits.MAX_INPUT_BYTES)}")
-        with os.fdopen(os.dup(fd), "rb") as fh:
-            data = fh.read(limits.MAX_INPUT_BYTES + 1)
-    except OSError as exc:
-        raise WorkbookError(f"{shown}: cannot be read ({exc.strerror}), {EXPECTED}") from None
-    finally:
-        os.close(fd)
-    if len(data) > limits.MAX_INPUT_BYTES:  # it grew while being read
-        raise WorkbookError(f"{shown}: is larger than {_mib(limits.MAX_INPUT_BYTES)}, expected "
-                            "a smaller workbook")
+    shown = display(Path(path))
+    data = read_bytes(path)
     if data.startswith(ZIP_MAGIC):
         return data, "zip"
     if data.startswith(CFB_MAGIC):

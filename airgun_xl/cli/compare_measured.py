@@ -1,0 +1,72 @@
+"""``airgun-xl compare-measured SHOT.xlsx MEASURED.csv``: the prediction against the test."""
+from pathlib import Path
+
+from ..choices import INTEGRATORS, MODELS
+
+
+def add_parser(sub):
+    p = sub.add_parser("compare-measured",
+                       help="compare the shot's predicted pulse with a measured one (CSV)",
+                       description="Run the shot, read the measured pulse (a CSV of time and "
+                                   "acceleration, units in the header: s/ms/us and g/kG/m/s^2), "
+                                   "filter both alike (SAE J211), align them at the impact, "
+                                   "and score the peak, its time, the pulse, the velocity "
+                                   "change and their correlation.")
+    p.add_argument("shot", metavar="SHOT.xlsx")
+    p.add_argument("measured", metavar="MEASURED.csv")
+    p.add_argument("-o", "--output", metavar="OUT.xlsx",
+                   help="scores and traces (default: SHOT.measured.xlsx)")
+    p.add_argument("--force", action="store_true")
+    p.add_argument("--cfc", type=int, help="filter both traces: SAE J211 class 60, 180, 600 "
+                                           "or 1000")
+    p.add_argument("--align", default="threshold", choices=("threshold", "xcorr"),
+                   help="impact instant: first crossing of 5%% of the peak (default), or the "
+                        "cross-correlation's best lag")
+    p.add_argument("--sign", type=float, default=1.0, choices=(1.0, -1.0),
+                   help="-1 when the recorder's axis is opposite to the macro's")
+    p.add_argument("--time-unit", help="s, ms or us (default: from the header)")
+    p.add_argument("--accel-unit", help="g, kG or m/s^2 (default: from the header)")
+    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
+    p.add_argument("--model", choices=MODELS, default="4-mass")
+    p.set_defaults(run=run)
+
+
+def run(args):
+    import dataclasses
+
+    import numpy as np
+
+    from ..models import apply_model
+    from ..shot import Shot
+    from ..studies.measured import compare
+    from ..studies.shock import CFC_CLASSES, cfc_coefficients
+    from ..transaction import check_output
+    from ..workbook.measured import write_comparison
+    from ..workbook.trace import read_trace
+
+    if args.cfc is not None and args.cfc not in CFC_CLASSES:
+        cfc_coefficients(args.cfc, 1.0)  # its one-line error, before the run
+    shot_path = Path(args.shot)
+    output = Path(args.output) if args.output else shot_path.with_name(
+        shot_path.stem + ".measured.xlsx")
+    check_output(output, args.force, inputs=[args.shot, args.measured])
+    trace = read_trace(args.measured, args.time_unit, args.accel_unit, args.sign)
+    shot = Shot.from_workbook(args.shot)
+    result = dataclasses.replace(shot, params=apply_model(shot.params, args.model)).run(
+        integrator=args.integrator, track=())
+    finite = np.isfinite(result.accel_kg)
+    c = compare(result.history.time[finite], result.accel_kg[finite], trace, args.cfc,
+                args.align)
+    about = [("Shot", str(args.shot)), ("Measured", trace.name),
+             ("Units read", f"time {trace.units[0]}, acceleration {trace.units[1]}"),
+             ("Filter", f"CFC {args.cfc}" if args.cfc else "none"),
+             ("Alignment", args.align)]
+    write_comparison(output, c, about, args.force)
+    print(f"wrote {output}: {trace.name} against {args.shot} ({len(c.time):,} samples, "
+          f"aligned by {args.align}, shift {c.shift * 1e3:.4f} ms)")
+    print(f"  peak {c.predicted.peak_kg:.4f} kG predicted, {c.measured.peak_kg:.4f} measured "
+          f"({c.errors['peak_kg']:+.2%}); pulse {c.predicted.pulse_duration * 1e3:.4f} ms, "
+          f"{c.measured.pulse_duration * 1e3:.4f} ({c.errors['pulse_duration']:+.2%})")
+    print(f"  velocity change {c.predicted.delta_v:.3f} m/s, {c.measured.delta_v:.3f} "
+          f"({c.errors['delta_v']:+.2%}); correlation r = {c.correlation:.4f}")
+    return 0

@@ -1,0 +1,122 @@
+"""A prediction against the pulse that was measured: filtered alike, aligned, and scored.
+
+Both traces are filtered with the same SAE J211 channel class (when one is given), each at its
+own sample rate; the prediction is then interpolated onto the measurement's grid. Alignment
+puts the measured trace's impact instant on the prediction's: the first sample at or above
+``threshold`` of its own peak (``"threshold"``), or the lag that maximises their
+cross-correlation (``"xcorr"``, scipy.signal). The scores are the headline figures of each
+trace (peak, its time, the pulse duration by the Summary's 10 % rule, the velocity change)
+with their errors, and Pearson's correlation of the aligned traces over their overlap.
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..engine.summary import pulse
+from ..errors import OptionError
+from .shock import cfc_filter
+
+#: The impact instant: the first sample at or above this fraction of the trace's peak.
+IMPACT_FRACTION = 0.05
+
+#: kG to m/s^2, the macro's convention.
+KG_MS2 = 9800.0
+
+ALIGNMENTS = ("threshold", "xcorr")
+
+
+@dataclass
+class Figures:
+    peak_kg: float
+    time_of_peak: float  # [s] after the impact instant
+    pulse_duration: float  # [s]
+    delta_v: float  # [m/s], the integral of the acceleration over the trace
+
+
+@dataclass
+class Comparison:
+    """The two traces on one grid and their scores."""
+
+    time: np.ndarray  # [s] after the prediction's impact instant
+    predicted_kg: np.ndarray
+    measured_kg: np.ndarray
+    shift: float  # [s] added to the measured time to align it
+    alignment: str
+    cfc: object
+    predicted: Figures
+    measured: Figures
+    correlation: float
+    errors: dict = field(default_factory=dict)
+
+
+def _impact(time, accel):
+    peak = np.max(accel)
+    return float(time[np.argmax(accel >= IMPACT_FRACTION * peak)])
+
+
+def _figures(time, accel, impact):
+    from scipy.integrate import trapezoid
+
+    peak_index = int(np.argmax(accel))
+    _, _, duration = pulse(time, accel)
+    return Figures(float(accel[peak_index]), float(time[peak_index] - impact), duration,
+                   float(trapezoid(accel, time) * KG_MS2))
+
+
+def compare(pred_time, pred_kg, trace, cfc=None, alignment="threshold"):
+    """Score a predicted pulse against a measured :class:`~airgun_xl.workbook.trace.Trace`.
+
+    Parameters
+    ----------
+    pred_time, pred_kg : numpy.ndarray
+        The prediction: time [s] and acceleration [kG] (finite samples).
+    trace : Trace
+    cfc : int, optional
+        SAE J211 channel class for both traces.
+    alignment : {"threshold", "xcorr"}
+
+    Returns
+    -------
+    Comparison
+    """
+    if alignment not in ALIGNMENTS:
+        raise OptionError(f"--align: found {alignment!r}, expected one of "
+                          f"{', '.join(ALIGNMENTS)}")
+    dt_pred = float(pred_time[1] - pred_time[0])
+    pred = cfc_filter(pred_kg, dt_pred, cfc) if cfc else np.asarray(pred_kg, float)
+    meas = cfc_filter(trace.accel_kg, trace.dt, cfc) if cfc else trace.accel_kg
+    if np.max(meas) < -np.min(meas):
+        raise OptionError(f"--sign: the measured pulse is mostly negative (from "
+                          f"{np.min(meas):.4g} to {np.max(meas):.4g} kG), expected the macro's "
+                          "sign, a deceleration positive (try --sign -1)")
+    impact_pred = _impact(pred_time, pred)
+    shift = impact_pred - _impact(trace.time, meas)
+    if alignment == "xcorr":
+        from scipy.signal import correlate, correlation_lags
+
+        # the prediction on the measurement's step; pred_grid[n + k] ~ meas[n] at the best k
+        grid = np.arange(pred_time[0], pred_time[-1], trace.dt)
+        pred_grid = np.interp(grid, pred_time, pred)
+        lags = correlation_lags(len(pred_grid), len(meas))
+        k = lags[np.argmax(correlate(pred_grid, meas))]
+        shift = float(grid[0] + k * trace.dt - trace.time[0])
+    time = trace.time + shift
+    inside = (time >= pred_time[0]) & (time <= pred_time[-1])
+    if inside.sum() < 16:
+        raise OptionError("--align: the aligned traces overlap in fewer than 16 samples, "
+                          "expected the measured pulse to cover the predicted one")
+    t = time[inside]
+    measured = meas[inside]
+    predicted = np.interp(t, pred_time, pred)
+    p_fig = _figures(t, predicted, impact_pred)
+    m_fig = _figures(t, measured, impact_pred)
+    correlation = float(np.corrcoef(predicted, measured)[0, 1])
+    errors = {
+        "peak_kg": (p_fig.peak_kg - m_fig.peak_kg) / m_fig.peak_kg,
+        "time_of_peak": p_fig.time_of_peak - m_fig.time_of_peak,
+        "pulse_duration": (p_fig.pulse_duration - m_fig.pulse_duration)
+        / m_fig.pulse_duration if m_fig.pulse_duration else np.nan,
+        "delta_v": (p_fig.delta_v - m_fig.delta_v) / m_fig.delta_v if m_fig.delta_v else np.nan,
+    }
+    return Comparison(t - impact_pred, predicted, measured, shift, alignment, cfc, p_fig,
+                      m_fig, correlation, errors)

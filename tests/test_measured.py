@@ -1,0 +1,118 @@
+"""Issue 12 (first part): a prediction against a measured pulse. The "measured" pulses are the
+model's own, written to CSV as a recorder would (10 us samples, g or m/s^2, a 2 ms
+pre-trigger), so every score has a known answer."""
+import numpy as np
+import openpyxl
+import pytest
+from conftest import TEMPLATE
+
+import airgun_xl
+from airgun_xl.cli import main
+
+SHOT = airgun_xl.load(TEMPLATE)
+PRE_TRIGGER = 2e-3
+
+
+def _write(path, shot, time_unit="ms", accel_unit="g", sign=1.0, noise=0.0, every=20):
+    """The shot's test-item pulse every ``every`` rows (0.5 us x 20 = 10 us), shifted by the
+    pre-trigger, in the given units, with Gaussian noise [g]."""
+    r = shot.run(track=())
+    keep = np.isfinite(r.accel_kg)
+    t = r.history.time[keep][::every] + PRE_TRIGGER
+    a_kg = sign * r.accel_kg[keep][::every]
+    a_kg = a_kg + np.random.default_rng(1).normal(0, noise / 1000, len(a_kg))
+    scale_t = {"s": 1.0, "ms": 1e3}[time_unit]
+    scale_a = {"g": 1000.0, "m/s^2": 9800.0}[accel_unit]
+    lines = [f"time [{time_unit}],acceleration [{accel_unit}]"]
+    lines += [f"{float(ti) * scale_t!r},{float(ai) * scale_a!r}" for ti, ai in zip(t, a_kg)]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _scores(out):
+    ws = openpyxl.load_workbook(out)["Compared"]
+    rows = {r[0]: r[1:5] for r in ws.iter_rows(values_only=True) if r[0]}
+    return rows
+
+
+@pytest.mark.parametrize("align", ["threshold", "xcorr"])
+def test_the_model_against_itself(tmp_path, capsys, align):
+    """Aligned to within one measured sample (10 us): the peak agrees within 1 %, the pulse and
+    the velocity change within 0.5 %, r > 0.999; the shift undoes the 2 ms pre-trigger."""
+    measured = _write(tmp_path / "m.csv", SHOT)
+    out = tmp_path / "c.xlsx"
+    assert main(["compare-measured", str(TEMPLATE), str(measured), "-o", str(out), "--align",
+                 align]) == 0
+    s = _scores(out)
+    assert abs(s["Peak acceleration"][3]) < 0.01
+    assert abs(s["Pulse duration (>= 10% of peak)"][3]) < 0.005
+    assert abs(s["Velocity change"][3]) < 0.005
+    assert s["Velocity change"][1] == pytest.approx(243.5, rel=0.01)  # v0 into rest
+    assert s["Correlation (Pearson r)"][0] > 0.999
+    assert s["Shift of the measured time (ms)"][0] == pytest.approx(-2.0, abs=0.011)
+    assert "correlation r = " in capsys.readouterr().out
+
+
+def test_a_different_shot_scores_as_the_direct_comparison(tmp_path):
+    """Measured = shot A with zeta 0.05 and sigma_y 5 % higher, noisy, CFC 1000 on both: the
+    peak error equals the one between the two runs filtered alike, to 1 %."""
+    from airgun_xl.studies.shock import cfc_filter
+
+    other = SHOT.with_params(zeta=0.05, sigmay=SHOT.params.sigmay * 1.05)
+    measured = _write(tmp_path / "m.csv", other, noise=20.0)
+    out = tmp_path / "c.xlsx"
+    assert main(["compare-measured", str(TEMPLATE), str(measured), "-o", str(out), "--cfc",
+                 "1000"]) == 0
+    peaks = []
+    for shot in (SHOT, other):
+        a = shot.run(track=()).accel_kg
+        peaks.append(cfc_filter(a[np.isfinite(a)], 5e-7, 1000).max())
+    expected = (peaks[0] - peaks[1]) / peaks[1]
+    assert _scores(out)["Peak acceleration"][3] == pytest.approx(expected, abs=0.01)
+
+
+def test_units_from_the_header(tmp_path):
+    """The same pulse in s and m/s^2 scores as in ms and g (to rounding of the CSV digits)."""
+    a, b = _write(tmp_path / "a.csv", SHOT), _write(tmp_path / "b.csv", SHOT, "s", "m/s^2")
+    outs = [tmp_path / "a.xlsx", tmp_path / "b.xlsx"]
+    for m, out in zip((a, b), outs):
+        assert main(["compare-measured", str(TEMPLATE), str(m), "-o", str(out)]) == 0
+    sa, sb = _scores(outs[0]), _scores(outs[1])
+    for key in ("Peak acceleration", "Velocity change"):
+        assert sa[key][1] == pytest.approx(sb[key][1], rel=1e-9)
+
+
+def _bad(path, rows, header="time [ms],acceleration [g]"):
+    path.write_text("\n".join([header] + rows) + "\n")
+    return path
+
+
+GOOD = [f"{i * 0.01},{100.0 * i}" for i in range(40)]
+
+
+@pytest.mark.parametrize("make,start", [
+    (lambda p: _bad(p, GOOD[:20] + ["0.05,7"] + GOOD[21:]), "row 22: time 0.05 does not "
+                                                             "follow 0.19"),
+    (lambda p: _bad(p, GOOD[:5] + ["0.05,nan"] + GOOD[6:]), "row 7 holds 0.05, nan"),
+    (lambda p: _bad(p, GOOD[:10] + GOOD[12:]), "row 12: a step of 3e-05 s"),
+    (lambda p: _bad(p, GOOD, "t,a"), "--time-unit: the time header 't' names no unit"),
+    (lambda p: _bad(p, GOOD[:5]), "holds 5 samples, expected at least 16"),
+    (lambda p: _bad(p, GOOD[:3] + ["0.03,=cmd|' /C calc'!A0"] + GOOD[4:]),
+     "row 5 holds ['0.03', \"=cmd|' /C calc'!A0\"], expected two numbers"),
+])
+def test_bad_measured_files_are_one_line_naming_the_row(tmp_path, capsys, make, start):
+    measured = make(tmp_path / "m.csv")
+    out = tmp_path / "c.xlsx"
+    assert main(["compare-measured", str(TEMPLATE), str(measured), "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and start in err[0], err
+    assert not out.exists()
+
+
+def test_a_negative_pulse_asks_for_the_sign(tmp_path, capsys):
+    measured = _write(tmp_path / "m.csv", SHOT, sign=-1.0)
+    out = tmp_path / "c.xlsx"
+    assert main(["compare-measured", str(TEMPLATE), str(measured), "-o", str(out)]) == 2
+    assert "try --sign -1" in capsys.readouterr().err
+    assert main(["compare-measured", str(TEMPLATE), str(measured), "-o", str(out), "--sign",
+                 "-1"]) == 0
