@@ -120,3 +120,16 @@ def test_srs_command_refuses_bad_options(tmp_path, capsys, args, start):
     assert err == [f"airgun-xl: error: {start}"] or err[0].startswith(
         f"airgun-xl: error: {start}")
     assert len(err) == 1 and not out.exists()
+
+
+def test_srs_command_leaves_an_existing_output_alone(tmp_path, capsys):
+    from conftest import TEMPLATE
+
+    from airgun_xl.cli import main
+
+    out = tmp_path / "srs.xlsx"
+    out.write_bytes(b"an earlier result")
+    assert main(["srs", str(TEMPLATE), "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "already exists" in err[0] and "--force" in err[0]
+    assert out.read_bytes() == b"an earlier result"

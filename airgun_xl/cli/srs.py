@@ -41,6 +41,7 @@ def run(args):
         default_frequencies,
         srs,
     )
+    from ..transaction import check_output
     from ..workbook.srs import write_srs
 
     if args.cfc is not None and args.cfc not in CFC_CLASSES:
@@ -52,6 +53,7 @@ def run(args):
     shot_path = Path(args.shot)
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".srs.xlsx")
+    check_output(output, args.force, inputs=[args.shot])  # before the run, not after
     result = dataclasses.replace(shot, params=apply_model(shot.params, args.model)).run(
         integrator=args.integrator, track=())
     pulse = result.accel_kg[np.isfinite(result.accel_kg)]

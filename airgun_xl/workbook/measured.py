@@ -3,7 +3,7 @@ from ..transaction import atomic_path, check_output
 from .charts import nice_range
 from .columns_sheet import ColumnsWorksheet
 from .page_setup import not_printed, one_page
-from .sheets import write_number_columns
+from .sheets import write_about, write_number_columns
 from .writer import close_workbook, new_workbook
 
 ROWS = (("Peak acceleration", "peak_kg", "kG", 1.0, "0.000"),
@@ -24,10 +24,7 @@ def write_comparison(path, comparison, about, force=False):
         pct = wb.add_format({"num_format": "0.00%"})
         ws.set_column(0, 0, 34)
         ws.set_column(1, 4, 14)
-        for r, (label, text) in enumerate(about):
-            ws.write_string(r, 0, label, bold)
-            ws.write_string(r, 1, text)
-        head = len(about) + 1
+        head = write_about(ws, about, bold) + 1
         ws.write_row(head, 0, ["Figure", "Predicted", "Measured", "Unit", "Error"], bold)
         for i, (label, key, unit, factor, fmt) in enumerate(ROWS, start=head + 1):
             form = wb.add_format({"num_format": fmt})

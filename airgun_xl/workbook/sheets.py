@@ -37,6 +37,15 @@ class Ref:
         return [self.sheet, self.first_row, self.y_col, self.last_row, self.y_col]
 
 
+def write_about(ws, about, bold):
+    """Label and text lines at the head of a sheet (rows 0..), the labels bold; returns the
+    first row after them."""
+    for r, (label, text) in enumerate(about):
+        ws.write_string(r, 0, label, bold)
+        ws.write_string(r, 1, text)
+    return len(about)
+
+
 def write_number_columns(ws, first_row, columns):
     """Write ``{col: array}`` down from ``first_row``; NaN cells are left empty."""
     for col, values in columns.items():

@@ -4,6 +4,7 @@ import numpy as np
 from ..transaction import atomic_path, check_output
 from .charts import nice_range
 from .page_setup import one_page
+from .sheets import write_about
 from .writer import close_workbook, new_workbook
 
 
@@ -19,10 +20,7 @@ def write_srs(path, frequencies, spectrum, about, force=False):
         bold = wb.add_format({"bold": True})
         ws.set_column(0, 0, 22)
         ws.set_column(1, 1, 18)
-        for r, (label, text) in enumerate(about):
-            ws.write_string(r, 0, label, bold)
-            ws.write_string(r, 1, text)
-        head = len(about) + 1
+        head = write_about(ws, about, bold) + 1
         ws.write_row(head, 0, ["Frequency (Hz)", "SRS maximax (kG)"], bold)
         for i, (f, s) in enumerate(zip(frequencies.tolist(), spectrum.tolist()), start=1):
             ws.write_number(head + i, 0, f)
