@@ -11,6 +11,7 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields, replace
 
 from .cells import BY_NAME, CELLS, MAX_STEPS, expectation
+from .crush_law import LEGACY_LAW, CrushLaw
 from .errors import CellError
 
 
@@ -131,6 +132,9 @@ class ShotParams:
         Damping ratio [-]; E43, Eq. (18).
     v1, v31, v32, v33 : float
         Initial velocities of Y1, Y31, Y32, Y33 [m/s]; A27..A30.
+    crush_law : CrushLaw
+        The crush factor's law, Eq. (8): the macro's polynomial unless a calibration fitted
+        another (the workbook's "Crush law" sheet).
     """
 
     m1: float
@@ -156,6 +160,7 @@ class ShotParams:
     v31: float
     v32: float
     v33: float
+    crush_law: CrushLaw = LEGACY_LAW
 
     @classmethod
     def from_cells(cls, raw_by_address: Mapping[str, object]) -> ShotParams:
@@ -191,7 +196,7 @@ class ShotParams:
         """
         left_out = {3: (), 2: ("m33", "k3"), 1: ("m32", "m33", "k2", "k3")}[self.bird_masses]
         for f in fields(self):
-            if f.name not in left_out:
+            if f.name not in left_out and f.name in BY_NAME:
                 check_value(BY_NAME[f.name], getattr(self, f.name))
         if self.hcone == 0 and self.hcylinder == 0:
             c = BY_NAME["hcone"]

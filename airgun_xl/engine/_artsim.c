@@ -10,7 +10,8 @@
  *
  * Python interface (module airgun_xl.engine._artsim):
  *   legacy_kernel(params, rows, t, y1, y31, y32, y33, crush, m31, defl, xp, force, m1, v1, v31)
- *     params: a sequence of 22 floats in the order of the enum below;
+ *     params: a sequence of 29 floats in the order of the enum below (the crush-factor law's
+ *     seven coefficients, constant term first, before the bound);
  *     the other arguments: writable, C-contiguous float64 buffers of length >= rows. The
  *     tracked columns from crush on may be None: they are then neither computed nor stored.
  *     Returns (final M1, final m31, first diverged row or -1, final x_plastic, max and min
@@ -34,20 +35,23 @@
 #define PI_MACRO 3.141592653
 
 enum { P_M1, P_M31, P_M32, P_M33, P_K2, P_K3, P_DELTA, P_RHO, P_RCONE, P_HCONE, P_HCYL,
-       P_MMIT, P_VCONE, P_E, P_EC, P_SIGMAY, P_ZETA, P_V1, P_V31, P_V32, P_V33, P_BOUND,
-       P_COUNT };
+       P_MMIT, P_VCONE, P_E, P_EC, P_SIGMAY, P_ZETA, P_V1, P_V31, P_V32, P_V33,
+       P_LAW0, P_LAW1, P_LAW2, P_LAW3, P_LAW4, P_LAW5, P_LAW6, P_BOUND, P_COUNT };
 
 typedef struct {
     double *t, *y1, *y31, *y32, *y33, *crush, *m31, *defl, *xp, *force, *m1, *v1, *v31;
 } Columns;
 
-/* Strain-rate amplification of the crush force, Eq. (8), with the macro's coefficients. */
-static double crush_factor_poly(double Vobr)
+/* Strain-rate amplification of the crush force, Eq. (8): the polynomial c[0] + c[1] V + ...
+ * + c[6] V^6, highest power first as the macro writes it. With the macro's coefficients (c[5]
+ * and c[2] negative) it equals the macro's "- (0.000000000125438) * (V^5)" bit for bit: a + (-b)c
+ * rounds as a - bc. */
+static double crush_factor_poly(const double *c, double Vobr)
 {
     double V = Vobr;
-    return (2.627437E-13) * (V * V * V * V * V * V) - (0.000000000125438) * (V * V * V * V * V)
-           + (0.0000000159241) * (V * V * V * V) + (0.0000005551838) * (V * V * V)
-           - (0.0001897436) * (V * V) + (0.008340218) * (V) + 1.257647;
+    return (c[6]) * (V * V * V * V * V * V) + (c[5]) * (V * V * V * V * V)
+           + (c[4]) * (V * V * V * V) + (c[3]) * (V * V * V)
+           + (c[2]) * (V * V) + (c[1]) * (V) + c[0];
 }
 
 /* The mitigator's state between steps (the macro's variables of the same names). */
@@ -113,7 +117,7 @@ static double mitigator_force(Mitigator *s, const double *p, double y1, double y
         s->M1 = p[P_M1] + p[P_MMIT] - temp; /* Range("A2") + Range("E25") - temp */
         s->m31 = p[P_M31] + temp;
         Vobr = (((y31 - yn31) - (y1 - yn1)) / delta);
-        s->crushFactor = crush_factor_poly(Vobr);
+        s->crushFactor = crush_factor_poly(p + P_LAW0, Vobr);
         if (s->crushFactor < 1)
             s->crushFactor = 1;
         s->Force = sigmay * Area * s->crushFactor;
@@ -398,6 +402,7 @@ typedef struct {
     double m1[LANES], mmit[LANES], m31p[LANES], m32[LANES], m33[LANES], k2[LANES], k3[LANES];
     double rho[LANES], rcone[LANES], hcone[LANES], hcyl[LANES], E[LANES], ec[LANES];
     double sigmay[LANES], c2[LANES], c3[LANES], delta[LANES], dd[LANES];
+    double law[7][LANES];
 } LaneParams;
 
 typedef struct {
@@ -439,7 +444,9 @@ LANE_CLONES static void lane_step(const LaneParams *restrict q, LaneState *restr
         double Al = wedge ? Aw : AreaFull;
         double temp = wedge ? tw : tc;
         double V = (((y31 - yn31) - (y1 - yn1)) / delta);
-        double cf = crush_factor_poly(V);
+        double cf = (q->law[6][i]) * (V * V * V * V * V * V) + (q->law[5][i]) * (V * V * V * V * V)
+                    + (q->law[4][i]) * (V * V * V * V) + (q->law[3][i]) * (V * V * V)
+                    + (q->law[2][i]) * (V * V) + (q->law[1][i]) * (V) + q->law[0][i];
         double Fl, F, M1n, m31n, M1l, m31l, yP2, yP3, sv, dd = q->dd[i], k2 = q->k2[i];
         double k3 = q->k3[i];
         double c2 = q->c2[i], c3 = q->c3[i];
@@ -490,7 +497,7 @@ static void legacy_lanes(const double *params, int n, Py_ssize_t rows, double **
     LaneParams q;
     LaneState s;
     double bound[LANES];
-    int alive[LANES], i;
+    int alive[LANES], i, j;
     Py_ssize_t k;
     for (i = 0; i < LANES; i++) {
         const double *p = params + (Py_ssize_t)(i < n ? i : 0) * P_COUNT; /* pad: shot 0 */
@@ -500,6 +507,8 @@ static void legacy_lanes(const double *params, int n, Py_ssize_t rows, double **
         q.E[i] = p[P_E]; q.ec[i] = p[P_EC]; q.sigmay[i] = p[P_SIGMAY];
         q.delta[i] = p[P_DELTA]; q.dd[i] = p[P_DELTA] * p[P_DELTA];
         bound[i] = p[P_BOUND];
+        for (j = 0; j < 7; j++)
+            q.law[j][i] = p[P_LAW0 + j];
         s.M1[i] = p[P_M1] + p[P_MMIT];
         s.m31[i] = p[P_M31];
         s.vcone[i] = p[P_VCONE];
@@ -581,7 +590,7 @@ static PyObject *py_batch_kernel(PyObject *self, PyObject *args)
         || views[1].len < rows * (Py_ssize_t)sizeof(double)
         || views[2].len < n * rows * (Py_ssize_t)sizeof(double)
         || views[3].len < n * N_FINALS * (Py_ssize_t)sizeof(double)) {
-        PyErr_SetString(PyExc_ValueError, "buffer sizes do not match (n x 22, rows, n x rows, "
+        PyErr_SetString(PyExc_ValueError, "buffer sizes do not match (n x 29, rows, n x rows, "
                                           "n x 8)");
         goto fail;
     }

@@ -17,8 +17,9 @@ PI_MACRO = 3.141592653
 
 # Parameter order: the C enum (P_M1 .. P_BOUND).
 (P_M1, P_M31, P_M32, P_M33, P_K2, P_K3, P_DELTA, P_RHO, P_RCONE, P_HCONE, P_HCYL, P_MMIT,
- P_VCONE, P_E, P_EC, P_SIGMAY, P_ZETA, P_V1, P_V31, P_V32, P_V33, P_BOUND) = range(22)
-P_COUNT = 22
+ P_VCONE, P_E, P_EC, P_SIGMAY, P_ZETA, P_V1, P_V31, P_V32, P_V33, P_LAW0, P_LAW1, P_LAW2,
+ P_LAW3, P_LAW4, P_LAW5, P_LAW6, P_BOUND) = range(29)
+P_COUNT = 29
 N_FINALS = 8
 
 
@@ -32,12 +33,13 @@ def _div(a, b):
         return math.copysign(math.inf, a) * math.copysign(1.0, b)
 
 
-def crush_factor_poly(Vobr):
-    """Strain-rate amplification of the crush force, Eq. (8), term by term as the C code."""
+def crush_factor_poly(c, Vobr):
+    """Strain-rate amplification of the crush force, Eq. (8): the law's coefficients ``c``
+    (constant term first), highest power first as the C code."""
     V = Vobr
-    return ((2.627437E-13) * (V * V * V * V * V * V) - (0.000000000125438) * (V * V * V * V * V)
-            + (0.0000000159241) * (V * V * V * V) + (0.0000005551838) * (V * V * V)
-            - (0.0001897436) * (V * V) + (0.008340218) * (V) + 1.257647)
+    return ((c[6]) * (V * V * V * V * V * V) + (c[5]) * (V * V * V * V * V)
+            + (c[4]) * (V * V * V * V) + (c[3]) * (V * V * V)
+            + (c[2]) * (V * V) + (c[1]) * (V) + c[0])
 
 
 class Mitigator:
@@ -91,7 +93,7 @@ class Mitigator:
             self.M1 = p[P_M1] + p[P_MMIT] - temp
             self.m31 = p[P_M31] + temp
             Vobr = (((y31 - yn31) - (y1 - yn1)) / delta)
-            self.crushFactor = crush_factor_poly(Vobr)
+            self.crushFactor = crush_factor_poly(p[P_LAW0:P_LAW6 + 1], Vobr)
             if self.crushFactor < 1:
                 self.crushFactor = 1.0
             self.Force = sigmay * Area * self.crushFactor

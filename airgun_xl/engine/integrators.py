@@ -171,7 +171,8 @@ def run_newmark(p, track=TRACKED):
 
 
 def kernel_params(p):
-    """The kernel's parameter list; a left-out mass (reduced model) gets a stand-in of 1 kg.
+    """The kernel's parameter list, the crush law's seven coefficients last; a left-out mass
+    (reduced model) gets a stand-in of 1 kg.
 
     Its spring is 0, so the stand-in moves freely and exerts no force (c = 2 zeta sqrt(0) = 0).
     """
@@ -180,7 +181,7 @@ def kernel_params(p):
         values["m33"] = 1.0
     if p.bird_masses < 2:
         values["m32"] = 1.0
-    return [values[name] for name in KERNEL_PARAMS]
+    return [values[name] for name in KERNEL_PARAMS] + list(p.crush_law.coefficients)
 
 
 def blank_left_out(history, p):

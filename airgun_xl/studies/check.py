@@ -4,7 +4,7 @@ import math
 from dataclasses import dataclass
 
 from ..cells import BY_ADDRESS
-from ..engine.legacy_law import CRUSH_FIT_RANGE, crush_factor
+from ..crush_law import CRUSH_FIT_RANGE, crush_factor
 from ..engine.stability import WARN_RATIO, critical_time_step, full_length
 
 #: Bird masses differing by this factor or more make a stiff, badly scaled system.

@@ -1,0 +1,76 @@
+"""Issue 12: the crush-factor law is a parameter. The macro's polynomial stays the default (the
+legacy cases still match to the last digit: test_legacy_cases); any other law runs the same
+in the C kernel, the batch's lanes and the pure-Python reference."""
+import numpy as np
+import pytest
+from conftest import CASES, REFERENCE
+
+import airgun_xl
+from airgun_xl.crush_law import LEGACY_LAW, CrushLaw
+from airgun_xl.engine import _reference as ref
+from airgun_xl.engine.batch import run_batch
+from airgun_xl.engine.integrators import displacement_bound, kernel_params
+
+SHOT_A = REFERENCE / CASES["shot_a_appendix_5us"]["input"]
+
+
+def test_legacy_law_is_the_macros_polynomial_term_by_term():
+    V = np.linspace(-50, 400, 9001)
+    macro = ((2.627437E-13) * (V * V * V * V * V * V) - (0.000000000125438) * (V * V * V * V * V)
+             + (0.0000000159241) * (V * V * V * V) + (0.0000005551838) * (V * V * V)
+             - (0.0001897436) * (V * V) + (0.008340218) * (V) + 1.257647)
+    assert np.array_equal(LEGACY_LAW.poly(V), macro)  # bit for bit: the kernel's order
+    assert LEGACY_LAW(0.0) == 1.257647 and LEGACY_LAW(400.0) > 200  # Eq. (8) and its blow-up
+
+
+def test_a_law_pads_to_degree_six_and_refuses_nonsense():
+    law = CrushLaw((1.1, 0.002), (0, 200), "fitted")
+    assert law.coefficients == (1.1, 0.002, 0, 0, 0, 0, 0)
+    assert law(100.0) == pytest.approx(1.3, rel=1e-15)  # 1.1 + 0.2 (one rounding)
+    assert law(-500.0) == 1.0  # clamped at 1, as the macro
+    with pytest.raises(ValueError, match="coefficients"):
+        CrushLaw((1.0,) * 8)
+    with pytest.raises(ValueError, match="finite"):
+        CrushLaw((1.0, float("nan")))
+
+
+def test_the_run_uses_the_law_it_is_given():
+    p = airgun_xl.load(SHOT_A).params
+    law = CrushLaw((1.4, 0.003, -1e-5), (0, 250), "fitted")
+    h = airgun_xl.Shot(p.replace(crush_law=law)).run().history
+    # row k is stepped from rows k-1 and k-2: its relative velocity is theirs
+    v = np.full(p.rows, np.nan)
+    v[2:] = ((h.y31[1:-1] - h.y31[:-2]) - (h.y1[1:-1] - h.y1[:-2])) / p.delta
+    cf = h.crush_factor
+    loading = np.r_[False, cf[1:] != cf[:-1]] & np.isfinite(cf)  # unloading holds the factor
+    assert loading.sum() > 900  # of 1,202 rows at 5 us: the crush lasts most of the run
+    # the crush column is the law at the step's relative velocity (the kernel's own arithmetic)
+    assert np.array_equal(cf[loading], law(v[loading]))
+    legacy = airgun_xl.Shot(p).run().history
+    assert not np.allclose(legacy.y33, h.y33)  # and it changes the run
+
+
+@pytest.mark.parametrize("integrator", ["legacy_kernel", "newmark_kernel"])
+def test_a_fitted_law_bit_for_bit_in_c_and_python(integrator):
+    compiled = pytest.importorskip("airgun_xl.engine._artsim")
+    p = airgun_xl.load(SHOT_A).params.replace(crush_law=LEGACY_LAW.scaled(1.13))
+    values = kernel_params(p) + [displacement_bound(p)]
+    out = []
+    for module in (compiled, ref):
+        arrays = [np.zeros(p.rows) for _ in range(5)] + [np.full(p.rows, np.nan)
+                                                         for _ in range(8)]
+        out.append((getattr(module, integrator)(values, p.rows, *arrays), arrays))
+    (fc, ac), (fr, ar) = out
+    assert np.array_equal(fc, fr, equal_nan=True)
+    assert all(np.array_equal(x, y, equal_nan=True) for x, y in zip(ac, ar))
+
+
+def test_lanes_carry_each_shots_own_law():
+    p = airgun_xl.load(SHOT_A).params
+    shots = [p.replace(crush_law=LEGACY_LAW.scaled(s)) for s in (0.9, 1.0, 1.1, 1.2, 1.3)]
+    batch = run_batch(shots, threads=1)
+    for i, q in enumerate(shots):
+        solo = run_batch([q], threads=1)
+        assert np.array_equal(batch.figures[i], solo.figures[0], equal_nan=True)
+    peaks = batch.figures[:, 0]
+    assert (np.diff(peaks) > 0).all()  # a stronger law, a higher peak
