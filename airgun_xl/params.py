@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields, replace
+from typing import Any
 
 from .cells import BY_NAME, CELLS, MAX_STEPS, expectation
 from .crush_law import LEGACY_LAW, CrushLaw
@@ -179,8 +180,9 @@ class ShotParams:
         for mass, velocity, previous in (("C2", "A29", "A28"), ("D2", "A30", "A29")):
             if mass in reduced and raw.get(velocity) is None:
                 raw[velocity] = raw.get(previous)  # a left-out mass moves with its neighbour
-        values = {c.name: 0.0 if c.address in reduced else check_value(c, raw.get(c.address))
-                  for c in CELLS}
+        values: dict[str, Any] = {
+            c.name: 0.0 if c.address in reduced else check_value(c, raw.get(c.address))
+            for c in CELLS}
         return cls(**values)
 
     def __post_init__(self) -> None:
@@ -245,9 +247,9 @@ class ShotParams:
         """Rows between filtered samples, ``1/(E2*E34)``, a double as in the macro."""
         return 1 / (self.delta * self.filter_frequency)
 
-    def replace(self, **changes: float) -> ShotParams:
+    def replace(self, **changes: Any) -> ShotParams:
         """A copy with some fields changed, checked again (on construction)."""
         return replace(self, **changes)
 
-    def as_dict(self) -> dict[str, float]:
+    def as_dict(self) -> dict[str, Any]:
         return asdict(self)

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from .choices import HOSTS, TRACKED
+from .crush_law import LEGACY_LAW, CrushLaw
 from .engine import filtered_acceleration, get_integrator, test_item_derivatives
 from .errors import OptionError
 from .limits import check_memory, fill_bytes
@@ -79,6 +80,11 @@ class Shot:
     def with_params(self, **changes: float) -> Shot:
         """The same shot with some parameters changed (checked again)."""
         return Shot(self.params.replace(**changes), self.source, list(self.warnings))
+
+    def with_law(self, law: CrushLaw | None) -> Shot:
+        """The same shot with another crush-factor law (None: the macro's, Eq. 8)."""
+        return Shot(self.params.replace(crush_law=law or LEGACY_LAW), self.source,
+                    list(self.warnings))
 
     def run(self, integrator: str = "legacy", host: str = "excel",
             track: Collection[str] = TRACKED) -> Result:

@@ -40,6 +40,10 @@ def add_parser(sub):
                         "run still stops)")
     p.add_argument("--model", choices=MODELS, default="4-mass",
                    help="4-mass: ArtSim (default); rigid: the previous rigid-body model")
+    p.add_argument("--crush-law", choices=("workbook", "legacy"), default="workbook",
+                   help="workbook: the law the workbook's Crush law sheet names (a calibrated "
+                        "workbook's fitted law), else the macro's (default); legacy: the "
+                        "macro's polynomial, Eq. (8), whatever the workbook says")
     p.add_argument("--compare-models", action="store_true",
                    help="also run the other model; both curves in the acceleration chart and "
                         "both peaks in the Summary")
@@ -70,7 +74,9 @@ def print_summary(output, filled):
              + (f", 1 in {stride} on the sheets" if stride > 1 else "")
              + f"; {result.params.model.split(' (')[0]} model"
              + (" (rigid)" if result.model == "rigid" else "")
-             + f", {result.integrator} integrator"]
+             + f", {result.integrator} integrator"
+             + ("" if result.params.crush_law.is_legacy else
+                ", the workbook's fitted crush law (Crush law sheet)")]
     if s is not None:
         filtered = ("no filtered samples" if s.filtered_peak_kg != s.filtered_peak_kg else
                     f"filtered {s.filtered_peak_kg:.5f} kG at "
@@ -101,6 +107,8 @@ def run(args):
     started = time.perf_counter()
     output = Path(args.output) if args.output else default_output(args.shot)
     shot = Shot.from_workbook(args.shot)
+    if args.crush_law == "legacy":
+        shot = shot.with_law(None)
     outputs = from_sheet(shot.source.outputs_block).with_flags(
         args.only, args.no_charts, args.every, args.max_sheet_rows, args.sidecar)
     options = Options(args.integrator, args.host, args.model, args.compare_models, args.force,

@@ -23,6 +23,8 @@ from ..errors import AirgunXlError, CellError, WorkbookError
 from ..params import Found, ShotParams, describe
 from . import guard
 from .formula_eval import Evaluator, FormulaFailure, SheetView
+from .law_sheet import KEY as LAW_KEY
+from .law_sheet import law_from_cells
 
 #: Columns read from a sheet other than the parameter sheet (Outputs, or one a formula names).
 OTHER_COLUMNS = 26
@@ -59,6 +61,11 @@ class Source:
     def outputs_block(self):
         """Cells of the workbook's Outputs sheet, if it has one."""
         return self.other_sheets.get("OUTPUTS", {})
+
+    @property
+    def law_block(self):
+        """Cells of the workbook's Crush law sheet, if it has one."""
+        return self.other_sheets.get(LAW_KEY)
 
     def view(self, extra_columns=None):
         """A :class:`SheetView` over the parameter sheet and the other sheets."""
@@ -108,7 +115,7 @@ def _read_zip(path, data):
             if first:
                 text = " ".join(f for _, f in cells.values() if f).upper()
                 wanted = {t.upper() for t in wb_f.sheetnames[1:]
-                          if t.upper() in text or t.upper() == "OUTPUTS"}
+                          if t.upper() in text or t.upper() in ("OUTPUTS", LAW_KEY)}
     except AirgunXlError:
         raise
     except Exception as exc:  # noqa: BLE001 - any parser failure on untrusted bytes is one line
@@ -150,7 +157,7 @@ def _read_xls(path, data):
         wb = CalamineWorkbook.from_filelike(io.BytesIO(data))
         names = list(wb.sheet_names)
         sheets = {}
-        for name in names[:1] + [n for n in names[1:] if n.upper() == "OUTPUTS"]:
+        for name in names[:1] + [n for n in names[1:] if n.upper() in ("OUTPUTS", LAW_KEY)]:
             first = not sheets
             rows = wb.get_sheet_by_name(name).to_python(skip_empty_area=False)
             cells = {}
@@ -266,4 +273,7 @@ def read_params(path):
     source = read_source(path)
     check_time_header(source)
     raw, warnings = parameter_values(source)
-    return ShotParams.from_cells(raw), source, warnings
+    params = ShotParams.from_cells(raw)
+    if source.law_block is not None:
+        params = params.replace(crush_law=law_from_cells(source.law_block))
+    return params, source, warnings

@@ -37,6 +37,8 @@ from ..transaction import atomic_path, check_output, display
 from .charts import add_charts, series_data
 from .columns_sheet import ColumnsWorksheet, fast_deflate
 from .formula_eval import Evaluator, FormulaFailure
+from .law_sheet import SHEET_NAME as LAW_SHEET
+from .law_sheet import write_law_sheet
 from .page_setup import not_printed, one_page
 from .safe_text import (
     BOOLEAN_FORMAT,
@@ -93,7 +95,7 @@ def new_workbook(path):
 
 
 #: The sheets a fill adds after sheet 1, by their fixed names.
-OUTPUT_SHEETS = ("Summary", "Charts", "Tracked", "Spectrum", "ChartData", SHEET_NAME)
+OUTPUT_SHEETS = ("Summary", "Charts", "Tracked", "Spectrum", "ChartData", SHEET_NAME, LAW_SHEET)
 
 
 def sheet_names(source_title):
@@ -350,5 +352,7 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
         warnings += write_cells(outputs_ws, source.outputs_block)
         one_page(outputs_ws, max(r for r, _ in source.outputs_block) - 1,
                  max(c for _, c in source.outputs_block) - 1)
+    if not result.params.crush_law.is_legacy:  # a fitted law goes with the shot
+        write_law_sheet(wb, result.params.crush_law, names[LAW_SHEET])
     close_workbook(wb, shown if shown is not None else tmp)
     return warnings
