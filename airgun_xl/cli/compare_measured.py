@@ -55,13 +55,17 @@ def run(args):
     result = dataclasses.replace(shot, params=apply_model(shot.params, args.model)).run(
         integrator=args.integrator, track=())
     finite = np.isfinite(result.accel_kg)
+    other = "rigid" if args.model == "4-mass" else "4-mass"
+    rigid = dataclasses.replace(shot, params=apply_model(shot.params, other)).run(
+        integrator=args.integrator, track=())
+    ok = np.isfinite(rigid.accel_kg)
     c = compare(result.history.time[finite], result.accel_kg[finite], trace, args.cfc,
-                args.align)
+                args.align, rigid=(rigid.history.time[ok], rigid.accel_kg[ok]))
     about = [("Shot", str(args.shot)), ("Measured", trace.name),
              ("Units read", f"time {trace.units[0]}, acceleration {trace.units[1]}"),
              ("Filter", f"CFC {args.cfc}" if args.cfc else "none"),
              ("Alignment", args.align)]
-    write_comparison(output, c, about, args.force)
+    write_comparison(output, c, about, args.force, models=(args.model, other))
     print(f"wrote {output}: {trace.name} against {args.shot} ({len(c.time):,} samples, "
           f"aligned by {args.align}, shift {c.shift * 1e3:.4f} ms)")
     print(f"  peak {c.predicted.peak_kg:.4f} kG predicted, {c.measured.peak_kg:.4f} measured "
@@ -69,4 +73,7 @@ def run(args):
           f"{c.measured.pulse_duration * 1e3:.4f} ({c.errors['pulse_duration']:+.2%})")
     print(f"  velocity change {c.predicted.delta_v:.3f} m/s, {c.measured.delta_v:.3f} "
           f"({c.errors['delta_v']:+.2%}); correlation r = {c.correlation:.4f}")
+    r = c.iso
+    print(f"  ISO/TS 18571 rating {r.overall:.3f} ({r.grade}): corridor {r.corridor:.3f}, "
+          f"phase {r.phase:.3f}, magnitude {r.magnitude:.3f}, slope {r.slope:.3f}")
     return 0

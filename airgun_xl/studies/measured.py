@@ -47,6 +47,14 @@ class Comparison:
     measured: Figures
     correlation: float
     errors: dict = field(default_factory=dict)
+    iso: object = None  # iso18571.Rating of the prediction against the test
+    interval: tuple = (np.nan, np.nan)  # the rating's evaluation interval [s], as ``time``
+    predicted_spectrum: object = None  # engine.summary.Spectrum of the aligned traces
+    measured_spectrum: object = None
+    srs_frequencies: np.ndarray = None  # [Hz]
+    predicted_srs: np.ndarray = None  # maximax, Q = 10 [kG]
+    measured_srs: np.ndarray = None
+    rigid_kg: np.ndarray = None  # the rigid model's prediction on ``time`` (Fig. 13)
 
 
 def _impact(time, accel):
@@ -63,7 +71,7 @@ def _figures(time, accel, impact):
                    float(trapezoid(accel, time) * KG_MS2))
 
 
-def compare(pred_time, pred_kg, trace, cfc=None, alignment="threshold"):
+def compare(pred_time, pred_kg, trace, cfc=None, alignment="threshold", rigid=None):
     """Score a predicted pulse against a measured :class:`~airgun_xl.workbook.trace.Trace`.
 
     Parameters
@@ -74,6 +82,9 @@ def compare(pred_time, pred_kg, trace, cfc=None, alignment="threshold"):
     cfc : int, optional
         SAE J211 channel class for both traces.
     alignment : {"threshold", "xcorr"}
+    rigid : (numpy.ndarray, numpy.ndarray), optional
+        The rigid model's time [s] and acceleration [kG], filtered and placed as the
+        prediction, for the report's Fig. 13.
 
     Returns
     -------
@@ -118,5 +129,35 @@ def compare(pred_time, pred_kg, trace, cfc=None, alignment="threshold"):
         / m_fig.pulse_duration if m_fig.pulse_duration else np.nan,
         "delta_v": (p_fig.delta_v - m_fig.delta_v) / m_fig.delta_v if m_fig.delta_v else np.nan,
     }
-    return Comparison(t - impact_pred, predicted, measured, shift, alignment, cfc, p_fig,
-                      m_fig, correlation, errors)
+    out = Comparison(t - impact_pred, predicted, measured, shift, alignment, cfc, p_fig,
+                     m_fig, correlation, errors)
+    _spectra_and_rating(out, trace.dt)
+    if rigid is not None:
+        r_time, r_kg = rigid
+        r_dt = float(r_time[1] - r_time[0])
+        r = cfc_filter(r_kg, r_dt, cfc) if cfc else np.asarray(r_kg, float)
+        out.rigid_kg = np.interp(t, r_time, r)
+    return out
+
+
+def _spectra_and_rating(c, dt):
+    """The ISO/TS 18571 rating over the measured pulse (10 % rule) widened by a tenth of its
+    duration each side; both amplitude spectra with their peaks and the errors of the
+    dominant one; both SRS (maximax, Q = 10, 100 Hz to 10 kHz or a tenth of the rate)."""
+    from ..engine.summary import amplitude_spectrum
+    from .iso18571 import rating
+    from .shock import default_frequencies, srs
+
+    start, end, duration = pulse(c.time, c.measured_kg)
+    margin = 0.1 * duration
+    c.interval = (max(c.time[0], start - margin), min(c.time[-1], end + margin))
+    c.iso = rating(c.time, c.measured_kg, c.predicted_kg, *c.interval)
+    c.predicted_spectrum = amplitude_spectrum(c.predicted_kg, dt)
+    c.measured_spectrum = amplitude_spectrum(c.measured_kg, dt)
+    if c.predicted_spectrum.peaks and c.measured_spectrum.peaks:
+        fp, fm = c.predicted_spectrum.peaks[0], c.measured_spectrum.peaks[0]
+        c.errors["dominant_frequency"] = (fp - fm) / fm
+    c.srs_frequencies = default_frequencies(100.0, min(10_000.0, 0.1 / dt))
+    c.predicted_srs = srs(c.predicted_kg, dt, c.srs_frequencies)
+    c.measured_srs = srs(c.measured_kg, dt, c.srs_frequencies)
+    c.errors["srs_peak"] = float(c.predicted_srs.max() / c.measured_srs.max() - 1)

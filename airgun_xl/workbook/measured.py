@@ -1,4 +1,7 @@
-"""The ``compare-measured`` workbook: the scores, and the two aligned traces with a chart."""
+"""The ``compare-measured`` workbook: the scores (headline figures, ISO/TS 18571 rating,
+spectra and SRS), the aligned traces, and the report's Figs. 13-15 as native charts."""
+import numpy as np
+
 from ..transaction import atomic_path, check_output
 from .charts import nice_range
 from .columns_sheet import ColumnsWorksheet
@@ -11,55 +14,184 @@ ROWS = (("Peak acceleration", "peak_kg", "kG", 1.0, "0.000"),
         ("Pulse duration (>= 10% of peak)", "pulse_duration", "ms", 1e3, "0.0000"),
         ("Velocity change", "delta_v", "m/s", 1.0, "0.00"))
 
+ISO_ROWS = (("Corridor (weight 0.4)", "corridor"), ("Phase (0.2)", "phase"),
+            ("Magnitude (0.2)", "magnitude"), ("Slope (0.2)", "slope"),
+            ("Overall rating R", "overall"))
 
-def write_comparison(path, comparison, about, force=False):
-    """Write the Compared sheet (figures, errors, correlation, alignment) and the Traces sheet
-    (time, predicted, measured) with a chart of both, at ``path``."""
+PREDICTED, MEASURED, RIGID = "#1f4e79", "#c00000", "#7f7f7f"
+SPECTRUM_FROM_HZ = 1_000.0  # below: the pulse's own shape, as the fill's chart
+SPECTRUM_TO_HZ = 15_000.0
+
+
+def _line(color, dash=None):
+    line = {"color": color, "width": 1.25}
+    if dash:
+        line["dash_type"] = dash
+    return line
+
+
+def _series(chart, sheet, name, n, x_col, y_col, color, dash=None, first=1):
+    chart.add_series({"name": name, "categories": [sheet, first, x_col, first + n - 1, x_col],
+                      "values": [sheet, first, y_col, first + n - 1, y_col],
+                      "line": _line(color, dash), "marker": {"type": "none"}})
+
+
+def _write_scores(wb, ws, c, head, bold, models):
+    pct = wb.add_format({"num_format": "0.00%"})
+    score = wb.add_format({"num_format": "0.000"})
+    ws.write_row(head, 0, ["Figure", "Predicted", "Measured", "Unit", "Error"], bold)
+    row = head + 1
+    for label, key, unit, factor, fmt in ROWS:
+        form = wb.add_format({"num_format": fmt})
+        ws.write_string(row, 0, label)
+        ws.write_number(row, 1, getattr(c.predicted, key) * factor, form)
+        ws.write_number(row, 2, getattr(c.measured, key) * factor, form)
+        ws.write_string(row, 3, unit)
+        if key == "time_of_peak":
+            ws.write_number(row, 4, c.errors[key] * factor, form)
+        else:
+            ws.write_number(row, 4, c.errors[key], pct)
+        row += 1
+    khz = wb.add_format({"num_format": "0.00"})
+    for k in range(3):
+        p = c.predicted_spectrum.peaks[k] if k < len(c.predicted_spectrum.peaks) else None
+        m = c.measured_spectrum.peaks[k] if k < len(c.measured_spectrum.peaks) else None
+        if p is None and m is None:
+            continue
+        ws.write_string(row, 0, f"FFT peak {k + 1} (strongest first)")
+        for col, value in ((1, p), (2, m)):
+            if value is not None:
+                ws.write_number(row, col, value / 1e3, khz)
+        ws.write_string(row, 3, "kHz")
+        if k == 0 and "dominant_frequency" in c.errors:
+            ws.write_number(row, 4, c.errors["dominant_frequency"], pct)
+        row += 1
+    ws.write_string(row, 0, "SRS peak (maximax, Q = 10)")
+    ws.write_number(row, 1, float(c.predicted_srs.max()), score)
+    ws.write_number(row, 2, float(c.measured_srs.max()), score)
+    ws.write_string(row, 3, "kG")
+    ws.write_number(row, 4, c.errors["srs_peak"], pct)
+    row += 2
+    r = c.iso
+    ws.write_row(row, 0, ["ISO/TS 18571", "Score"], bold)
+    row += 1
+    for label, key in ISO_ROWS:
+        ws.write_string(row, 0, label)
+        ws.write_number(row, 1, getattr(r, key), score)
+        row += 1
+    ws.write_string(row, 0, "Grade")
+    ws.write_string(row, 1, r.grade)
+    row += 1
+    for label, value in (("Evaluation interval from (ms)", c.interval[0] * 1e3),
+                         ("Evaluation interval to (ms)", c.interval[1] * 1e3),
+                         ("Phase shift n_eps (samples at 10 kHz)", float(r.shift)),
+                         ("Correlation (Pearson r)", c.correlation),
+                         ("Shift of the measured time (ms)", c.shift * 1e3)):
+        ws.write_string(row, 0, label)
+        ws.write_number(row, 1, value)
+        row += 1
+    if c.rigid_kg is not None:
+        ws.write_string(row, 0, f"Peak of the {models[1]} model (kG)")
+        ws.write_number(row, 1, float(np.max(c.rigid_kg)), score)
+        row += 1
+    return row
+
+
+def _traces_chart(wb, c, n, models):
+    chart = wb.add_chart({"type": "scatter", "subtype": "straight"})
+    _series(chart, "Traces", "Measured", n, 0, 2, MEASURED)
+    _series(chart, "Traces", f"Predicted, {models[0]} model", n, 0, 1, PREDICTED)
+    values = list(c.predicted_kg) + list(c.measured_kg)
+    if c.rigid_kg is not None:
+        _series(chart, "Traces", f"Predicted, {models[1]} model", n, 0, 3, RIGID, "dash")
+        values += list(c.rigid_kg)
+    lo, hi = nice_range(c.time)
+    ylo, yhi = nice_range(values, include_zero=True)
+    chart.set_title({"name": "Test against prediction (Fig. 13)"})
+    chart.set_x_axis({"name": "Time after impact (s)", "min": lo, "max": hi})
+    chart.set_y_axis({"name": "Acceleration (kG)", "min": ylo, "max": yhi})
+    chart.set_legend({"position": "bottom"})
+    chart.set_size({"width": 720, "height": 420})
+    return chart
+
+
+def _spectrum_chart(wb, c, n):
+    chart = wb.add_chart({"type": "scatter", "subtype": "straight"})
+    _series(chart, "Spectra", "Measured", n, 0, 2, MEASURED)
+    _series(chart, "Spectra", "Predicted", n, 0, 1, PREDICTED)
+    keep = c.predicted_spectrum.frequency >= SPECTRUM_FROM_HZ
+    _, yhi = nice_range(list(c.predicted_spectrum.amplitude[keep])
+                        + list(c.measured_spectrum.amplitude[keep]), include_zero=True)
+    chart.set_title({"name": "Spectra of test and prediction (Figs. 14-15)"})
+    chart.set_x_axis({"name": "Frequency (Hz)", "min": SPECTRUM_FROM_HZ,
+                      "max": SPECTRUM_TO_HZ})
+    chart.set_y_axis({"name": "Amplitude (kG)", "min": 0, "max": yhi})
+    chart.set_legend({"position": "bottom"})
+    chart.set_size({"width": 720, "height": 380})
+    return chart
+
+
+def _srs_chart(wb, c, n):
+    chart = wb.add_chart({"type": "scatter", "subtype": "straight"})
+    _series(chart, "SRS", "Measured", n, 0, 2, MEASURED)
+    _series(chart, "SRS", "Predicted", n, 0, 1, PREDICTED)
+    both = np.concatenate([c.predicted_srs, c.measured_srs])
+    lo = 10.0 ** np.floor(np.log10(max(float(both.min()), 1e-12)))
+    hi = 10.0 ** np.ceil(np.log10(max(float(both.max()), 1e-12)))
+    f = c.srs_frequencies
+    chart.set_title({"name": "Shock response spectra (maximax, Q = 10)"})
+    chart.set_x_axis({"name": "Natural frequency (Hz)", "log_base": 10,
+                      "min": 10.0 ** np.floor(np.log10(f[0])),
+                      "max": 10.0 ** np.ceil(np.log10(f[-1]))})
+    chart.set_y_axis({"name": "Peak response (kG)", "log_base": 10, "min": lo, "max": hi})
+    chart.set_legend({"position": "bottom"})
+    chart.set_size({"width": 720, "height": 380})
+    return chart
+
+
+def write_comparison(path, comparison, about, force=False, models=("4-mass", "rigid")):
+    """Write the Compared sheet (figures, errors, the ISO/TS 18571 rating, spectra and SRS
+    figures, and the charts of Figs. 13-15) and its data sheets (Traces, Spectra, SRS) at
+    ``path``; ``models`` names the prediction's model and the compared one."""
     c = comparison
     check_output(path, force)
     with atomic_path(path, force) as tmp:
         wb = new_workbook(tmp)
         ws = wb.add_worksheet("Compared")
         bold = wb.add_format({"bold": True})
-        pct = wb.add_format({"num_format": "0.00%"})
-        ws.set_column(0, 0, 34)
+        ws.set_column(0, 0, 38)
         ws.set_column(1, 4, 14)
         head = write_about(ws, about, bold) + 1
-        ws.write_row(head, 0, ["Figure", "Predicted", "Measured", "Unit", "Error"], bold)
-        for i, (label, key, unit, factor, fmt) in enumerate(ROWS, start=head + 1):
-            form = wb.add_format({"num_format": fmt})
-            ws.write_string(i, 0, label)
-            ws.write_number(i, 1, getattr(c.predicted, key) * factor, form)
-            ws.write_number(i, 2, getattr(c.measured, key) * factor, form)
-            ws.write_string(i, 3, unit)
-            if key == "time_of_peak":
-                ws.write_number(i, 4, c.errors[key] * factor, form)
-            else:
-                ws.write_number(i, 4, c.errors[key], pct)
-        row = head + len(ROWS) + 2
-        for label, value in (("Correlation (Pearson r)", c.correlation),
-                             ("Shift of the measured time (ms)", c.shift * 1e3)):
-            ws.write_string(row, 0, label)
-            ws.write_number(row, 1, value)
-            row += 1
+        row = _write_scores(wb, ws, c, head, bold, models)
+
         data = wb.add_worksheet("Traces", worksheet_class=ColumnsWorksheet)
-        data.write_row(0, 0, ["Time after impact (s)", "Predicted (kG)", "Measured (kG)"], bold)
-        write_number_columns(data, 1, {0: c.time, 1: c.predicted_kg, 2: c.measured_kg})
+        names = ["Time after impact (s)", "Predicted (kG)", "Measured (kG)"]
+        columns = {0: c.time, 1: c.predicted_kg, 2: c.measured_kg}
+        if c.rigid_kg is not None:
+            names.append(f"Predicted, {models[1]} model (kG)")
+            columns[3] = c.rigid_kg
+        data.write_row(0, 0, names, bold)
+        write_number_columns(data, 1, columns)
         not_printed(data)
-        n = len(c.time)
-        chart = wb.add_chart({"type": "scatter", "subtype": "straight"})
-        for col, name, color in ((2, "Measured", "#c00000"), (1, "Predicted", "#1f4e79")):
-            chart.add_series({"name": name, "categories": ["Traces", 1, 0, n, 0],
-                              "values": ["Traces", 1, col, n, col],
-                              "line": {"color": color, "width": 1.25},
-                              "marker": {"type": "none"}})
-        lo, hi = nice_range(c.time)
-        ylo, yhi = nice_range(list(c.predicted_kg) + list(c.measured_kg), include_zero=True)
-        chart.set_title({"name": "Test against prediction (Fig. 13)"})
-        chart.set_x_axis({"name": "Time after impact (s)", "min": lo, "max": hi})
-        chart.set_y_axis({"name": "Acceleration (kG)", "min": ylo, "max": yhi})
-        chart.set_legend({"position": "bottom"})
-        chart.set_size({"width": 720, "height": 420})
-        ws.insert_chart(row + 1, 0, chart)
-        one_page(ws, row + 23, 8)  # the table and the chart (420 px: about 21 rows)
+
+        spectra = wb.add_worksheet("Spectra", worksheet_class=ColumnsWorksheet)
+        spectra.write_row(0, 0, ["Frequency (Hz)", "Predicted (kG)", "Measured (kG)"], bold)
+        f = c.predicted_spectrum.frequency
+        n_spec = min(len(f), len(c.measured_spectrum.amplitude))
+        write_number_columns(spectra, 1, {0: f[:n_spec],
+                                          1: c.predicted_spectrum.amplitude[:n_spec],
+                                          2: c.measured_spectrum.amplitude[:n_spec]})
+        not_printed(spectra)
+
+        srs = wb.add_worksheet("SRS", worksheet_class=ColumnsWorksheet)
+        srs.write_row(0, 0, ["Natural frequency (Hz)", "Predicted (kG)", "Measured (kG)"],
+                      bold)
+        write_number_columns(srs, 1, {0: c.srs_frequencies, 1: c.predicted_srs,
+                                      2: c.measured_srs})
+        not_printed(srs)
+
+        ws.insert_chart(row + 1, 0, _traces_chart(wb, c, len(c.time), models))
+        ws.insert_chart(row + 23, 0, _spectrum_chart(wb, c, n_spec))
+        ws.insert_chart(row + 43, 0, _srs_chart(wb, c, len(c.srs_frequencies)))
+        one_page(ws, row + 63, 8)  # the tables and the three charts
         close_workbook(wb, path)
