@@ -5,6 +5,7 @@ from .. import __version__
 from ..errors import OptionError
 from . import (
     archive,
+    calibrate,
     check,
     compare_measured,
     convergence,
@@ -17,7 +18,7 @@ from . import (
 )
 
 COMMANDS = (fill, diff, archive, check, convergence, design, sweep, srs, compare_measured,
-            template)
+            calibrate, template)
 
 
 class _Parser(argparse.ArgumentParser):

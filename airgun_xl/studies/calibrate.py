@@ -272,6 +272,23 @@ def _objective_residuals(aligned, objective):
     return np.concatenate(parts)
 
 
+def check_fit(names, objective="l2"):
+    """The fit's names, unique and in order; one line naming the fault otherwise."""
+    names = list(dict.fromkeys(names))
+    unknown = [n for n in names if n not in FIT_PARAMETERS]
+    if unknown or not names:
+        raise OptionError(f"--fit: found {','.join(unknown) or 'nothing'}, expected names "
+                          f"from {', '.join(FIT_PARAMETERS)}")
+    if "E40" in names and "scale" in names:
+        raise OptionError("--fit: found both E40 and scale, expected one of them: the yield "
+                          "stress and the law's scale multiply the same crush force, so no "
+                          "pulse can tell them apart")
+    if objective not in OBJECTIVES:
+        raise OptionError(f"--objective: found {objective!r}, expected one of "
+                          f"{', '.join(OBJECTIVES)}")
+    return names
+
+
 def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
     """Fit E40, E43 and/or a law scale to measured shots by least squares.
 
@@ -291,18 +308,7 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
     """
     from scipy.optimize import least_squares
 
-    names = list(dict.fromkeys(names))
-    unknown = [n for n in names if n not in FIT_PARAMETERS]
-    if unknown or not names:
-        raise OptionError(f"--fit: found {','.join(unknown) or 'nothing'}, expected names "
-                          f"from {', '.join(FIT_PARAMETERS)}")
-    if "E40" in names and "scale" in names:
-        raise OptionError("--fit: found both E40 and scale, expected one of them: the yield "
-                          "stress and the law's scale multiply the same crush force, so no "
-                          "pulse can tell them apart")
-    if objective not in OBJECTIVES:
-        raise OptionError(f"--objective: found {objective!r}, expected one of "
-                          f"{', '.join(OBJECTIVES)}")
+    names = check_fit(names, objective)
     p0 = pairs[0][0]
     start = {"E40": p0.sigmay, "E43": p0.zeta, "scale": 1.0}
     x0, lo, hi = [], [], []
@@ -339,6 +345,87 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
                         xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=200)
     return FitResult(dict(zip(names, map(float, fit.x))), {n: start[n] for n in names},
                      float(fit.cost), evaluations[0], shots(fit.x))
+
+
+@dataclass
+class Score:
+    rms: float  # RMS error over the measured pulse, relative to its peak
+    iso: float  # ISO/TS 18571 overall rating
+
+
+@dataclass
+class Calibration:
+    """What :func:`calibrate` found: each shot's fitted parameters, and the way there."""
+
+    params: list
+    law_calibration: LawCalibration | None
+    fitted: dict
+    start: dict
+    before: list
+    after: list
+    aligned: list  # each shot's pulses after calibration
+    runs: int = 0
+    seconds: float = 0.0
+
+
+def score(a):
+    """RMS error and ISO/TS 18571 rating of an aligned pair, over the measured pulse."""
+    from ..engine.summary import pulse
+    from .iso18571 import rating
+
+    start, end, duration = pulse(a.time, a.measured_kg)
+    lo, hi = max(a.time[0], start - 0.1 * duration), min(a.time[-1], end + 0.1 * duration)
+    return Score(rms_error(a), rating(a.time, a.measured_kg, a.simulated_kg, lo, hi).overall)
+
+
+def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objective="l2",
+              integrator="legacy"):
+    """Calibrate the model on measured shots: the crush-factor law (the report's iteration,
+    then least squares on the law's values, :func:`refine_law`), then the named parameters
+    (:func:`fit_parameters`).
+
+    Parameters
+    ----------
+    params : list of ShotParams
+    traces : list of Trace
+        The measured pulse of each shot.
+    law : bool
+    fit : sequence of str
+        Names from :data:`FIT_PARAMETERS`.
+
+    Returns
+    -------
+    Calibration
+    """
+    import time
+
+    started = time.perf_counter()
+    counter = {"runs": 0}
+    pairs = list(zip(params, traces))
+
+    def run_all(ps):
+        counter["runs"] += len(ps)
+        return [align(_run(p, integrator), t, cfc) for p, t in zip(ps, traces)]
+
+    before = [score(a) for a in run_all(params)]
+    law_cal = None
+    if law:
+        law_cal = calibrate_law(pairs, cfc, degree, integrator)
+        counter["runs"] += len(law_cal.iterations) * len(pairs)
+        refined, evaluations = refine_law(pairs, law_cal.law, cfc, objective, integrator,
+                                          degree)
+        counter["runs"] += evaluations * len(pairs)
+        params = [p.replace(crush_law=refined) for p in params]
+        pairs = list(zip(params, traces))
+    fitted, start = {}, {}
+    if fit:
+        result = fit_parameters(pairs, fit, cfc, objective, integrator)
+        counter["runs"] += result.evaluations * len(pairs)
+        params, fitted, start = result.params, result.values, result.start
+    aligned = run_all(params)
+    after = [score(a) for a in aligned]
+    return Calibration(params, law_cal, fitted, start, before, after, aligned,
+                       counter["runs"], time.perf_counter() - started)
 
 
 def synthetic_measurement(p, dt=1e-5, noise=0.01, ringing_hz=8000.0, ringing=0.1, seed=0,

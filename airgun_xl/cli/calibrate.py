@@ -1,0 +1,92 @@
+"""``airgun-xl calibrate SHOT.xlsx MEASURED.csv [SHOT2.xlsx MEASURED2.csv ...]``: the model
+fitted to the shots that were fired."""
+from pathlib import Path
+
+from ..choices import INTEGRATORS
+from ..errors import OptionError
+
+
+def add_parser(sub):
+    p = sub.add_parser("calibrate", help="fit the crush-factor law, E40 or zeta to measured "
+                                         "shots; write a workbook fill can run",
+                       description="Recover the crush-factor law from one or more measured "
+                                   "shots by the report's iteration (force over static crush "
+                                   "force against relative velocity, refit, rerun, until the "
+                                   "law moves < 1 %%), then a least-squares finish; and/or fit "
+                                   "E40, E43 (zeta) or the law's scale by least squares. "
+                                   "Writes the first shot's workbook with the fitted values "
+                                   "and a Crush law sheet that fill runs.")
+    p.add_argument("pairs", nargs="+", metavar="SHOT.xlsx MEASURED.csv",
+                   help="each shot's workbook followed by its measured pulse (CSV)")
+    p.add_argument("-o", "--output", metavar="OUT.xlsx",
+                   help="the calibrated workbook (default: SHOT.calibrated.xlsx)")
+    p.add_argument("--force", action="store_true")
+    p.add_argument("--law", action="store_true",
+                   help="recover the crush-factor law (the default when --fit is not given)")
+    p.add_argument("--fit", metavar="NAMES",
+                   help="fit these by least squares, comma-separated: E40, E43, scale "
+                        "(E40 and scale exclude each other)")
+    p.add_argument("--objective", choices=("l2", "iso18571"), default="l2",
+                   help="what the least squares minimise: the filtered pulses' difference "
+                        "(default) or 1 - the ISO/TS 18571 rating")
+    p.add_argument("--cfc", type=int, default=None,
+                   help="filter both pulses: SAE J211 class 60, 180, 600 or 1000 (recommended "
+                        "for the law: the recorder's ringing; it hides zeta)")
+    p.add_argument("--degree", type=int, default=6, help="of the law's polynomial (1-6, "
+                                                          "default 6 as Eq. 8)")
+    p.add_argument("--sign", type=float, default=1.0, choices=(1.0, -1.0))
+    p.add_argument("--time-unit", help="s, ms or us (default: from the header)")
+    p.add_argument("--accel-unit", help="g, kG or m/s^2 (default: from the header)")
+    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
+    p.set_defaults(run=run)
+
+
+def _pairs(values):
+    if len(values) % 2:
+        raise OptionError(f"calibrate: found {len(values)} files, expected pairs of "
+                          "SHOT.xlsx MEASURED.csv")
+    return [(values[i], values[i + 1]) for i in range(0, len(values), 2)]
+
+
+def run(args):
+    from ..shot import Shot
+    from ..studies.calibrate import calibrate, check_fit
+    from ..studies.shock import CFC_CLASSES, cfc_coefficients
+    from ..transaction import check_output
+    from ..workbook.calibration import write_calibration
+    from ..workbook.trace import read_trace
+
+    files = _pairs(args.pairs)
+    if args.cfc is not None and args.cfc not in CFC_CLASSES:
+        cfc_coefficients(args.cfc, 1.0)  # its one-line error, before any run
+    if not 1 <= args.degree <= 6:
+        raise OptionError(f"--degree: found {args.degree}, expected 1 to 6 (Eq. 8 is of "
+                          "degree 6)")
+    names = [n.strip() for n in (args.fit or "").split(",") if n.strip()]
+    if args.fit is not None:
+        names = check_fit(names, args.objective)
+    law = args.law or not names
+    first = Path(files[0][0])
+    output = Path(args.output) if args.output else first.with_name(
+        first.stem + ".calibrated.xlsx")
+    check_output(output, args.force, inputs=[f for pair in files for f in pair])
+    shots = [Shot.from_workbook(s) for s, _ in files]
+    traces = [read_trace(m, args.time_unit, args.accel_unit, args.sign) for _, m in files]
+    cal = calibrate([s.params for s in shots], traces, law=law, fit=names, cfc=args.cfc,
+                    degree=args.degree, objective=args.objective,
+                    integrator=args.integrator)
+    write_calibration(output, shots[0], cal, files, args, args.force)
+    print(f"wrote {output}: calibrated on {len(files)} shot{'s' * (len(files) > 1)} "
+          f"({cal.runs} runs, {cal.seconds:.2f} s)")
+    if cal.law_calibration is not None:
+        lc = cal.law_calibration
+        lo, hi = cal.params[0].crush_law.v_range
+        print(f"  crush law: {'converged' if lc.converged else 'NOT converged'} in "
+              f"{len(lc.iterations)} iterations (last change {lc.iterations[-1].change:.2%}), "
+              f"then least squares; valid {lo:.1f} to {hi:.1f} m/s")
+    for name, value in cal.fitted.items():
+        print(f"  {name}: {cal.start[name]:.6g} -> {value:.6g}")
+    for i, (before, after) in enumerate(zip(cal.before, cal.after), start=1):
+        print(f"  shot {i}: RMS error {before.rms:.2%} -> {after.rms:.2%}; ISO/TS 18571 "
+              f"{before.iso:.3f} -> {after.iso:.3f}")
+    return 0

@@ -1,0 +1,176 @@
+"""The ``calibrate`` workbook: a shot ``fill`` can run with the fitted values, and the
+calibration's report.
+
+Sheet 1 is the first shot's parameter block with E40 and E43 replaced by their fitted values
+(when fitted); the Outputs block follows it; ``Crush law`` holds a fitted law (when one was
+fitted). ``Calibration`` reports the iterations, the fitted values, each shot's scores before
+and after, the law against the macro's (the report's Figs. 7-8) and the first shot's pulses;
+``Law`` and ``Pulses`` hold the charts' data.
+"""
+import numpy as np
+
+from ..crush_law import LEGACY_LAW
+from ..transaction import atomic_path, check_output
+from .charts import nice_range
+from .columns_sheet import ColumnsWorksheet
+from .law_sheet import write_law_sheet
+from .page_setup import not_printed, one_page
+from .sheets import write_about, write_number_columns
+from .writer import close_workbook, new_workbook, sheet_names, write_cells
+
+#: Fitted name -> (parameter cell (row, col), ShotParams field).
+CELLS = {"E40": ((40, 5), "sigmay"), "E43": ((43, 5), "zeta")}
+
+
+def _parameter_sheet(wb, shot, params, names, fitted):
+    source = shot.source
+    block = {k: v for k, v in source.block.items() if k[1] <= 7}
+    for name, (cell, field) in CELLS.items():
+        if name in fitted:
+            block[cell] = (getattr(params, field), None)  # the fitted value, a plain number
+    ws = wb.add_worksheet(names["first"], worksheet_class=ColumnsWorksheet)
+    warnings = write_cells(ws, block, {k: v[0] for k, v in block.items()})
+    if source.outputs_block:
+        out = wb.add_worksheet(names["Outputs"], worksheet_class=ColumnsWorksheet)
+        warnings += write_cells(out, source.outputs_block)
+    return warnings
+
+
+def _line(color, dash=None):
+    line = {"color": color, "width": 1.5}
+    if dash:
+        line["dash_type"] = dash
+    return line
+
+
+def _law_chart(wb, n_grid, n_samples, v_range, values):
+    chart = wb.add_chart({"type": "scatter"})
+    if n_samples:
+        chart.add_series({"name": "Measured samples (last iteration)",
+                          "categories": ["Law", 1, 3, n_samples, 3],
+                          "values": ["Law", 1, 4, n_samples, 4],
+                          "marker": {"type": "circle", "size": 2,
+                                     "fill": {"color": "#f4b183"}, "border": {"none": True}}})
+    chart.add_series({"name": "Fitted law", "categories": ["Law", 1, 0, n_grid, 0],
+                      "values": ["Law", 1, 2, n_grid, 2], "line": _line("#c00000"),
+                      "marker": {"type": "none"}})
+    chart.add_series({"name": "The macro's law, Eq. (8)",
+                      "categories": ["Law", 1, 0, n_grid, 0],
+                      "values": ["Law", 1, 1, n_grid, 1], "line": _line("#1f4e79", "dash"),
+                      "marker": {"type": "none"}})
+    lo, hi = nice_range(v_range)
+    ylo, yhi = nice_range(values, include_zero=True)
+    chart.set_title({"name": "Crush factor against relative velocity (Figs. 7-8)"})
+    chart.set_x_axis({"name": "Relative velocity (m/s)", "min": lo, "max": hi})
+    chart.set_y_axis({"name": "Crush factor (-)", "min": ylo, "max": yhi})
+    chart.set_legend({"position": "bottom"})
+    chart.set_size({"width": 720, "height": 400})
+    return chart
+
+
+def _pulse_chart(wb, a):
+    n = len(a.time)
+    chart = wb.add_chart({"type": "scatter", "subtype": "straight"})
+    for col, name, color in ((2, "Measured", "#c00000"), (1, "Calibrated model", "#1f4e79")):
+        chart.add_series({"name": name, "categories": ["Pulses", 1, 0, n, 0],
+                          "values": ["Pulses", 1, col, n, col], "line": _line(color),
+                          "marker": {"type": "none"}})
+    lo, hi = nice_range(a.time)
+    ylo, yhi = nice_range(list(a.simulated_kg) + list(a.measured_kg), include_zero=True)
+    chart.set_title({"name": "Shot 1: measured and calibrated pulses"})
+    chart.set_x_axis({"name": "Time (s)", "min": lo, "max": hi})
+    chart.set_y_axis({"name": "Acceleration (kG)", "min": ylo, "max": yhi})
+    chart.set_legend({"position": "bottom"})
+    chart.set_size({"width": 720, "height": 400})
+    return chart
+
+
+def write_calibration(path, shot, cal, files, options, force=False):
+    """Write the calibrated workbook at ``path`` (atomically); returns the copy's warnings."""
+    check_output(path, force)
+    params = cal.params[0]
+    law = params.crush_law
+    with atomic_path(path, force) as tmp:
+        wb = new_workbook(tmp)
+        names = sheet_names(shot.source.sheet_title)
+        warnings = _parameter_sheet(wb, shot, params, names, cal.fitted)
+        if not law.is_legacy:
+            write_law_sheet(wb, law, names["Crush law"])
+        ws = wb.add_worksheet("Calibration")
+        bold = wb.add_format({"bold": True})
+        pct = wb.add_format({"num_format": "0.00%"})
+        num = wb.add_format({"num_format": "0.000"})
+        ws.set_column(0, 0, 34)
+        ws.set_column(1, 5, 15)
+        about = [(f"Shot {i}", f"{s} against {m}") for i, (s, m) in enumerate(files, start=1)]
+        about += [("Filter", f"CFC {options.cfc}" if options.cfc else "none"),
+                  ("Objective", options.objective),
+                  ("Runs", f"{cal.runs} in {cal.seconds:.2f} s")]
+        row = write_about(ws, about, bold) + 1
+        lc = cal.law_calibration
+        if lc is not None:
+            ws.write_string(row, 0, "Crush-law iteration (report, section 3.2)", bold)
+            row += 1
+            ws.write_row(row, 0, ["Iteration", "Law change", "Worst RMS error", "Samples"],
+                         bold)
+            for it in lc.iterations:
+                row += 1
+                ws.write_number(row, 0, it.number)
+                ws.write_number(row, 1, it.change, pct)
+                ws.write_number(row, 2, it.rms_error, pct)
+                ws.write_number(row, 3, it.samples)
+            row += 1
+            ws.write_string(row, 0, "Converged (< 1 %)" if lc.converged else
+                            "NOT converged: the last law was kept")
+            row += 1
+            ws.write_string(row, 0, "Then least squares on the law's values at 7 velocities")
+            row += 1
+            ws.write_string(row, 0, "Valid from / to (m/s)")
+            ws.write_number(row, 1, law.v_range[0], num)
+            ws.write_number(row, 2, law.v_range[1], num)
+            row += 2
+        if cal.fitted:
+            ws.write_row(row, 0, ["Fitted", "Start", "Fitted", "Change"], bold)
+            for name, value in cal.fitted.items():
+                row += 1
+                ws.write_string(row, 0, name)
+                ws.write_number(row, 1, cal.start[name])
+                ws.write_number(row, 2, value)
+                ws.write_number(row, 3, value / cal.start[name] - 1 if cal.start[name]
+                                else 0.0, pct)
+            row += 2
+        ws.write_row(row, 0, ["Shot", "RMS error before", "after", "ISO/TS 18571 before",
+                              "after"], bold)
+        for i, (b, a) in enumerate(zip(cal.before, cal.after), start=1):
+            row += 1
+            ws.write_number(row, 0, i)
+            ws.write_number(row, 1, b.rms, pct)
+            ws.write_number(row, 2, a.rms, pct)
+            ws.write_number(row, 3, b.iso, num)
+            ws.write_number(row, 4, a.iso, num)
+        row += 2
+
+        # the law against the macro's, over its range; the last iteration's samples
+        grid = np.linspace(*law.v_range, 101)
+        data = wb.add_worksheet("Law", worksheet_class=ColumnsWorksheet)
+        data.write_row(0, 0, ["Relative velocity (m/s)", "Macro's law (-)", "Fitted law (-)",
+                              "Sample velocity (m/s)", "Sample crush factor (-)"], bold)
+        columns = {0: grid, 1: LEGACY_LAW(grid), 2: law(grid)}
+        v = lc.velocity if lc is not None else np.zeros(0)
+        x = lc.factor if lc is not None else np.zeros(0)
+        if len(v):
+            columns.update({3: v, 4: x})
+        write_number_columns(data, 1, columns)
+        not_printed(data)
+        a = cal.aligned[0]
+        pulses = wb.add_worksheet("Pulses", worksheet_class=ColumnsWorksheet)
+        pulses.write_row(0, 0, ["Time (s)", "Calibrated model (kG)", "Measured (kG)"], bold)
+        write_number_columns(pulses, 1, {0: a.time, 1: a.simulated_kg, 2: a.measured_kg})
+        not_printed(pulses)
+        values = list(columns[1]) + list(columns[2]) + list(np.percentile(x, [1, 99])
+                                                            if len(x) else [])
+        ws.insert_chart(row, 0, _law_chart(wb, len(grid), len(v), law.v_range, values))
+        ws.insert_chart(row + 21, 0, _pulse_chart(wb, a))
+        one_page(ws, row + 42, 6)
+        close_workbook(wb, path)
+    return warnings
