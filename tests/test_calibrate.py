@@ -105,7 +105,7 @@ def test_a_scaled_law_is_recovered(tmp_path):
 
 
 def test_cli_writes_a_workbook_fill_runs(tmp_path, capsys):
-    traces = _measured(tmp_path, {"crush_law": TRUTH, "zeta": 0.02})
+    _measured(tmp_path, {"crush_law": TRUTH, "zeta": 0.02})
     shots = _workbooks(tmp_path)
     out = tmp_path / "cal.xlsx"
     assert main(["calibrate", str(shots[0]), str(tmp_path / "m0.csv"), str(shots[1]),
