@@ -18,8 +18,16 @@ def add_parser(sub):
                                    "acceleration of the test item, and write the designed "
                                    "shot as a filled workbook.")
     p.add_argument("shot", metavar="SHOT.xlsx")
-    p.add_argument("--target-peak", required=True, metavar="PEAK",
-                   help="requested peak: 12kG, 11750g or 1.2e5m/s2")
+    target = p.add_mutually_exclusive_group(required=True)
+    target.add_argument("--target-peak", metavar="PEAK",
+                        help="requested peak: 12kG, 11750g or 1.2e5m/s2")
+    target.add_argument("--target-srs", metavar="REQ.csv",
+                        help="required shock response spectrum (CSV: 'frequency [Hz],srs [g]'):"
+                             " the least value whose SRS envelops it")
+    p.add_argument("--q", type=float, default=10.0,
+                   help="the SRS's quality factor, with --target-srs (default 10)")
+    p.add_argument("--accel-unit", help="the required SRS's unit, g, kG or m/s^2 (default: "
+                                        "from its header)")
     p.add_argument("--target-duration", metavar="DURATION",
                    help="requested pulse duration (>= 10%% of peak): 5ms, 4500us; needs two "
                         "--vary")
@@ -49,12 +57,11 @@ def _range(text):
 
 
 def run(args):
-    from ..pipeline import Options, fill_workbook
     from ..shot import Shot
     from ..studies.design import solve_peak, solve_peak_and_duration, variable
-    from . import note, warn
-    from .progress import Progress
 
+    if args.target_srs is not None:
+        return run_srs(args)
     target = parse_peak(args.target_peak)
     duration = parse_duration(args.target_duration) if args.target_duration else None
     names = args.vary or ["A28"]
@@ -67,9 +74,6 @@ def run(args):
                           "--target-duration)")
     bounds = _range(args.range) if args.range else None
     shot = Shot.from_workbook(args.shot)
-    shot_path = Path(args.shot)
-    output = Path(args.output) if args.output else shot_path.with_name(
-        shot_path.stem + ".design.xlsx")
     started = time.perf_counter()
     with cluster_runner(args) as runner:
         if duration is None:
@@ -86,6 +90,51 @@ def run(args):
           f"{design.duration * 1e3:.4f} ms"
           + (f" (target {duration * 1e3:.4f} ms)" if duration is not None else ""))
     print(f"  {design.evaluations} simulations in {solve_seconds:.2f} s")
+    return _write_design(args, shot, design)
+
+
+def run_srs(args):
+    from ..shot import Shot
+    from ..studies.design import solve_srs, variable
+    from ..workbook.trace import read_spectrum
+
+    for flag, value in (("--scheduler", args.scheduler), ("--workers", args.workers),
+                        ("--chunk", args.chunk)):
+        if value is not None:
+            raise OptionError(f"{flag}: found with --target-srs, expected it only with "
+                              "--target-peak (an SRS design runs on this machine)")
+    if args.target_duration:
+        raise OptionError("--target-duration: found with --target-srs, expected one target: "
+                          "the spectrum, or a peak and a duration")
+    names = args.vary or ["A28"]
+    if len(names) != 1:
+        raise OptionError("--vary: found two parameters, expected one with --target-srs")
+    var = variable(names[0])
+    if not args.q > 0.5:
+        raise OptionError(f"--q: found {args.q!r}, expected a quality factor above 0.5")
+    bounds = _range(args.range) if args.range else None
+    frequencies, required = read_spectrum(args.target_srs, args.accel_unit)
+    shot = Shot.from_workbook(args.shot)
+    started = time.perf_counter()
+    design = solve_srs(shot.params, frequencies, required, var, args.q, args.integrator,
+                       args.model, bounds)
+    print(f"{var.cell}{'..A30' if var.cell == 'A28' else ''} = {design.values[0]:.6g} "
+          f"{var.unit}")
+    print(f"  its SRS (Q = {args.q:g}) envelops the {len(frequencies)} required levels with a "
+          f"least margin of {design.margin:+.2%}, at {design.governing_hz:,.0f} Hz")
+    print(f"  peak {design.peak_kg:.5f} kG, pulse {design.duration * 1e3:.4f} ms; "
+          f"{design.evaluations} simulations in {time.perf_counter() - started:.2f} s")
+    return _write_design(args, shot, design)
+
+
+def _write_design(args, shot, design):
+    from ..pipeline import Options, fill_workbook
+    from . import note, warn
+    from .progress import Progress
+
+    shot_path = Path(args.shot)
+    output = Path(args.output) if args.output else shot_path.with_name(
+        shot_path.stem + ".design.xlsx")
     warn(design.warnings)
     designed = with_cells(shot, design)
     outputs = from_sheet(shot.source.outputs_block)

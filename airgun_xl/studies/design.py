@@ -75,6 +75,8 @@ class Design:
     duration: float
     evaluations: int
     warnings: list = field(default_factory=list)
+    margin: float = math.nan  # SRS designs: least SRS / required - 1 over the frequencies
+    governing_hz: float = math.nan  # where that least margin is
 
 
 class _Objective:
@@ -211,3 +213,79 @@ def design_warnings(p, target_kg, achieved):
     if speed is not None:  # the words the fill of the designed shot uses too
         out.append(str(speed))
     return out
+
+
+def srs_margin(p, frequencies, required, q, integrator="legacy", model="4-mass"):
+    """(margin, index): the least ratio of the shot's SRS to the required one, less 1, over
+    ``frequencies`` [Hz], and the index of the frequency where it is (the governing one)."""
+    from ..shot import Shot
+    from .shock import srs
+
+    r = Shot(apply_model(p, model)).run(integrator=integrator, track=())
+    a = r.accel_kg[np.isfinite(r.accel_kg)]
+    if not len(a) or not np.isfinite(r.history.y33).all():
+        return math.nan, 0
+    ratio = srs(a, p.delta, frequencies, q) / required
+    k = int(np.argmin(ratio))
+    return float(ratio[k] - 1), k
+
+
+def solve_srs(p, frequencies, required, var, q=10.0, integrator="legacy", model="4-mass",
+              bounds=None):
+    """The least value of ``var`` whose shock response spectrum envelops ``required``.
+
+    Shock test specifications give a spectrum the test must reach at every frequency; the
+    cheapest test meets it with the least margin. The margin (the least of SRS / required,
+    less 1) is scanned over the range, then brentq finds where it first reaches 0.
+
+    Parameters
+    ----------
+    frequencies, required : numpy.ndarray
+        The specification: natural frequencies [Hz] and SRS levels [kG].
+    q : float
+        The SRS's quality factor.
+
+    Raises
+    ------
+    DesignError
+        When no value in the range envelops the requirement: the message names the governing
+        frequency and how far the best value falls short.
+    """
+    from scipy.optimize import brentq
+
+    evaluations = [0]
+
+    def margin(x):
+        evaluations[0] += 1
+        return srs_margin(var.apply(p, x), frequencies, required, q, integrator, model)
+
+    lo, hi = bounds or var.bounds(p)
+    xs = np.linspace(lo, hi, SCAN_POINTS)
+    scanned = [margin(x) for x in xs]
+    ms = np.array([m for m, _ in scanned])
+    if np.isfinite(ms[0]) and ms[0] >= 0:
+        x = lo  # the least value of the range already envelops it
+    else:
+        bracket = _bracket(xs, ms, 0.0)
+        if bracket is None:
+            finite = np.isfinite(ms)
+            if not finite.any():
+                raise DesignError(f"the required SRS is out of reach: every shot diverged for "
+                                  f"{var.label} in {lo:.4g}-{hi:.4g} {var.unit}")
+            best = int(np.nanargmax(ms))
+            k = scanned[best][1]
+            raise DesignError(
+                f"the required SRS is out of reach for {var.label} in {lo:.4g}-{hi:.4g} "
+                f"{var.unit}: the best, {var.label} = {xs[best]:.4g} {var.unit}, reaches "
+                f"{1 + ms[best]:.1%} of it at {frequencies[k]:,.0f} Hz (the governing "
+                f"frequency; {required[k]:.4g} kG required)")
+        x = brentq(lambda v: margin(v)[0], *bracket, xtol=1e-10, rtol=1e-10, maxiter=100)
+    solved = var.apply(p, x)
+    m, k = margin(x)
+    from ..engine.batch import run_batch
+
+    figs = run_batch([apply_model(solved, model)], integrator).figures[0]
+    design = Design([var], [x], solved, float(figs[0]), float(figs[3]), evaluations[0] + 1,
+                    margin=m, governing_hz=float(frequencies[k]))
+    design.warnings = design_warnings(solved, design.peak_kg, design.peak_kg)
+    return design

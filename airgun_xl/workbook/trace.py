@@ -71,6 +71,66 @@ def _unit(header, table, option, which):
     return key
 
 
+def _table(path, expected, columns):
+    """(shown name, header, n x 2 values) of a two-column CSV; every row checked."""
+    shown = display(Path(path))
+    data = read_bytes(path, expected, "CSV")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise WorkbookError(f"{shown}: is not UTF-8 text (byte {exc.start}), {expected}") \
+            from None
+    try:
+        dialect = csv.Sniffer().sniff(text[:4096], delimiters=",;\t")
+    except csv.Error:
+        dialect = csv.excel
+    rows = list(csv.reader(io.StringIO(text), dialect))
+    rows = [r for r in rows if any(cell.strip() for cell in r)]
+    if len(rows) < 2 or len(rows[0]) < 2:
+        raise WorkbookError(f"{shown}: holds {len(rows)} rows of {len(rows[0]) if rows else 0} "
+                            f"columns, {expected}")
+    values = np.empty((len(rows) - 1, 2))
+    for i, row in enumerate(rows[1:], start=2):
+        try:
+            a, b = float(row[0]), float(row[1])
+        except (ValueError, IndexError):
+            raise WorkbookError(f"{shown}: row {i} holds {row[:2]!r}, expected two numbers "
+                                f"({columns[0]}, {columns[1]})") from None
+        if not (math.isfinite(a) and math.isfinite(b)):
+            raise WorkbookError(f"{shown}: row {i} holds {row[0].strip()}, {row[1].strip()}, "
+                                "expected finite numbers (no NaN or inf)")
+        values[i - 2] = a, b
+    return shown, rows[0], values
+
+
+#: Frequency units [Hz per unit] of a required spectrum.
+FREQUENCY_UNITS = {"Hz": 1.0, "kHz": 1e3}
+
+EXPECTED_SPECTRUM = ("expected a CSV of natural frequency and required SRS level (two "
+                     "columns, a header row such as 'frequency [Hz],srs [g]')")
+
+
+def read_spectrum(path, accel_unit=None):
+    """A required shock response spectrum: (frequencies [Hz], levels [kG]), from a CSV whose
+    header gives the units (``frequency [Hz]``, ``srs [g]``); frequencies increasing and
+    positive, levels positive. Raises WorkbookError or OptionError naming the row or unit."""
+    if accel_unit is not None and accel_unit not in ACCEL_UNITS:
+        raise OptionError(f"--accel-unit: found {accel_unit!r}, expected one of "
+                          f"{', '.join(ACCEL_UNITS)}")
+    shown, header, values = _table(path, EXPECTED_SPECTRUM, ("frequency", "level"))
+    f_unit = _unit(header[0], FREQUENCY_UNITS, "--target-srs", "frequency")
+    a_unit = accel_unit or _unit(header[1], ACCEL_UNITS, "--accel-unit", "level")
+    f = values[:, 0] * FREQUENCY_UNITS[f_unit]
+    for k in range(len(f)):
+        if f[k] <= 0 or (k and f[k] <= f[k - 1]):
+            raise WorkbookError(f"{shown}: row {k + 2}: frequency {values[k, 0]:g}, expected "
+                                "positive frequencies, increasing")
+        if values[k, 1] <= 0:
+            raise WorkbookError(f"{shown}: row {k + 2}: level {values[k, 1]:g}, expected a "
+                                "positive SRS level")
+    return f, values[:, 1] * ACCEL_UNITS[a_unit]
+
+
 def read_trace(path, time_unit=None, accel_unit=None, sign=1.0):
     """Read a measured pulse from a CSV file.
 
@@ -89,40 +149,13 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0):
     OptionError
         For a unit that cannot be told or is not known.
     """
-    shown = display(Path(path))
-    data = read_bytes(path, EXPECTED, "CSV")
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise WorkbookError(f"{shown}: is not UTF-8 text (byte {exc.start}), {EXPECTED}") \
-            from None
-    try:
-        dialect = csv.Sniffer().sniff(text[:4096], delimiters=",;\t")
-    except csv.Error:
-        dialect = csv.excel
-    rows = list(csv.reader(io.StringIO(text), dialect))
-    rows = [r for r in rows if any(cell.strip() for cell in r)]
-    if len(rows) < 2 or len(rows[0]) < 2:
-        raise WorkbookError(f"{shown}: holds {len(rows)} rows of {len(rows[0]) if rows else 0} "
-                            f"columns, {EXPECTED}")
-    header = rows[0]
     for option, given, table in (("--time-unit", time_unit, TIME_UNITS),
                                  ("--accel-unit", accel_unit, ACCEL_UNITS)):
         if given is not None and given not in table:
             raise OptionError(f"{option}: found {given!r}, expected one of {', '.join(table)}")
+    shown, header, values = _table(path, EXPECTED, ("time", "acceleration"))
     t_unit = time_unit or _unit(header[0], TIME_UNITS, "--time-unit", "time")
     a_unit = accel_unit or _unit(header[1], ACCEL_UNITS, "--accel-unit", "acceleration")
-    values = np.empty((len(rows) - 1, 2))
-    for i, row in enumerate(rows[1:], start=2):
-        try:
-            t, a = float(row[0]), float(row[1])
-        except (ValueError, IndexError):
-            raise WorkbookError(f"{shown}: row {i} holds {row[:2]!r}, expected two numbers "
-                                "(time, acceleration)") from None
-        if not (math.isfinite(t) and math.isfinite(a)):
-            raise WorkbookError(f"{shown}: row {i} holds {row[0].strip()}, {row[1].strip()}, "
-                                "expected finite numbers (no NaN or inf)")
-        values[i - 2] = t, a
     if len(values) < MIN_SAMPLES:
         raise WorkbookError(f"{shown}: holds {len(values)} samples, expected at least "
                             f"{MIN_SAMPLES}")
