@@ -130,3 +130,87 @@ def test_a_negative_pulse_asks_for_the_sign(tmp_path, capsys):
     assert "try --sign -1" in capsys.readouterr().err
     assert main(["compare-measured", str(TEMPLATE), str(measured), "-o", str(out), "--sign",
                  "-1"]) == 0
+
+
+def _pulse(shot=SHOT, every=20):
+    r = shot.run(track=())
+    keep = np.isfinite(r.accel_kg)
+    return r.history.time[keep][::every] + PRE_TRIGGER, r.accel_kg[keep][::every]
+
+
+def _score_of(tmp_path, measured, *extra):
+    out = tmp_path / f"c{len(list(tmp_path.iterdir()))}.xlsx"
+    assert main(["compare-measured", str(TEMPLATE), str(measured), "-o", str(out),
+                 *extra]) == 0
+    return _scores(out)
+
+
+def test_a_workbook_column_range_scores_as_the_csv(tmp_path):
+    """The same pulse in columns C:D of a sheet named Recorder (ms and g, header first) gives
+    the CSV's scores exactly: the same numbers, read another way."""
+    t, a = _pulse()
+    wb = openpyxl.Workbook()
+    ws = wb.active
+    ws.title = "Recorder"
+    ws["A1"] = "shot 17, channel 3"
+    ws.append([None, None, "time [ms]", "accel [g]"])
+    for ti, ai in zip(t.tolist(), a.tolist()):
+        ws.append([None, None, ti * 1e3, ai * 1e3])
+    wb.save(tmp_path / "trace.xlsx")
+    csv_scores = _score_of(tmp_path, _write(tmp_path / "m.csv", SHOT))
+    # row 1 is a note in A: the range's header is the first row with C or D filled
+    xlsx_scores = _score_of(tmp_path, f"{tmp_path / 'trace.xlsx'}:Recorder!C:D")
+    assert xlsx_scores["Peak acceleration"] == pytest.approx(csv_scores["Peak acceleration"],
+                                                             rel=1e-12)
+    assert xlsx_scores["Overall rating R"] == pytest.approx(csv_scores["Overall rating R"],
+                                                            rel=1e-12)
+
+
+@pytest.mark.parametrize("spec, message", [
+    ("{d}/trace.xlsx:Nope!C:D", "has no sheet 'Nope' (it has 'Recorder')"),
+    ("{d}/trace.xlsx:Recorder!C:C", "names one column"),
+    ("{d}/trace.xlsx:Recorder!A:B", "row 2 holds ['x', 1.0], expected two finite numbers"),
+])
+def test_a_bad_column_range_is_one_line(tmp_path, capsys, spec, message):
+    wb = openpyxl.Workbook()
+    ws = wb.active
+    ws.title = "Recorder"
+    ws.append(["time [ms]", "accel [g]", "time [ms]", "accel [g]"])
+    ws.append(["x", 1, 0.0, 1.0])
+    wb.save(tmp_path / "trace.xlsx")
+    before = set(tmp_path.iterdir())
+    assert main(["compare-measured", str(TEMPLATE), spec.format(d=tmp_path), "-o",
+                 str(tmp_path / "c.xlsx")]) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+    assert set(tmp_path.iterdir()) == before
+
+
+def test_a_tdms_waveform_scores_as_the_csv(tmp_path, capsys):
+    """A LabVIEW TDMS waveform channel (wf_increment 10 us, unit_string g) gives the CSV's
+    scores; --channel picks it by GROUP/CHANNEL; a missing one lists what there is."""
+    nptdms = pytest.importorskip("nptdms")
+    t, a = _pulse()
+    with nptdms.TdmsWriter(str(tmp_path / "shot.tdms")) as writer:
+        writer.write_segment([
+            nptdms.ChannelObject("Recorder", "temperature", np.full(5, 21.0)),
+            nptdms.ChannelObject("Recorder", "accel", a * 1e3, properties={
+                "wf_increment": float(t[1] - t[0]), "wf_start_offset": float(t[0]),
+                "unit_string": "g"})])
+    csv_scores = _score_of(tmp_path, _write(tmp_path / "m.csv", SHOT))
+    tdms_scores = _score_of(tmp_path, tmp_path / "shot.tdms")
+    assert tdms_scores["Peak acceleration"] == pytest.approx(csv_scores["Peak acceleration"],
+                                                             rel=1e-9)
+    assert tdms_scores["Overall rating R"][0] > 0.98
+    named = _score_of(tmp_path, tmp_path / "shot.tdms", "--channel", "Recorder/accel")
+    assert named["Peak acceleration"] == tdms_scores["Peak acceleration"]
+    capsys.readouterr()
+    assert main(["compare-measured", str(TEMPLATE), str(tmp_path / "shot.tdms"), "--channel",
+                 "Recorder/x", "-o", str(tmp_path / "z.xlsx")]) == 2
+    assert "--channel: found 'Recorder/x', expected one of the file's waveform channels: " \
+           "Recorder/accel" in capsys.readouterr().err
+    (tmp_path / "bad.tdms").write_bytes(b"TDSm" + bytes(40))
+    assert main(["compare-measured", str(TEMPLATE), str(tmp_path / "bad.tdms"), "-o",
+                 str(tmp_path / "z.xlsx")]) == 2
+    assert "bad.tdms: is not a readable TDMS file" in capsys.readouterr().err
+    assert not (tmp_path / "z.xlsx").exists()

@@ -17,7 +17,8 @@ def add_parser(sub):
                                    "Writes the first shot's workbook with the fitted values "
                                    "and a Crush law sheet that fill runs.")
     p.add_argument("pairs", nargs="+", metavar="SHOT.xlsx MEASURED.csv",
-                   help="each shot's workbook followed by its measured pulse (CSV)")
+                   help="each shot's workbook followed by its measured pulse (a CSV, "
+                        "trace.xlsx:Sheet1!A:B or a TDMS file)")
     p.add_argument("-o", "--output", metavar="OUT.xlsx",
                    help="the calibrated workbook (default: SHOT.calibrated.xlsx)")
     p.add_argument("--force", action="store_true")
@@ -34,6 +35,9 @@ def add_parser(sub):
                         "for the law: the recorder's ringing; it hides zeta)")
     p.add_argument("--degree", type=int, default=6, help="of the law's polynomial (1-6, "
                                                           "default 6 as Eq. 8)")
+    p.add_argument("--channel", metavar="GROUP/CHANNEL",
+                   help="TDMS only: the channel of every measured file (default: the first "
+                        "waveform channel)")
     p.add_argument("--sign", type=float, default=1.0, choices=(1.0, -1.0))
     p.add_argument("--time-unit", help="s, ms or us (default: from the header)")
     p.add_argument("--accel-unit", help="g, kG or m/s^2 (default: from the header)")
@@ -54,7 +58,7 @@ def run(args):
     from ..studies.shock import CFC_CLASSES, cfc_coefficients
     from ..transaction import check_output
     from ..workbook.calibration import write_calibration
-    from ..workbook.trace import read_trace
+    from ..workbook.trace import input_file, read_trace
 
     files = _pairs(args.pairs)
     if args.cfc is not None and args.cfc not in CFC_CLASSES:
@@ -69,9 +73,11 @@ def run(args):
     first = Path(files[0][0])
     output = Path(args.output) if args.output else first.with_name(
         first.stem + ".calibrated.xlsx")
-    check_output(output, args.force, inputs=[f for pair in files for f in pair])
+    check_output(output, args.force,
+                 inputs=[input_file(f) for pair in files for f in pair])
     shots = [Shot.from_workbook(s) for s, _ in files]
-    traces = [read_trace(m, args.time_unit, args.accel_unit, args.sign) for _, m in files]
+    traces = [read_trace(m, args.time_unit, args.accel_unit, args.sign, args.channel)
+              for _, m in files]
     cal = calibrate([s.params for s in shots], traces, law=law, fit=names, cfc=args.cfc,
                     degree=args.degree, objective=args.objective,
                     integrator=args.integrator)

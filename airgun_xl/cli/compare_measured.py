@@ -6,14 +6,19 @@ from ..choices import INTEGRATORS, MODELS
 
 def add_parser(sub):
     p = sub.add_parser("compare-measured",
-                       help="compare the shot's predicted pulse with a measured one (CSV)",
+                       help="compare the shot's predicted pulse with a measured one (CSV, "
+                            "xlsx, TDMS)",
                        description="Run the shot, read the measured pulse (a CSV of time and "
                                    "acceleration, units in the header: s/ms/us and g/kG/m/s^2), "
                                    "filter both alike (SAE J211), align them at the impact, "
                                    "and score the peak, its time, the pulse, the velocity "
                                    "change and their correlation.")
     p.add_argument("shot", metavar="SHOT.xlsx")
-    p.add_argument("measured", metavar="MEASURED.csv")
+    p.add_argument("measured", metavar="MEASURED",
+                   help="the measured pulse: a CSV (time, acceleration, units in the header), "
+                        "a workbook's columns (trace.xlsx:Sheet1!A:B) or a LabVIEW TDMS file")
+    p.add_argument("--channel", metavar="GROUP/CHANNEL",
+                   help="TDMS only: the channel (default: the first waveform channel)")
     p.add_argument("-o", "--output", metavar="OUT.xlsx",
                    help="scores and traces (default: SHOT.measured.xlsx)")
     p.add_argument("--force", action="store_true")
@@ -42,15 +47,16 @@ def run(args):
     from ..studies.shock import CFC_CLASSES, cfc_coefficients
     from ..transaction import check_output
     from ..workbook.measured import write_comparison
-    from ..workbook.trace import read_trace
+    from ..workbook.trace import input_file, read_trace
 
     if args.cfc is not None and args.cfc not in CFC_CLASSES:
         cfc_coefficients(args.cfc, 1.0)  # its one-line error, before the run
     shot_path = Path(args.shot)
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".measured.xlsx")
-    check_output(output, args.force, inputs=[args.shot, args.measured])
-    trace = read_trace(args.measured, args.time_unit, args.accel_unit, args.sign)
+    check_output(output, args.force, inputs=[args.shot, input_file(args.measured)])
+    trace = read_trace(args.measured, args.time_unit, args.accel_unit, args.sign,
+                       args.channel)
     shot = Shot.from_workbook(args.shot)
     result = dataclasses.replace(shot, params=apply_model(shot.params, args.model)).run(
         integrator=args.integrator, track=())

@@ -1,5 +1,6 @@
-"""A measured pulse from a CSV file: a time column and an acceleration column, with units
-from the header (``time [ms]``, ``accel (g)``) or given, every row checked.
+"""A measured pulse from a CSV file, a workbook's column range or a LabVIEW TDMS file: time and
+acceleration, with units from the header (``time [ms]``, ``accel (g)``, a TDMS channel's
+``unit_string``) or given, every row checked; and a required shock response spectrum (CSV).
 
 The file is read like any untrusted input (:func:`airgun_xl.workbook.guard.read_bytes`: a
 regular file, size capped). Each fault is one line naming the row: a row that is not two
@@ -15,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import OptionError, WorkbookError
+from .. import limits
+from ..errors import AirgunXlError, OptionError, WorkbookError
 from ..transaction import display
 from .guard import read_bytes
 
@@ -103,6 +105,130 @@ def _table(path, expected, columns):
     return shown, rows[0], values
 
 
+#: ``FILE:SHEET!COL:COL``: a column range of a workbook.
+RANGE = re.compile(r"^(?P<file>.+\.(?:xlsx|xlsm|xls)):(?P<sheet>[^!]+)!(?P<a>[A-Za-z]{1,3})"
+                   r"(?:\d*)?:(?P<b>[A-Za-z]{1,3})(?:\d*)?$", re.IGNORECASE)
+
+EXPECTED_RANGE = ("expected a column range of time and acceleration with a header row, "
+                  "e.g. trace.xlsx:Sheet1!A:B")
+EXPECTED_TDMS = "expected a LabVIEW TDMS file with a waveform channel of acceleration"
+
+
+def input_file(spec):
+    """The file a measured source names (the workbook of ``trace.xlsx:Sheet1!A:B``)."""
+    found = RANGE.match(str(spec))
+    return found["file"] if found and not Path(str(spec)).exists() else str(spec)
+
+
+def _source_table(path, channel=None):
+    """(shown, header, values) of any measured source."""
+    text = str(path)
+    found = RANGE.match(text)
+    if found and not Path(text).exists():
+        if channel is not None:
+            raise OptionError("--channel: found with a workbook range, expected it only "
+                              "with a TDMS file")
+        return _range_table(found)
+    if text.lower().endswith(".tdms"):
+        return _tdms_table(path, channel)
+    if channel is not None:
+        raise OptionError("--channel: found with a CSV file, expected it only with a TDMS "
+                          "file")
+    return _table(path, EXPECTED, ("time", "acceleration"))
+
+
+def _column(letters):
+    n = 0
+    for ch in letters.upper():
+        n = n * 26 + ord(ch) - 64
+    return n - 1
+
+
+def _range_table(found):
+    from . import guard
+
+    path = Path(found["file"])
+    shown = f"{display(path)}:{found['sheet']}!{found['a'].upper()}:{found['b'].upper()}"
+    data, kind = guard.read_input(path)
+    if kind == "zip":
+        guard.open_zip(path, data).close()  # sizes, ratios and entities, before any parser
+    else:
+        for k, (rows, columns) in enumerate(guard.xls_extents(path, data)):
+            guard.check_extent(path, f"sheet {k + 1}", rows, columns, limits.MAX_XLS_CELLS)
+    a, b = _column(found["a"]), _column(found["b"])
+    if a == b:
+        raise OptionError(f"{shown}: names one column, {EXPECTED_RANGE}")
+    try:
+        from python_calamine import CalamineWorkbook
+
+        wb = CalamineWorkbook.from_filelike(io.BytesIO(data))
+        if found["sheet"] not in wb.sheet_names:
+            raise WorkbookError(f"{shown}: has no sheet {found['sheet']!r} (it has "
+                                f"{', '.join(map(repr, wb.sheet_names[:5]))}), "
+                                f"{EXPECTED_RANGE}")
+        rows = wb.get_sheet_by_name(found["sheet"]).to_python(skip_empty_area=False)
+    except AirgunXlError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - any parser failure on untrusted bytes: one line
+        raise WorkbookError(f"{shown}: is not a readable workbook ({type(exc).__name__}), "
+                            f"{EXPECTED_RANGE}") from None
+    rows = [r for r in rows if len(r) > max(a, b) and (r[a] != "" or r[b] != "")]
+    if len(rows) < 2:
+        raise WorkbookError(f"{shown}: holds {len(rows)} rows, {EXPECTED_RANGE}")
+    header = [str(rows[0][a]), str(rows[0][b])]
+    values = np.empty((len(rows) - 1, 2))
+    for i, row in enumerate(rows[1:], start=2):
+        cells = (row[a], row[b])
+        if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in cells) \
+                or not all(math.isfinite(v) for v in cells):
+            raise WorkbookError(f"{shown}: row {i} holds {list(cells)!r}, expected two finite "
+                                "numbers (time, acceleration)")
+        values[i - 2] = cells
+    return shown, header, values
+
+
+def _tdms_table(path, channel):
+    try:
+        from nptdms import TdmsFile
+    except ImportError:
+        raise OptionError(f"{display(Path(path))}: reading TDMS needs npTDMS, expected it "
+                          "installed: pip install 'airgun-xl[tdms]'") from None
+    shown = display(Path(path))
+    data = read_bytes(path, EXPECTED_TDMS, "TDMS")
+    try:
+        tdms = TdmsFile.read(io.BytesIO(data))
+        channels = [c for g in tdms.groups() for c in g.channels()]
+    except Exception as exc:  # noqa: BLE001 - any parser failure on untrusted bytes: one line
+        raise WorkbookError(f"{shown}: is not a readable TDMS file ({type(exc).__name__}), "
+                            f"{EXPECTED_TDMS}") from None
+    waves = [c for c in channels if "wf_increment" in c.properties]
+    names = [f"{c.group_name}/{c.name}" for c in waves]
+    if channel is not None:
+        if channel not in names:
+            raise OptionError(f"--channel: found {channel!r}, expected one of the file's "
+                              f"waveform channels: {', '.join(names[:8]) or 'none'}")
+        chosen = waves[names.index(channel)]
+    elif waves:
+        chosen = waves[0]
+    else:
+        raise WorkbookError(f"{shown}: has no waveform channel (wf_increment), "
+                            f"{EXPECTED_TDMS}")
+    accel = np.asarray(chosen[:], dtype=float)
+    dt = float(chosen.properties["wf_increment"])
+    start = float(chosen.properties.get("wf_start_offset", 0.0))
+    if not (math.isfinite(dt) and dt > 0):
+        raise WorkbookError(f"{shown}: channel {chosen.name!r} has wf_increment {dt!r}, "
+                            "expected a positive sample step [s]")
+    bad = ~np.isfinite(accel)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise WorkbookError(f"{shown}: channel {chosen.name!r} sample {k} is {accel[k]}, "
+                            "expected finite numbers (no NaN or inf)")
+    unit = str(chosen.properties.get("unit_string", ""))
+    header = ["time [s]", f"{chosen.name} [{unit}]" if unit else chosen.name]
+    return shown, header, np.column_stack([start + dt * np.arange(len(accel)), accel])
+
+
 #: Frequency units [Hz per unit] of a required spectrum.
 FREQUENCY_UNITS = {"Hz": 1.0, "kHz": 1e3}
 
@@ -131,12 +257,16 @@ def read_spectrum(path, accel_unit=None):
     return f, values[:, 1] * ACCEL_UNITS[a_unit]
 
 
-def read_trace(path, time_unit=None, accel_unit=None, sign=1.0):
-    """Read a measured pulse from a CSV file.
+def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
+    """Read a measured pulse: a CSV file, a column range of a workbook
+    (``trace.xlsx:Sheet1!A:B``, time then acceleration, a header row first), or a LabVIEW
+    TDMS file (a waveform channel; needs the ``tdms`` extra, npTDMS).
 
     Parameters
     ----------
-    path : path
+    path : str or path
+    channel : str, optional
+        TDMS only: ``GROUP/CHANNEL``; the first waveform channel by default.
     time_unit, accel_unit : str, optional
         Keys of :data:`TIME_UNITS` / :data:`ACCEL_UNITS`; read from the header when None.
     sign : float
@@ -153,7 +283,7 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0):
                                  ("--accel-unit", accel_unit, ACCEL_UNITS)):
         if given is not None and given not in table:
             raise OptionError(f"{option}: found {given!r}, expected one of {', '.join(table)}")
-    shown, header, values = _table(path, EXPECTED, ("time", "acceleration"))
+    shown, header, values = _source_table(path, channel)
     t_unit = time_unit or _unit(header[0], TIME_UNITS, "--time-unit", "time")
     a_unit = accel_unit or _unit(header[1], ACCEL_UNITS, "--accel-unit", "acceleration")
     if len(values) < MIN_SAMPLES:
