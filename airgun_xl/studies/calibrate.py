@@ -25,7 +25,7 @@ import numpy as np
 
 from ..crush_law import DEGREE, CrushLaw
 from ..errors import OptionError
-from .measured import IMPACT_FRACTION, KG_MS2
+from .measured import KG_MS2, crossing
 from .shock import cfc_filter
 
 #: The iteration stops when the law moves less than this over the samples' velocities (the
@@ -131,17 +131,6 @@ def align(result, trace, cfc=None):
     mass = np.interp(t, rows, h.m31[2:]) + p.m32 + p.m33
     v = np.interp(t, h.time[1:-1], (h.v31 - h.v1)[1:-1])
     return Aligned(t, sim, meas, shift, cf, v, loading, mass)
-
-
-def crossing(time, values, fraction=IMPACT_FRACTION):
-    """The instant [s] a trace first reaches ``fraction`` of its peak, interpolated between
-    samples (a whole-sample instant would misalign two pulses by up to a step)."""
-    level = fraction * np.max(values)
-    k = int(np.argmax(values >= level))
-    if k == 0:
-        return float(time[0])
-    a, b = values[k - 1], values[k]
-    return float(time[k - 1] + (time[k] - time[k - 1]) * (level - a) / (b - a))
 
 
 def rms_error(a):
@@ -369,12 +358,13 @@ class Calibration:
 
 
 def score(a):
-    """RMS error and ISO/TS 18571 rating of an aligned pair, over the measured pulse."""
+    """RMS error and ISO/TS 18571 rating of an aligned pair, over the measured pulse widened by
+    a tenth of its duration each side, from the impact on (as compare-measured rates it)."""
     from ..engine.summary import pulse
     from .iso18571 import rating
 
     start, end, duration = pulse(a.time, a.measured_kg)
-    lo, hi = max(a.time[0], start - 0.1 * duration), min(a.time[-1], end + 0.1 * duration)
+    lo, hi = max(0.0, start - 0.1 * duration), min(a.time[-1], end + 0.1 * duration)
     return Score(rms_error(a), rating(a.time, a.measured_kg, a.simulated_kg, lo, hi).overall)
 
 

@@ -57,9 +57,34 @@ class Comparison:
     rigid_kg: np.ndarray = None  # the rigid model's prediction on ``time`` (Fig. 13)
 
 
-def _impact(time, accel):
-    peak = np.max(accel)
-    return float(time[np.argmax(accel >= IMPACT_FRACTION * peak)])
+#: Rest prepended to the prediction before it is filtered [s]: the recorder is at rest before
+#: the impact, and filtfilt's own edge padding (an odd reflection) would bend the rise.
+REST_BEFORE = 2e-3
+
+
+def crossing(time, values, fraction=IMPACT_FRACTION):
+    """The instant [s] a trace first reaches ``fraction`` of its peak, interpolated between
+    samples (a whole-sample instant would misalign two pulses by up to a step)."""
+    level = fraction * np.max(values)
+    k = int(np.argmax(values >= level))
+    if k == 0:
+        return float(time[0])
+    a, b = values[k - 1], values[k]
+    return float(time[k - 1] + (time[k] - time[k - 1]) * (level - a) / (b - a))
+
+
+def filtered_from_rest(time, values, cfc):
+    """(time, values) at rest for :data:`REST_BEFORE` before the first sample, then filtered
+    by channel class ``cfc``: the phaseless filter starts the rise before the impact, and
+    that part is kept."""
+    dt = float(time[1] - time[0])
+    n = int(round(REST_BEFORE / dt))
+    t = np.concatenate([time[0] - dt * np.arange(n, 0, -1), time])
+    v = np.concatenate([np.zeros(n), np.asarray(values, dtype=float)])
+    return t, (cfc_filter(v, dt, cfc) if cfc else v)
+
+
+_impact = crossing
 
 
 def _figures(time, accel, impact):
@@ -93,8 +118,8 @@ def compare(pred_time, pred_kg, trace, cfc=None, alignment="threshold", rigid=No
     if alignment not in ALIGNMENTS:
         raise OptionError(f"--align: found {alignment!r}, expected one of "
                           f"{', '.join(ALIGNMENTS)}")
-    dt_pred = float(pred_time[1] - pred_time[0])
-    pred = cfc_filter(pred_kg, dt_pred, cfc) if cfc else np.asarray(pred_kg, float)
+    raw_time, raw_kg = pred_time, np.asarray(pred_kg, float)
+    pred_time, pred = filtered_from_rest(pred_time, pred_kg, cfc)
     meas = cfc_filter(trace.accel_kg, trace.dt, cfc) if cfc else trace.accel_kg
     if np.max(meas) < -np.min(meas):
         raise OptionError(f"--sign: the measured pulse is mostly negative (from "
@@ -112,13 +137,16 @@ def compare(pred_time, pred_kg, trace, cfc=None, alignment="threshold", rigid=No
         k = lags[np.argmax(correlate(pred_grid, meas))]
         shift = float(grid[0] + k * trace.dt - trace.time[0])
     time = trace.time + shift
-    inside = (time >= pred_time[0]) & (time <= pred_time[-1])
+    inside = (time >= min(raw_time[0], impact_pred)) & (time <= raw_time[-1])
     if inside.sum() < 16:
         raise OptionError("--align: the aligned traces overlap in fewer than 16 samples, "
                           "expected the measured pulse to cover the predicted one")
     t = time[inside]
     measured = meas[inside]
-    predicted = np.interp(t, pred_time, pred)
+    # the raw prediction on the measurement's samples (at rest before it), then the same
+    # filter at the same rate: filtered alike, literally
+    on_grid = np.interp(time, raw_time, raw_kg, left=0.0)
+    predicted = (cfc_filter(on_grid, trace.dt, cfc) if cfc else on_grid)[inside]
     p_fig = _figures(t, predicted, impact_pred)
     m_fig = _figures(t, measured, impact_pred)
     correlation = float(np.corrcoef(predicted, measured)[0, 1])
@@ -134,8 +162,7 @@ def compare(pred_time, pred_kg, trace, cfc=None, alignment="threshold", rigid=No
     _spectra_and_rating(out, trace.dt)
     if rigid is not None:
         r_time, r_kg = rigid
-        r_dt = float(r_time[1] - r_time[0])
-        r = cfc_filter(r_kg, r_dt, cfc) if cfc else np.asarray(r_kg, float)
+        r_time, r = filtered_from_rest(r_time, r_kg, cfc)
         out.rigid_kg = np.interp(t, r_time, r)
     return out
 
