@@ -11,7 +11,7 @@ import numpy as np
 
 from ..crush_law import LEGACY_LAW
 from ..transaction import atomic_path, check_output
-from .charts import nice_range
+from .charts import line_series, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
 from .law_sheet import write_law_sheet
 from .page_setup import not_printed, one_page
@@ -36,13 +36,6 @@ def _parameter_sheet(wb, shot, params, names, fitted):
     return warnings
 
 
-def _line(color, dash=None):
-    line = {"color": color, "width": 1.5}
-    if dash:
-        line["dash_type"] = dash
-    return line
-
-
 def _law_chart(wb, n_grid, n_samples, v_range, values):
     chart = wb.add_chart({"type": "scatter"})
     if n_samples:
@@ -51,38 +44,25 @@ def _law_chart(wb, n_grid, n_samples, v_range, values):
                           "values": ["Law", 1, 4, n_samples, 4],
                           "marker": {"type": "circle", "size": 2,
                                      "fill": {"color": "#f4b183"}, "border": {"none": True}}})
-    chart.add_series({"name": "Fitted law", "categories": ["Law", 1, 0, n_grid, 0],
-                      "values": ["Law", 1, 2, n_grid, 2], "line": _line("#c00000"),
-                      "marker": {"type": "none"}})
-    chart.add_series({"name": "The macro's law, Eq. (8)",
-                      "categories": ["Law", 1, 0, n_grid, 0],
-                      "values": ["Law", 1, 1, n_grid, 1], "line": _line("#1f4e79", "dash"),
-                      "marker": {"type": "none"}})
+    line_series(chart, "Law", "Fitted law", 1, n_grid, 0, 2, "#c00000")
+    line_series(chart, "Law", "The macro's law, Eq. (8)", 1, n_grid, 0, 1, "#1f4e79", "dash")
     lo, hi = nice_range(v_range)
     ylo, yhi = nice_range(values, include_zero=True)
-    chart.set_title({"name": "Crush factor against relative velocity (Figs. 7-8)"})
-    chart.set_x_axis({"name": "Relative velocity (m/s)", "min": lo, "max": hi})
-    chart.set_y_axis({"name": "Crush factor (-)", "min": ylo, "max": yhi})
-    chart.set_legend({"position": "bottom"})
-    chart.set_size({"width": 720, "height": 400})
-    return chart
+    return titled(chart, "Crush factor against relative velocity (Figs. 7-8)",
+                  {"name": "Relative velocity (m/s)", "min": lo, "max": hi},
+                  {"name": "Crush factor (-)", "min": ylo, "max": yhi})
 
 
 def _pulse_chart(wb, a):
     n = len(a.time)
     chart = wb.add_chart({"type": "scatter", "subtype": "straight"})
     for col, name, color in ((2, "Measured", "#c00000"), (1, "Calibrated model", "#1f4e79")):
-        chart.add_series({"name": name, "categories": ["Pulses", 1, 0, n, 0],
-                          "values": ["Pulses", 1, col, n, col], "line": _line(color),
-                          "marker": {"type": "none"}})
+        line_series(chart, "Pulses", name, 1, n, 0, col, color)
     lo, hi = nice_range(a.time)
     ylo, yhi = nice_range(list(a.simulated_kg) + list(a.measured_kg), include_zero=True)
-    chart.set_title({"name": "Shot 1: measured and calibrated pulses"})
-    chart.set_x_axis({"name": "Time (s)", "min": lo, "max": hi})
-    chart.set_y_axis({"name": "Acceleration (kG)", "min": ylo, "max": yhi})
-    chart.set_legend({"position": "bottom"})
-    chart.set_size({"width": 720, "height": 400})
-    return chart
+    return titled(chart, "Shot 1: measured and calibrated pulses",
+                  {"name": "Time (s)", "min": lo, "max": hi},
+                  {"name": "Acceleration (kG)", "min": ylo, "max": yhi})
 
 
 def write_calibration(path, shot, cal, files, options, force=False):

@@ -134,6 +134,38 @@ def nice_range(values, include_zero=False):
             float(f"{math.ceil(hi / step) * step:.12g}"))
 
 
+def titled(chart, title, x_axis, y_axis, height=400, legend="bottom"):
+    """Set a chart's title, both axes (dicts for xlsxwriter: explicit limits), legend and
+    size (720 px wide); returns the chart."""
+    chart.set_title({"name": title})
+    chart.set_x_axis(x_axis)
+    chart.set_y_axis(y_axis)
+    chart.set_legend({"position": legend} if legend else {"none": True})
+    chart.set_size({"width": 720, "height": height})
+    return chart
+
+
+def log_axis(name, values, gridlines=False):
+    """An xlsxwriter log axis over whole decades around ``values`` (positive)."""
+    v = np.asarray(values, dtype=float)
+    axis = {"name": name, "log_base": 10,
+            "min": 10.0 ** np.floor(np.log10(max(float(v.min()), 1e-12))),
+            "max": 10.0 ** np.ceil(np.log10(max(float(v.max()), 1e-12)))}
+    if gridlines:
+        axis["major_gridlines"] = {"visible": True}
+    return axis
+
+
+def line_series(chart, sheet, name, first, last, x_col, y_col, color, dash=None):
+    """A line (no markers) of ``sheet``'s rows ``first..last`` (0-based), x from ``x_col``."""
+    line = {"color": color, "width": 1.25}
+    if dash:
+        line["dash_type"] = dash
+    chart.add_series({"name": name, "categories": [sheet, first, x_col, last, x_col],
+                      "values": [sheet, first, y_col, last, y_col], "line": line,
+                      "marker": {"type": "none"}})
+
+
 def _axis(title, lo, hi, gridlines=True):
     return {"name": title, "min": lo, "max": hi,
             "major_gridlines": {"visible": gridlines, "line": {"color": "#d9d9d9"}},

@@ -3,7 +3,7 @@ spectra and SRS), the aligned traces, and the report's Figs. 13-15 as native cha
 import numpy as np
 
 from ..transaction import atomic_path, check_output
-from .charts import nice_range
+from .charts import line_series, log_axis, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
 from .page_setup import not_printed, one_page
 from .sheets import write_about, write_number_columns
@@ -23,17 +23,8 @@ SPECTRUM_FROM_HZ = 1_000.0  # below: the pulse's own shape, as the fill's chart
 SPECTRUM_TO_HZ = 15_000.0
 
 
-def _line(color, dash=None):
-    line = {"color": color, "width": 1.25}
-    if dash:
-        line["dash_type"] = dash
-    return line
-
-
-def _series(chart, sheet, name, n, x_col, y_col, color, dash=None, first=1):
-    chart.add_series({"name": name, "categories": [sheet, first, x_col, first + n - 1, x_col],
-                      "values": [sheet, first, y_col, first + n - 1, y_col],
-                      "line": _line(color, dash), "marker": {"type": "none"}})
+def _series(chart, sheet, name, n, x_col, y_col, color, dash=None):
+    line_series(chart, sheet, name, 1, n, x_col, y_col, color, dash)
 
 
 def _write_scores(wb, ws, c, head, bold, models):
@@ -107,12 +98,9 @@ def _traces_chart(wb, c, n, models):
         values += list(c.rigid_kg)
     lo, hi = nice_range(c.time)
     ylo, yhi = nice_range(values, include_zero=True)
-    chart.set_title({"name": "Test against prediction (Fig. 13)"})
-    chart.set_x_axis({"name": "Time after impact (s)", "min": lo, "max": hi})
-    chart.set_y_axis({"name": "Acceleration (kG)", "min": ylo, "max": yhi})
-    chart.set_legend({"position": "bottom"})
-    chart.set_size({"width": 720, "height": 420})
-    return chart
+    return titled(chart, "Test against prediction (Fig. 13)",
+                  {"name": "Time after impact (s)", "min": lo, "max": hi},
+                  {"name": "Acceleration (kG)", "min": ylo, "max": yhi}, 420)
 
 
 def _spectrum_chart(wb, c, n):
@@ -122,13 +110,9 @@ def _spectrum_chart(wb, c, n):
     keep = c.predicted_spectrum.frequency >= SPECTRUM_FROM_HZ
     _, yhi = nice_range(list(c.predicted_spectrum.amplitude[keep])
                         + list(c.measured_spectrum.amplitude[keep]), include_zero=True)
-    chart.set_title({"name": "Spectra of test and prediction (Figs. 14-15)"})
-    chart.set_x_axis({"name": "Frequency (Hz)", "min": SPECTRUM_FROM_HZ,
-                      "max": SPECTRUM_TO_HZ})
-    chart.set_y_axis({"name": "Amplitude (kG)", "min": 0, "max": yhi})
-    chart.set_legend({"position": "bottom"})
-    chart.set_size({"width": 720, "height": 380})
-    return chart
+    return titled(chart, "Spectra of test and prediction (Figs. 14-15)",
+                  {"name": "Frequency (Hz)", "min": SPECTRUM_FROM_HZ, "max": SPECTRUM_TO_HZ},
+                  {"name": "Amplitude (kG)", "min": 0, "max": yhi}, 380)
 
 
 def _srs_chart(wb, c, n):
@@ -136,17 +120,9 @@ def _srs_chart(wb, c, n):
     _series(chart, "SRS", "Measured", n, 0, 2, MEASURED)
     _series(chart, "SRS", "Predicted", n, 0, 1, PREDICTED)
     both = np.concatenate([c.predicted_srs, c.measured_srs])
-    lo = 10.0 ** np.floor(np.log10(max(float(both.min()), 1e-12)))
-    hi = 10.0 ** np.ceil(np.log10(max(float(both.max()), 1e-12)))
-    f = c.srs_frequencies
-    chart.set_title({"name": "Shock response spectra (maximax, Q = 10)"})
-    chart.set_x_axis({"name": "Natural frequency (Hz)", "log_base": 10,
-                      "min": 10.0 ** np.floor(np.log10(f[0])),
-                      "max": 10.0 ** np.ceil(np.log10(f[-1]))})
-    chart.set_y_axis({"name": "Peak response (kG)", "log_base": 10, "min": lo, "max": hi})
-    chart.set_legend({"position": "bottom"})
-    chart.set_size({"width": 720, "height": 380})
-    return chart
+    return titled(chart, "Shock response spectra (maximax, Q = 10)",
+                  log_axis("Natural frequency (Hz)", c.srs_frequencies),
+                  log_axis("Peak response (kG)", both), 380)
 
 
 def write_comparison(path, comparison, about, force=False, models=("4-mass", "rigid")):

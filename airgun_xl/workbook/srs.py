@@ -1,8 +1,7 @@
 """The ``srs`` workbook: a shot's shock response spectrum as a table and a log-log chart."""
-import numpy as np
 
 from ..transaction import atomic_path, check_output
-from .charts import nice_range
+from .charts import log_axis, titled
 from .page_setup import one_page
 from .sheets import write_about
 from .writer import close_workbook, new_workbook
@@ -31,17 +30,9 @@ def write_srs(path, frequencies, spectrum, about, force=False):
                           "values": ["SRS", head + 1, 1, head + n, 1],
                           "line": {"color": "#1f4e79", "width": 1.5},
                           "marker": {"type": "none"}})
-        lo = 10.0 ** np.floor(np.log10(max(float(spectrum.min()), 1e-12)))
-        hi = 10.0 ** np.ceil(np.log10(max(float(spectrum.max()), 1e-12)))
-        xlo, xhi = nice_range(np.log10(frequencies))
-        chart.set_title({"name": "Shock response spectrum of the test-item acceleration"})
-        chart.set_x_axis({"name": "Natural frequency (Hz)", "log_base": 10,
-                          "min": 10.0 ** np.floor(xlo), "max": 10.0 ** np.ceil(xhi),
-                          "major_gridlines": {"visible": True}})
-        chart.set_y_axis({"name": "Peak response (kG)", "log_base": 10, "min": lo, "max": hi,
-                          "major_gridlines": {"visible": True}})
-        chart.set_legend({"none": True})
-        chart.set_size({"width": 720, "height": 440})
+        titled(chart, "Shock response spectrum of the test-item acceleration",
+               log_axis("Natural frequency (Hz)", frequencies, gridlines=True),
+               log_axis("Peak response (kG)", spectrum, gridlines=True), 440, legend=None)
         ws.insert_chart(1, 3, chart)
         one_page(ws, max(head + n, 24), 13)
         close_workbook(wb, path)
