@@ -120,3 +120,33 @@ def test_spectrum_chart_from_1_khz_with_natural_frequency_marks(tmp_path):
     marks = sorted({r[col - 1] for r in rows[1:] if r[col - 1] is not None})
     natural = summarize(airgun_xl.load(TEMPLATE).run()).natural_initial
     np.testing.assert_array_equal(marks, sorted(natural))
+
+
+@needs_lo
+def test_compare_and_calibration_workbooks_print_their_reports(tmp_path):
+    """compare-measured: one page, the scores, the rating and the three charts (the data
+    sheets unprinted). calibrate: the shot's parameters, its Outputs block, the Crush law and
+    the Calibration report, a page each. LibreOffice opens both (the PDF is its reading)."""
+    from airgun_xl.studies.calibrate import synthetic_measurement
+
+    p = airgun_xl.load(TEMPLATE).params
+    trace = synthetic_measurement(p.replace(sigmay=p.sigmay * 1.05), seed=5)
+    m = tmp_path / "m.csv"
+    m.write_text("time [s],acceleration [kG]\n" + "".join(
+        f"{t!r},{a!r}\n" for t, a in zip(trace.time.tolist(), trace.accel_kg.tolist())))
+    compared = tmp_path / "compared.xlsx"
+    assert main(["compare-measured", str(TEMPLATE), str(m), "--cfc", "1000", "-o",
+                 str(compared)]) == 0
+    pages = _pdf_pages(compared, tmp_path)
+    assert len(pages) == 1
+    assert re.search(r"Overall rating R\s+0\.9\d\d", pages[0])
+    assert "Test against prediction (Fig. 13)" in pages[0]
+    calibrated = tmp_path / "calibrated.xlsx"
+    assert main(["calibrate", str(TEMPLATE), str(m), "--cfc", "1000", "-o",
+                 str(calibrated)]) == 0
+    pages = _pdf_pages(calibrated, tmp_path)
+    assert len(pages) == 4
+    assert "Damping Factor (Zeta)" in pages[0]
+    assert re.search(r"positions\s+TRUE", pages[1])
+    assert re.search(r"Law\s+fitted", pages[2])
+    assert "Crush-law iteration" in pages[3] and "Figs. 7-8" in pages[3]

@@ -30,9 +30,12 @@ def _parameter_sheet(wb, shot, params, names, fitted):
             block[cell] = (getattr(params, field), None)  # the fitted value, a plain number
     ws = wb.add_worksheet(names["first"], worksheet_class=ColumnsWorksheet)
     warnings = write_cells(ws, block, {k: v[0] for k, v in block.items()})
+    one_page(ws, max(r for r, _ in block) - 1, 6, landscape=False)
     if source.outputs_block:
         out = wb.add_worksheet(names["Outputs"], worksheet_class=ColumnsWorksheet)
         warnings += write_cells(out, source.outputs_block)
+        one_page(out, max(r for r, _ in source.outputs_block) - 1,
+                 max(c for _, c in source.outputs_block) - 1)
     return warnings
 
 

@@ -15,6 +15,7 @@ import math
 from ..crush_law import DEGREE, LEGACY_LAW, CrushLaw
 from ..errors import CellError
 from .columns_sheet import ColumnsWorksheet
+from .page_setup import one_page
 
 SHEET_NAME = "Crush law"
 KEY = SHEET_NAME.upper()
@@ -73,4 +74,5 @@ def write_law_sheet(wb, law, name=SHEET_NAME, note=NOTE):
         ws.write_string(FIRST_COEFFICIENT_ROW - 1 + k, 0, f"c{k}")
         ws.write_number_column(FIRST_COEFFICIENT_ROW - 1 + k, 1, [c])
     ws.write_string(FIRST_COEFFICIENT_ROW + DEGREE + 1, 0, note)
+    one_page(ws, FIRST_COEFFICIENT_ROW + DEGREE + 1, 1, landscape=False)
     return ws
