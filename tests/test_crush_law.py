@@ -74,3 +74,16 @@ def test_lanes_carry_each_shots_own_law():
         assert np.array_equal(batch.figures[i], solo.figures[0], equal_nan=True)
     peaks = batch.figures[:, 0]
     assert (np.diff(peaks) > 0).all()  # a stronger law, a higher peak
+
+
+def test_the_checks_hold_a_fitted_law_to_its_own_range():
+    """The impact-speed warning names the law the run uses and its range: the macro's
+    -20..250 m/s, or a fitted law's (here 0..200 m/s, at shot A's 243.5 m/s)."""
+    from airgun_xl.studies.check import impact_speed_finding
+
+    p = airgun_xl.load(SHOT_A).params
+    assert impact_speed_finding(p) is None  # 243.5 m/s inside the macro's -20..250
+    narrow = CrushLaw(LEGACY_LAW.coefficients, (0.0, 200.0), "fitted")
+    found = str(impact_speed_finding(p.replace(crush_law=narrow)))
+    assert "outside 0..200 m/s where the fitted crush law (Crush law sheet) holds" in found
+    assert f"crush factor {narrow(243.53532):.3g}" in found

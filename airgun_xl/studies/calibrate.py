@@ -156,15 +156,24 @@ def law_samples(a):
     return a.velocity[use], a.crush_factor[use] * f_meas[use] / f_sim[use]
 
 
-def fit_law(v, x, degree=DEGREE):
-    """A polynomial crush-factor law through samples (V [m/s], X [-]) by least squares."""
+def fit_law(v, x, degree=DEGREE, v_range=None):
+    """A polynomial crush-factor law through samples (V [m/s], X [-]) by least squares, valid
+    over ``v_range`` (the samples' span by default)."""
     from numpy.polynomial import Polynomial
 
     if len(v) <= degree:
         raise OptionError(f"--degree: {len(v)} samples of the law, expected more than the "
                           f"degree ({degree}); a longer or less filtered pulse")
     poly = Polynomial.fit(v, x, degree).convert()
-    return CrushLaw(tuple(poly.coef), (float(v.min()), float(v.max())), "fitted")
+    span = v_range or (float(v.min()), float(v.max()))
+    return CrushLaw(tuple(poly.coef), span, "fitted")
+
+
+def shots_range(pairs, v):
+    """The velocities the shots' pulses cover: from rest (or the least sample below it) to
+    the highest impact speed (the first sample is already a step past the impact)."""
+    impact = max(p.v31 - p.v1 for p, _ in pairs)
+    return (min(0.0, float(v.min())), max(float(impact), float(v.max())))
 
 
 def calibrate_law(pairs, cfc=None, degree=DEGREE, integrator="legacy",
@@ -197,7 +206,7 @@ def calibrate_law(pairs, cfc=None, degree=DEGREE, integrator="legacy",
             xs.append(x)
             errors.append(rms_error(a))
         v, x = np.concatenate(vs), np.concatenate(xs)
-        new = fit_law(v, x, degree)
+        new = fit_law(v, x, degree, shots_range(pairs, v))
         change = law_change(new, law, np.linspace(v.min(), v.max(), 101))
         out.iterations.append(Iteration(number, change, float(np.max(errors)), len(v)))
         out.law, out.velocity, out.factor = new, v, x

@@ -4,7 +4,6 @@ import math
 from dataclasses import dataclass
 
 from ..cells import BY_ADDRESS
-from ..crush_law import CRUSH_FIT_RANGE, crush_factor
 from ..engine.stability import WARN_RATIO, critical_time_step, full_length
 
 #: Bird masses differing by this factor or more make a stiff, badly scaled system.
@@ -77,13 +76,18 @@ def impact_speed_finding(p):
     """The warning for an impact speed past the crush-factor fit, or None.
 
     (A bird slower than the MEM crushes nothing at first: no warning.)"""
-    lo, hi = CRUSH_FIT_RANGE
+    lo, hi = p.crush_law.v_range
     v_rel = p.v31 - p.v1
     if v_rel <= hi:
         return None
     return Finding("warning", "A28", f"the bird meets the MEM at {v_rel:.4g} m/s, outside "
-                   f"{lo:g}..{hi:g} m/s where the crush-factor polynomial (Eq. 8) holds: it is "
-                   f"extrapolated there (crush factor {crush_factor(v_rel):.3g})")
+                   f"{lo:g}..{hi:g} m/s where {_law_words(p)} holds: it is "
+                   f"extrapolated there (crush factor {p.crush_law(v_rel):.3g})")
+
+
+def _law_words(p):
+    return ("the crush-factor polynomial (Eq. 8)" if p.crush_law.is_legacy else
+            "the fitted crush law (Crush law sheet)")
 
 
 def before_run(p, integrator="legacy"):
@@ -135,15 +139,15 @@ def after_run(result):
     found = []
     if stats is None:
         return found
-    lo, hi = CRUSH_FIT_RANGE
+    lo, hi = p.crush_law.v_range
     said = p.v31 - p.v1 > hi  # before_run already warned about the impact speed
     if not said and (stats.max_relative_velocity > hi or stats.min_relative_velocity < lo):
         worst = (stats.max_relative_velocity if stats.max_relative_velocity > hi
                  else stats.min_relative_velocity)
         found.append(Finding("warning", "A28", f"while crushing, the relative velocity reached "
-                             f"{worst:.4g} m/s, outside {lo:g}..{hi:g} m/s where the "
-                             "crush-factor polynomial (Eq. 8) holds (crush factor "
-                             f"{crush_factor(worst):.3g} there)"))
+                             f"{worst:.4g} m/s, outside {lo:g}..{hi:g} m/s where "
+                             f"{_law_words(p)} holds (crush factor "
+                             f"{p.crush_law(worst):.3g} there)"))
     length = p.hcone + p.hcylinder
     if stats.x_plastic > length:
         found.append(Finding("warning", "E19", f"the plastic front reached {stats.x_plastic:.4g}"
