@@ -70,7 +70,9 @@ class CrushLaw:
 
     @property
     def is_legacy(self):
-        return self.coefficients == LEGACY_COEFFICIENTS
+        """The macro's law: its coefficients, range and name."""
+        return (self.coefficients == LEGACY_COEFFICIENTS and self.v_range == CRUSH_FIT_RANGE
+                and self.name == "legacy")
 
 
 LEGACY_LAW = CrushLaw()
