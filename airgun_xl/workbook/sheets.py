@@ -189,6 +189,9 @@ def _summary_rows(result, summary, timings):
         ("Model", p.model + (" - the rigid-body model" if result.model == "rigid" else ""),
          "", ""),
         ("Integrator", result.integrator, "", ""),
+        ("Crush-factor law", "the macro's polynomial, Eq. (8)" if p.crush_law.is_legacy else
+         f"fitted, {p.crush_law.v_range[0]:.4g} to {p.crush_law.v_range[1]:.4g} m/s",
+         "", "" if p.crush_law.is_legacy else "the Crush law sheet (airgun-xl calibrate)"),
         ("Time step", p.delta, "step", "E2"),
         ("Critical time step", timings.get("dt_crit"), "step",
          "largest step stable from the first step, mitigator at full length (airgun-xl "
