@@ -10,8 +10,10 @@ way as the measured one, and each sample's factor is the current law's times the
 measured to the simulated force: X_new = X_old F_meas / F_sim. For a rigid bird and no filter
 F_sim = sigma_y A X_old, so this is the report's F_meas / (sigma_y A) exactly; with the OBR's
 springs and a CFC filter, the ringing and the filter's smearing are the same on both sides and
-cancel, so the iteration stops on the law that reproduces the measured pulse. The samples of
-all shots are pooled into one polynomial, as the report combined its two shots.
+cancel. The samples of all shots are pooled into one polynomial, as the report combined its two
+shots. Under a filter the pointwise ratio can settle short of the law that reproduces the
+pulses (1.6 % off in the recovery test), so :func:`refine_law` finishes by least squares on the
+law's values.
 
 The least squares (scipy.optimize.least_squares) fits any of E40 (sigma_y), E43 (zeta) and a
 scale of the whole law to the filtered pulses, on their difference (L2) or on the ISO/TS 18571
@@ -39,7 +41,8 @@ MAX_ITERATIONS = 12
 #: (the ratio of two small, noisy numbers).
 FORCE_FLOOR = 0.2
 
-#: Fit names: the parameter they move, its cell, and its bounds relative to the start.
+#: Fit names (cells, or the law's scale): the field they move, and their bounds relative to the
+#: start (None: zeta's absolute 0..0.5).
 FIT_PARAMETERS = {"E40": ("sigmay", 0.25, 4.0), "E43": ("zeta", None, None),
                   "scale": ("scale", 0.25, 4.0)}
 OBJECTIVES = ("l2", "iso18571")
@@ -99,7 +102,8 @@ def _run(p, integrator):
 
 def align(result, trace, cfc=None):
     """The run's pulse on the measured trace's grid, both filtered alike (``cfc``) and aligned
-    at the impact instant (where each first reaches :data:`IMPACT_FRACTION` of its peak).
+    at the impact instant (where each first reaches
+    :data:`~airgun_xl.studies.measured.IMPACT_FRACTION` of its peak).
 
     Every measured sample is kept (the run is at rest before it starts and holds its last
     value after), so the residuals of two runs have the same length."""
