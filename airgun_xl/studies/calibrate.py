@@ -27,7 +27,7 @@ import numpy as np
 
 from ..crush_law import DEGREE, CrushLaw
 from ..errors import OptionError
-from .measured import KG_MS2, crossing
+from .measured import KG_MS2, on_measured_grid, threshold_shift
 from .shock import cfc_filter
 
 #: The iteration stops when the law moves less than this over the samples' velocities (the
@@ -111,20 +111,12 @@ def align(result, trace, cfc=None):
     ok = np.isfinite(result.accel_kg)
     t_run, a_run = h.time[ok], result.accel_kg[ok]
     meas = cfc_filter(trace.accel_kg, trace.dt, cfc) if cfc else trace.accel_kg
-    t_meas = crossing(trace.time, meas)
-    # the run on the measured step, at rest before it as the recorder is before the impact:
-    # both filters then start from the same zeros (filtfilt's edge padding would not)
-    grid = np.arange(t_run[0] - (trace.time[-1] - trace.time[0]), t_run[-1], trace.dt)
-    on_grid = np.interp(grid, t_run, a_run, left=0.0)
-    on_grid = cfc_filter(on_grid, trace.dt, cfc) if cfc else on_grid
-    t_sim = crossing(grid, on_grid)
-    shift = t_sim - t_meas
+    shift = threshold_shift(t_run, a_run, trace, meas, cfc)[0]
     t = trace.time + shift
     if ((t >= t_run[0]) & (t <= t_run[-1])).sum() < 16:
         raise OptionError("the aligned traces overlap in fewer than 16 samples, expected the "
                           "measured pulse to cover the simulated one")
-    sim = np.interp(t, t_run, a_run, left=0.0)
-    sim = cfc_filter(sim, trace.dt, cfc) if cfc else sim
+    sim = on_measured_grid(t, t_run, a_run, trace.dt, cfc)
     rows = h.time[2:]
     cf = np.interp(t, rows, h.crush_factor[2:])
     prev = np.interp(t - result.params.delta, rows, h.deflection[2:])

@@ -84,7 +84,20 @@ def filtered_from_rest(time, values, cfc):
     return t, (cfc_filter(v, dt, cfc) if cfc else v)
 
 
-_impact = crossing
+def threshold_shift(pred_time, pred_kg, trace, meas, cfc):
+    """(shift, impact, filtered prediction): the shift [s] to add to the measured time so that
+    both impact instants coincide (:func:`crossing` of each filtered pulse), the prediction's
+    impact instant [s], and its filtered (time, values) from rest."""
+    pred_time, pred = filtered_from_rest(pred_time, pred_kg, cfc)
+    impact = crossing(pred_time, pred)
+    return impact - crossing(trace.time, meas), impact, (pred_time, pred)
+
+
+def on_measured_grid(time, pred_time, pred_kg, dt, cfc):
+    """The raw prediction at the measured samples ``time`` (at rest before it, holding its last
+    value after), then the measurement's filter at its rate: filtered alike, literally."""
+    on_grid = np.interp(time, pred_time, np.asarray(pred_kg, float), left=0.0)
+    return cfc_filter(on_grid, dt, cfc) if cfc else on_grid
 
 
 def _figures(time, accel, impact):
@@ -118,35 +131,29 @@ def compare(pred_time, pred_kg, trace, cfc=None, alignment="threshold", rigid=No
     if alignment not in ALIGNMENTS:
         raise OptionError(f"--align: found {alignment!r}, expected one of "
                           f"{', '.join(ALIGNMENTS)}")
-    raw_time, raw_kg = pred_time, np.asarray(pred_kg, float)
-    pred_time, pred = filtered_from_rest(pred_time, pred_kg, cfc)
     meas = cfc_filter(trace.accel_kg, trace.dt, cfc) if cfc else trace.accel_kg
     if np.max(meas) < -np.min(meas):
         raise OptionError(f"--sign: the measured pulse is mostly negative (from "
                           f"{np.min(meas):.4g} to {np.max(meas):.4g} kG), expected the macro's "
                           "sign, a deceleration positive (try --sign -1)")
-    impact_pred = _impact(pred_time, pred)
-    shift = impact_pred - _impact(trace.time, meas)
+    shift, impact_pred, (f_time, f_pred) = threshold_shift(pred_time, pred_kg, trace, meas, cfc)
     if alignment == "xcorr":
         from scipy.signal import correlate, correlation_lags
 
         # the prediction on the measurement's step; pred_grid[n + k] ~ meas[n] at the best k
-        grid = np.arange(pred_time[0], pred_time[-1], trace.dt)
-        pred_grid = np.interp(grid, pred_time, pred)
+        grid = np.arange(f_time[0], f_time[-1], trace.dt)
+        pred_grid = np.interp(grid, f_time, f_pred)
         lags = correlation_lags(len(pred_grid), len(meas))
         k = lags[np.argmax(correlate(pred_grid, meas))]
         shift = float(grid[0] + k * trace.dt - trace.time[0])
     time = trace.time + shift
-    inside = (time >= min(raw_time[0], impact_pred)) & (time <= raw_time[-1])
+    inside = (time >= min(pred_time[0], impact_pred)) & (time <= pred_time[-1])
     if inside.sum() < 16:
         raise OptionError("--align: the aligned traces overlap in fewer than 16 samples, "
                           "expected the measured pulse to cover the predicted one")
     t = time[inside]
     measured = meas[inside]
-    # the raw prediction on the measurement's samples (at rest before it), then the same
-    # filter at the same rate: filtered alike, literally
-    on_grid = np.interp(time, raw_time, raw_kg, left=0.0)
-    predicted = (cfc_filter(on_grid, trace.dt, cfc) if cfc else on_grid)[inside]
+    predicted = on_measured_grid(time, pred_time, pred_kg, trace.dt, cfc)[inside]
     p_fig = _figures(t, predicted, impact_pred)
     m_fig = _figures(t, measured, impact_pred)
     correlation = float(np.corrcoef(predicted, measured)[0, 1])
