@@ -65,7 +65,7 @@ def benches(repeat, tmp):
     commands = [
         ("compare-measured, shot A, CFC 1000 (ISO, FFT, SRS, rigid model, 3 charts)",
          ["compare-measured", shots[0], measured[0], "--cfc", "1000"], 1.0),
-        ("srs, shot A (61 frequencies, Q = 10)", ["srs", shots[0]], 1.0),
+        ("srs, shot A (81 frequencies, Q = 10)", ["srs", shots[0]], 1.0),
         ("calibrate, 2 shots, the law (iteration + least squares), CFC 1000",
          ["calibrate", *pairs, "--cfc", "1000"], 10.0),
         ("calibrate, 2 shots, --fit E40,E43 (unfiltered)",
