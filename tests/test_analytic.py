@@ -143,3 +143,36 @@ def test_filtered_calc_ignores_fractional_offsets():
     f = filtered_acceleration(y, 1.0, 100 / 3, host="calc")
     assert len(f.values) and np.all(f.values == 0)
     assert f.rows.tolist() == list(range(33, 33 + 34 * len(f.rows), 34))
+
+
+def test_filter_below_one_row_half_writes_first_differences_every_other_row():
+    """Issue 18.5, s = 0.5 (2s whole): both hosts leave Offset(-0.5) in place (Calc ignores
+    it, Excel rounds half to even: 0) and move Offset(1): each visited row reads Y at the
+    cursor twice and one row on, and writes one row on; the cursor then skips a row. Matched
+    on the runner's case ab_half_row by test_legacy_cases.py."""
+    y = np.arange(20.0) ** 2
+    for host in ("excel", "calc"):
+        f = filtered_acceleration(y, 1.0, 0.5, host=host)
+        # counter 3..20 - 1: 17 visits, two rows each, so the writes run past the 20 rows
+        # (reading empty cells as 0 there), as the runner's case shows to row 599 of 302
+        assert f.rows.tolist() == list(range(1, 35, 2))
+        assert f.values.tolist() == [(y[r] - y[r - 1]) / 0.25 for r in f.rows[:10]] + [
+            0.0] * 7
+        assert any("sub-row filter quirk" in w for w in f.warnings)
+
+
+def test_filter_below_one_row_fractional_differs_by_host():
+    """s = 0.3: Calc ignores both fractional Offsets (zeros on every row, as the runner's
+    ab_third_row); Excel rounds 0.6 to 1 and -0.3 to 0, so it writes differences on every
+    other row, as at s = 0.5 but scaled by 1/0.09."""
+    y = np.arange(20.0) ** 2
+    calc = filtered_acceleration(y, 1.0, 0.3, host="calc")
+    # counter 3..19.4: 17 visits
+    assert calc.rows.tolist() == list(range(17)) and np.all(calc.values == 0)
+    excel = filtered_acceleration(y, 1.0, 0.3, host="excel")
+    assert excel.rows.tolist() == list(range(1, 35, 2))
+    np.testing.assert_allclose(excel.values[:10], [(y[r] - y[r - 1]) / 0.09
+                                                   for r in excel.rows[:10]],
+                               rtol=1e-15)  # 1/(0.3^2) rounds apart from 1/0.09
+    assert "zeros on every row" in calc.warnings[0]
+    assert "every other row" in excel.warnings[0]

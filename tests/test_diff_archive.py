@@ -16,7 +16,7 @@ from airgun_xl.archive import SCRATCH, Archive, safe_name
 from airgun_xl.cli import main
 from airgun_xl.transaction import recover
 
-CALC_HOST_CASES = {"samplerate_non_integer"}
+CALC_HOST_CASES = {"samplerate_non_integer", "ab_third_row"}
 
 
 @pytest.mark.parametrize("name", sorted(CASES))

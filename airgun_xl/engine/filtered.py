@@ -37,6 +37,18 @@ def _offset(n, host):
     return round(n)  # Excel: nearest integer, halves to even (Python's round does the same)
 
 
+def sub_row_warning(samplerate, host):
+    """The quirk of a filter step below one row, by name (the macro's column AB then holds
+    zeros, or first differences divided by a second difference's step: no acceleration)."""
+    both, back = _offset(2 * samplerate, host), _offset(-samplerate, host)
+    shape = ("(Y33 one row on - Y33) / (E2*samplerate)^2 on every other row, a velocity "
+             "change over a time squared" if (both, back) == (1, 0) else
+             "zeros on every row" if both == back == 0 else "one-sided differences of Y33")
+    return (f"E34 (Filter Frequency): 1/(E2*E34) = {samplerate:.3g} rows is below one row "
+            f"(sub-row filter quirk): the macro's column AB then holds {shape} ({host}), not "
+            "an acceleration; it is reproduced, and no filtered peak is reported")
+
+
 @dataclass
 class Stencils:
     """Where the macro's filter reads and writes, for a run of ``n`` rows.
@@ -61,12 +73,10 @@ def filter_stencils(n, samplerate, host="excel"):
     """
     if host not in HOSTS:
         raise ValueError(f"host must be one of {HOSTS}")
-    empty = np.zeros(0, dtype=np.int64)
-    if samplerate < 1:  # a sample every row from a stencil inside one row: no filter at all
-        return Stencils(empty, empty, empty, empty, [
-            f"samplerate 1/(E2*E34) = {samplerate:.3g} is below one row: no filtered column"])
     warnings = []
-    if not float(samplerate).is_integer():
+    if samplerate < 1:  # every visited row writes; Offset(-sr) is fractional in both hosts
+        warnings.append(sub_row_warning(samplerate, host))
+    elif not float(samplerate).is_integer():
         warnings.append(
             f"samplerate 1/(E2*E34) = {samplerate:.6g} is not a whole number of rows: the legacy "
             f"filtered column is ill-defined (Excel rounds the offsets and drifts a row per "

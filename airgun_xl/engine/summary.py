@@ -177,7 +177,7 @@ def summarize(result):
         peak, t_peak = np.nan, np.nan
     f_rows, f_values = result.filtered.rows, result.filtered.values
     inside = f_rows < len(time)
-    if inside.any():
+    if inside.any() and p.samplerate >= 1:  # below a row, AB is no acceleration (quirk)
         kg = f_values[inside] / KG
         j = int(np.argmax(kg))
         f_peak, t_f_peak = float(kg[j]), float(time[f_rows[inside][j]])

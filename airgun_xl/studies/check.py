@@ -111,8 +111,7 @@ def before_run(p, integrator="legacy"):
                              f"{round(steps) + 2:,}"))
     s = p.samplerate
     if s < 1:
-        found.append(Finding("warning", "E34", f"1/(E2*E34) = {s:.3g}: less than a row between "
-                             "filter samples, so there is no filtered column"))
+        pass  # the sub-row filter quirk: named by the run (engine.filtered.sub_row_warning)
     elif 2 * s >= p.rows - 2:
         found.append(Finding("warning", "E34", f"1/(E2*E34) = {s:.6g} rows: the filter needs "
                              f"2 x that within the run's {p.rows:,} rows, so there is no "

@@ -71,15 +71,23 @@ def test_a_signal_at_a_random_moment_leaves_all_or_nothing(tmp_path, signum):
     archive = tmp_path / "archive"
     main(["fill", str(SHOT), "-o", str(tmp_path / "warm.xlsx"), "--archive", str(archive),
           "--only", "summary"])  # creates the archive; warms the bytecode
+    def fill(out):
+        return subprocess.Popen([sys.executable, "-m", "airgun_xl", "fill", str(SHOT), "-o",
+                                 str(out), "--archive", str(archive), "--sidecar", "always"],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+
+    # the moments are fractions of a whole fill's time on this machine, not fixed sleeps: a
+    # slower or busier machine stretches them alike
+    began = time.perf_counter()
+    assert fill(tmp_path / "timed.xlsx").wait(timeout=120) == 0
+    whole = time.perf_counter() - began
     rng = random.Random(signum)
     stopped = 0
     for i in range(8):
         out = tmp_path / f"o{i}.xlsx"
         entries = len(Archive(archive).entries())
-        proc = subprocess.Popen([sys.executable, "-m", "airgun_xl", "fill", str(SHOT), "-o",
-                                 str(out), "--archive", str(archive), "--sidecar", "always"],
-                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-        time.sleep(rng.uniform(0.2, 2.0))
+        proc = fill(out)
+        time.sleep(whole * rng.uniform(0.1, 0.8))
         proc.send_signal(signum)
         code = proc.wait(timeout=120)
         err = proc.stderr.read()
