@@ -11,6 +11,11 @@ INTEGRATORS = ("legacy", "newmark")
 #: Models (``airgun_xl.models``).
 MODELS = ("4-mass", "rigid")
 
+#: The mitigator's unloading force (``ShotParams.unloading``): the macro's, whose offset is
+#: set at the first unloading only (a force jump at any later one), or continuous, where
+#: each unloading starts from the force of the step before it.
+UNLOADINGS = ("macro", "continuous")
+
 #: Whose Offset rounding the filtered column reproduces (``airgun_xl.engine.filtered``).
 HOSTS = ("excel", "calc")
 

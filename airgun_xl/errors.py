@@ -68,11 +68,14 @@ class DivergenceError(AirgunXlError):
         Its time [s].
     values : dict
         The displacements Y1, Y31, Y32, Y33 at that row [m].
+    cause : str or None
+        What made it diverge, when known: ``"unloading quirk"`` (the macro's force jump at a
+        second unloading) or None.
     """
 
-    def __init__(self, message, row, time, values):
+    def __init__(self, message, row, time, values, cause=None):
         super().__init__(message)
-        self.row, self.time, self.values = row, time, values
+        self.row, self.time, self.values, self.cause = row, time, values, cause
 
 
 class DesignError(AirgunXlError):

@@ -12,8 +12,9 @@ from dataclasses import asdict, dataclass, fields, replace
 from typing import Any
 
 from .cells import BY_NAME, CELLS, MAX_STEPS, expectation
+from .choices import UNLOADINGS
 from .crush_law import LEGACY_LAW, CrushLaw
-from .errors import CellError
+from .errors import CellError, OptionError
 
 
 class Found(str):
@@ -136,6 +137,9 @@ class ShotParams:
     crush_law : CrushLaw
         The crush factor's law, Eq. (8): the macro's polynomial unless a calibration fitted
         another (the workbook's "Crush law" sheet).
+    unloading : {"macro", "continuous"}
+        The unloading force: the macro's (its offset is set at the first unloading only, so
+        a later one jumps; :mod:`airgun_xl.engine.quirks`), or continuous at every unloading.
     """
 
     m1: float
@@ -162,6 +166,7 @@ class ShotParams:
     v32: float
     v33: float
     crush_law: CrushLaw = LEGACY_LAW
+    unloading: str = "macro"
 
     @classmethod
     def from_cells(cls, raw_by_address: Mapping[str, object]) -> ShotParams:
@@ -196,6 +201,9 @@ class ShotParams:
         CellError
             Naming the cell at fault.
         """
+        if self.unloading not in UNLOADINGS:
+            raise OptionError(f"unloading: found {self.unloading!r}, expected one of "
+                              f"{', '.join(UNLOADINGS)}")
         left_out = {3: (), 2: ("m33", "k3"), 1: ("m32", "m33", "k2", "k3")}[self.bird_masses]
         for f in fields(self):
             if f.name not in left_out and f.name in BY_NAME:

@@ -74,13 +74,14 @@ def prepare_entry(archive, request, shot, workbook, filled, options, seconds):
         summary = {k: _plain(v) for k, v in dataclasses.asdict(s).items() if k != "spectrum"}
         summary["dominant_frequencies_hz"] = list(s.spectrum.peaks)
     summary.update(rows=result.rows, peak_kg=_plain(result.peak_kg),
-                   time_of_peak=_plain(result.time_of_peak))
+                   time_of_peak=_plain(result.time_of_peak), warnings=list(filled.warnings))
     provenance = {"engine": __version__, "versions": _versions(),
                   "input": display(shot.source.path) if shot.source else None,
                   "input_sha256": shot.source.sha256 if shot.source else None,
                   "started": request.started_at, "run_seconds": seconds,
                   "command": [display(a) for a in options.command],
                   "integrator": options.integrator, "model": options.model,
+                  "unloading": p.unloading,
                   "host": options.host, "stride": filled.stride}
     files = {"output.xlsx": workbook}
     if shot.source is not None:
@@ -89,7 +90,8 @@ def prepare_entry(archive, request, shot, workbook, filled, options, seconds):
     index = {"input_sha256": provenance["input_sha256"], "v0": p.v31, "delta": p.delta,
              "max_time": p.max_time, "sigmay": p.sigmay, "rcone": p.rcone,
              "peak_kg": summary["peak_kg"], "integrator": options.integrator,
-             "model": options.model, "engine": __version__}
+             "model": options.model, "engine": __version__,
+             "warnings": len(filled.warnings)}
     return archive.prepare(
         safe_name(request.name), files,
         {"params.json": params, "summary.json": summary, "provenance.json": provenance},

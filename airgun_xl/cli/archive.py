@@ -76,6 +76,29 @@ def run_history(args):
     return 0
 
 
+#: How ``show`` prints a figure of summary.json: (unit, factor from SI, digits after the point).
+FIGURE_UNITS = {
+    "peak_kg": ("kG", 1.0, 5), "filtered_peak_kg": ("kG", 1.0, 5),
+    "time_of_peak": ("ms", 1e3, 4), "time_of_filtered_peak": ("ms", 1e3, 4),
+    "pulse_start": ("ms", 1e3, 4), "pulse_end": ("ms", 1e3, 4),
+    "pulse_duration": ("ms", 1e3, 4), "max_crush": ("m", 1.0, 4),
+    "final_length": ("m", 1.0, 4), "final_m1": ("kg", 1.0, 4), "final_m31": ("kg", 1.0, 4),
+    "obr_exit_velocity": ("m/s", 1.0, 3), "mem_final_velocity": ("m/s", 1.0, 3),
+    "natural_initial": ("kHz", 1e-3, 3), "natural_final": ("kHz", 1e-3, 3),
+    "dominant_frequencies_hz": ("kHz", 1e-3, 3), "rows": ("", 1.0, 0),
+}
+
+
+def shown_figure(key, value):
+    """A summary.json figure with its unit: ``0.2885 ms``, ``5.333, 4.833 kHz``, ``n/a``."""
+    unit, factor, digits = FIGURE_UNITS.get(key, ("", 1.0, None))
+    values = value if isinstance(value, list) else [value]
+    if digits is None or not all(isinstance(v, (int, float)) or v is None for v in values):
+        return str(value)
+    text = ", ".join("n/a" if v is None else f"{v * factor:,.{digits}f}" for v in values)
+    return f"{text} {unit}".rstrip() if values else "none"
+
+
 def run_show(args):
     e = _archive(args.archive).get(args.entry)
     doc = {"entry": e.ref, "id": e.id, "path": str(e.path), "created": e.created,
@@ -89,8 +112,16 @@ def run_show(args):
     for p in doc["params"]:
         print(f"  {p['cell']:<4} {p['label']:<32} {p['value']!r:>22} {p['unit']}")
     print("figures:")
-    for k, v in doc["summary"].items():
-        print(f"  {k:<24} {v}")
+    summary = dict(doc["summary"])
+    warnings = summary.pop("warnings", None)
+    for k, v in summary.items():
+        print(f"  {k:<24} {shown_figure(k, v)}")
+    if warnings is None:
+        print("warnings: not recorded (an entry from before they were kept)")
+    else:
+        print(f"warnings: {len(warnings) or 'none'}")
+        for text in warnings:
+            print(f"  - {text}")
     prov = doc["provenance"]
     print(f"provenance: airgun-xl {prov['engine']}, {prov['integrator']} integrator, "
           f"{prov['model']} model, started {prov['started']}, {prov['run_seconds']:.2f} s")

@@ -22,15 +22,16 @@ def run(args):
     p = shot.params
     crit, findings = before_run(p, args.integrator)
     print(f"{args.shot}: {p.model}, {args.integrator} integrator")
-    print(f"  time step E2 = {p.delta:.4g} s, critical {crit.dt_crit:.4g} s from the first "
-          f"step (mitigator at full length {full_length(p):.4g} m), ratio {crit.ratio:.3g}: "
-          f"{crit.verdict}")
+    print(f"  time step E2 = {p.delta:.4g} s, critical {crit.dt_crit:.4g} s for the OBR chain "
+          f"(the springs that always act), ratio {crit.ratio:.3g}: {crit.verdict}")
     print(f"  set by {crit.limiting}")
-    print(f"  critical {crit.dt_compacted:.4g} s once fully compacted (length "
+    print(f"  while the mitigator unloads: critical {crit.dt_unloading:.4g} s at full length "
+          f"{full_length(p):.4g} m, {crit.dt_compacted:.4g} s fully compacted (length "
           f"{compacted_length(p):.4g} m, E37 = {p.ec:g})")
     if crit.unstable_crush is not None:
-        print(f"  unstable once crushed by {crit.unstable_crush:.4g} m (length below "
-              f"{crit.unstable_length:.4g} m): the run stops if it gets there")
+        print(f"  unstable while unloading once crushed by {crit.unstable_crush:.4g} m (length "
+              f"below {crit.unstable_length:.4g} m): the run is watched and stops where it "
+              "diverges")
     for message in shot.warnings:
         print(f"  warning: {message}")
     for f in findings:

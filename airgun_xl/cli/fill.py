@@ -4,7 +4,7 @@ import time
 from pathlib import Path
 
 from ..archive import ENV, archive_dir
-from ..choices import HOSTS, INTEGRATORS, MODELS, SIDECAR_MODES
+from ..choices import HOSTS, INTEGRATORS, MODELS, SIDECAR_MODES, UNLOADINGS
 from ..outputs import GROUPS, from_sheet
 from ..transaction import display
 
@@ -44,6 +44,10 @@ def add_parser(sub):
                    help="workbook: the law the workbook's Crush law sheet names (a calibrated "
                         "workbook's fitted law), else the macro's (default); legacy: the "
                         "macro's polynomial, Eq. (8), whatever the workbook says")
+    p.add_argument("--unloading", choices=UNLOADINGS, default="macro",
+                   help="macro: the macro's unloading force, quirk included (default); "
+                        "continuous: each unloading starts from the force before it (no jump "
+                        "at a second unloading)")
     p.add_argument("--compare-models", action="store_true",
                    help="also run the other model; both curves in the acceleration chart and "
                         "both peaks in the Summary")
@@ -68,6 +72,7 @@ def _ms(seconds):
 
 def print_summary(output, filled):
     from ..engine.summary import PULSE_FRACTION
+    from ..workbook.sheets import variant_name
 
     result, s, stride, sidecar = filled.result, filled.summary, filled.stride, filled.sidecar
     lines = [f"wrote {output}: {result.rows:,} rows"
@@ -91,7 +96,7 @@ def print_summary(output, filled):
         lines.append(f"  peak {result.peak_kg:.5f} kG at {_ms(result.time_of_peak)}")
     if filled.compared is not None:
         c = filled.compared
-        lines.append(f"  {c.model} model: peak {c.peak_kg:.5f} kG at {_ms(c.time_of_peak)}")
+        lines.append(f"  {variant_name(c)}: peak {c.peak_kg:.5f} kG at {_ms(c.time_of_peak)}")
     if sidecar is not None:
         lines.append(f"  full history in {sidecar}")
     print("\n".join(lines))
@@ -109,6 +114,8 @@ def run(args):
     shot = Shot.from_workbook(args.shot)
     if args.crush_law == "legacy":
         shot = shot.with_law(None)
+    if args.unloading != "macro":
+        shot = shot.with_params(unloading=args.unloading)
     outputs = from_sheet(shot.source.outputs_block).with_flags(
         args.only, args.no_charts, args.every, args.max_sheet_rows, args.sidecar)
     options = Options(args.integrator, args.host, args.model, args.compare_models, args.force,

@@ -10,8 +10,9 @@
  *
  * Python interface (module airgun_xl.engine._artsim):
  *   legacy_kernel(params, rows, t, y1, y31, y32, y33, crush, m31, defl, xp, force, m1, v1, v31)
- *     params: a sequence of 29 floats in the order of the enum below (the crush-factor law's
- *     seven coefficients, constant term first, before the bound);
+ *     params: a sequence of 30 floats in the order of the enum below (the crush-factor law's
+ *     seven coefficients, constant term first, then the unloading variant: 0 the macro's,
+ *     1 continuous, then the bound);
  *     the other arguments: writable, C-contiguous float64 buffers of length >= rows. The
  *     tracked columns from crush on may be None: they are then neither computed nor stored.
  *     Returns (final M1, final m31, first diverged row or -1, final x_plastic, max and min
@@ -36,7 +37,7 @@
 
 enum { P_M1, P_M31, P_M32, P_M33, P_K2, P_K3, P_DELTA, P_RHO, P_RCONE, P_HCONE, P_HCYL,
        P_MMIT, P_VCONE, P_E, P_EC, P_SIGMAY, P_ZETA, P_V1, P_V31, P_V32, P_V33,
-       P_LAW0, P_LAW1, P_LAW2, P_LAW3, P_LAW4, P_LAW5, P_LAW6, P_BOUND, P_COUNT };
+       P_LAW0, P_LAW1, P_LAW2, P_LAW3, P_LAW4, P_LAW5, P_LAW6, P_UNLOAD, P_BOUND, P_COUNT };
 
 typedef struct {
     double *t, *y1, *y31, *y32, *y33, *crush, *m31, *defl, *xp, *force, *m1, *v1, *v31;
@@ -97,7 +98,7 @@ static double mitigator_force(Mitigator *s, const double *p, double y1, double y
         if (s->forceCounter == 0) {
             s->Force = -k1 * (s->mitigatordeflection - hcone);
             s->dforce = s->Force - s->dforce; /* offset that keeps F continuous at the turn */
-            s->forceCounter = 0 + 1;          /* macro: fourcecounter + 1, a typo: Empty + 1 */
+            s->forceCounter = 0 + 1; /* quirk: fourcecounter (Empty) + 1, never reset below */
         }
         s->Force = -k1 * (s->mitigatordeflection - hcone) - s->dforce;
     } else {
@@ -122,6 +123,8 @@ static double mitigator_force(Mitigator *s, const double *p, double y1, double y
             s->crushFactor = 1;
         s->Force = sigmay * Area * s->crushFactor;
         s->dforce = s->Force;
+        if (p[P_UNLOAD] != 0)
+            s->forceCounter = 0; /* not the macro: each unloading starts from the force now */
         if (Area > 0 && Vobr > s->max_Vobr) s->max_Vobr = Vobr; /* while the law acts */
         if (Area > 0 && Vobr < s->min_Vobr) s->min_Vobr = Vobr;
         if (temp > s->max_temp) s->max_temp = temp;
@@ -401,7 +404,7 @@ static PyObject *py_newmark_kernel(PyObject *self, PyObject *args)
 typedef struct {
     double m1[LANES], mmit[LANES], m31p[LANES], m32[LANES], m33[LANES], k2[LANES], k3[LANES];
     double rho[LANES], rcone[LANES], hcone[LANES], hcyl[LANES], E[LANES], ec[LANES];
-    double sigmay[LANES], c2[LANES], c3[LANES], delta[LANES], dd[LANES];
+    double sigmay[LANES], c2[LANES], c3[LANES], delta[LANES], dd[LANES], unload[LANES];
     double law[7][LANES];
 } LaneParams;
 
@@ -465,7 +468,7 @@ LANE_CLONES static void lane_step(const LaneParams *restrict q, LaneState *restr
         s->maxT[i] = (loading & (temp > s->maxT[i])) ? temp : s->maxT[i];
         s->xP[i] = xPn;
         s->defl[i] = d;
-        s->fcount[i] = first ? 0 + 1 : s->fcount[i];
+        s->fcount[i] = first ? 0 + 1 : (loading & (q->unload[i] != 0)) ? 0 : s->fcount[i];
         s->dforce[i] = unload ? dfu : Fl;
         s->maxdef[i] = unload ? s->maxdef[i] : d;
         s->vcone[i] = (loading & wedge) ? tw : s->vcone[i];
@@ -507,6 +510,7 @@ static void legacy_lanes(const double *params, int n, Py_ssize_t rows, double **
         q.E[i] = p[P_E]; q.ec[i] = p[P_EC]; q.sigmay[i] = p[P_SIGMAY];
         q.delta[i] = p[P_DELTA]; q.dd[i] = p[P_DELTA] * p[P_DELTA];
         bound[i] = p[P_BOUND];
+        q.unload[i] = p[P_UNLOAD];
         for (j = 0; j < 7; j++)
             q.law[j][i] = p[P_LAW0 + j];
         s.M1[i] = p[P_M1] + p[P_MMIT];

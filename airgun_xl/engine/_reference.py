@@ -18,8 +18,8 @@ PI_MACRO = 3.141592653
 # Parameter order: the C enum (P_M1 .. P_BOUND).
 (P_M1, P_M31, P_M32, P_M33, P_K2, P_K3, P_DELTA, P_RHO, P_RCONE, P_HCONE, P_HCYL, P_MMIT,
  P_VCONE, P_E, P_EC, P_SIGMAY, P_ZETA, P_V1, P_V31, P_V32, P_V33, P_LAW0, P_LAW1, P_LAW2,
- P_LAW3, P_LAW4, P_LAW5, P_LAW6, P_BOUND) = range(29)
-P_COUNT = 29
+ P_LAW3, P_LAW4, P_LAW5, P_LAW6, P_UNLOAD, P_BOUND) = range(30)
+P_COUNT = 30
 N_FINALS = 8
 
 
@@ -76,7 +76,7 @@ class Mitigator:
             if self.forceCounter == 0:
                 self.Force = -k1 * (self.mitigatordeflection - hcone)
                 self.dforce = self.Force - self.dforce  # keeps F continuous at the turn
-                self.forceCounter = 0 + 1  # macro: fourcecounter + 1, a typo: Empty + 1
+                self.forceCounter = 0 + 1  # quirk: fourcecounter (Empty) + 1, never reset
             self.Force = -k1 * (self.mitigatordeflection - hcone) - self.dforce
         else:
             # loading: plastic crush with mass transfer
@@ -98,6 +98,8 @@ class Mitigator:
                 self.crushFactor = 1.0
             self.Force = sigmay * Area * self.crushFactor
             self.dforce = self.Force
+            if p[P_UNLOAD] != 0:
+                self.forceCounter = 0.0  # not the macro: each unloading starts from F now
             if Area > 0 and Vobr > self.max_Vobr:  # while the law acts
                 self.max_Vobr = Vobr
             if Area > 0 and Vobr < self.min_Vobr:

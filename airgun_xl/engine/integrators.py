@@ -6,6 +6,7 @@ None, neither computed nor stored. ``legacy`` is the faithful port of ArtSim's
 central-difference loop; ``newmark`` is a robust scheme. An integrator registers itself in
 :data:`INTEGRATORS` under its own name and is then selectable everywhere.
 """
+import math
 import time
 from dataclasses import dataclass
 
@@ -25,27 +26,38 @@ KERNEL_PARAMS = ("m1", "m31", "m32", "m33", "k2", "k3", "delta", "rho", "rcone",
 class KernelStats:
     """What the kernel saw, for the checks: final plastic front [m], largest and smallest
     relative velocity while loading [m/s], largest crushed mass [kg], largest mitigator
-    deflection (the maximum crush) [m]."""
+    deflection (the maximum crush) [m]; the row where a run the unloading quirk threw past
+    :func:`displacement_bound` passed it (None: it never did)."""
 
     x_plastic: float
     max_relative_velocity: float
     min_relative_velocity: float
     max_crushed_mass: float
     max_crush: float
+    past_bound: int = None  # first row index past displacement_bound (the quirk's run), or None
 
 
 def divergence_error(integrator, p, row, arrays):
-    """The :class:`~airgun_xl.errors.DivergenceError` for a run stopped at ``row``."""
+    """The :class:`~airgun_xl.errors.DivergenceError` for a run stopped at ``row``; when the
+    macro's unloading-force quirk fired before it, the quirk is named as the cause."""
+    from .watch import unloading_quirk
+
     names = ("Y1", "Y31", "Y32", "Y33")
     values = [a[row] for a in arrays[1:5]]
     worst = max(range(4), key=lambda i: abs(values[i]) if values[i] == values[i] else
                 float("inf"))
     time_at = arrays[0][row]
-    return DivergenceError(
-        f"the {integrator} scheme diverged at step {row - 1:,} (t = {time_at:.6g} s): "
-        f"{names[worst]} = {values[worst]:.3g} m, beyond the {displacement_bound(p):.3g} m "
-        "no physical run reaches; expected a smaller E2 (Timestep) or the newmark integrator",
-        row, time_at, dict(zip(names, values)))
+    where = (f"the {integrator} scheme diverged at step {row - 1:,} (t = {time_at:.6g} s): "
+             f"{names[worst]} = {values[worst]:.3g} m, beyond the {displacement_bound(p):.3g} m "
+             "no physical run reaches")
+    quirk = (unloading_quirk(History(*arrays, np.nan, np.nan, 0.0), stop=row)
+             if p.unloading == "macro" else None)
+    if quirk is not None:
+        return DivergenceError(
+            f"{where}; the cause is {quirk}; expected --unloading continuous (the same shot "
+            "without the quirk)", row, time_at, dict(zip(names, values)), "unloading quirk")
+    return DivergenceError(f"{where}; expected a smaller E2 (Timestep) or the newmark "
+                           "integrator", row, time_at, dict(zip(names, values)))
 
 
 @dataclass
@@ -131,10 +143,22 @@ def _run(kernel, name, p, track):
     elapsed = time.perf_counter() - started
     if bad >= 0 and p.hcone == 0 and not x_plastic > 0:
         raise no_wedge_error(p, bad)
+    past_bound = None
     if bad >= 0:
-        raise divergence_error(name, p, bad, arrays)
+        error = divergence_error(name, p, bad, arrays)
+        if error.cause != "unloading quirk":
+            raise error
+        # the macro's quirk threw the run past the physical bound: run on as the macro
+        # does, stopping only where a value stops being finite (the checks name the quirk)
+        values[-1] = math.inf
+        final_m1, final_m31, bad, x_plastic, max_v, min_v, max_crushed, max_crush = kernel(
+            values, rows, *arrays)
+        elapsed = time.perf_counter() - started
+        if bad >= 0:
+            raise divergence_error(name, p, bad, arrays)
+        past_bound = error.row
     history = History(*arrays, final_m1, final_m31, elapsed)
-    history.stats = KernelStats(x_plastic, max_v, min_v, max_crushed, max_crush)
+    history.stats = KernelStats(x_plastic, max_v, min_v, max_crushed, max_crush, past_bound)
     return blank_left_out(history, p)
 
 
@@ -171,7 +195,8 @@ def run_newmark(p, track=TRACKED):
 
 
 def kernel_params(p):
-    """The kernel's parameter list, the crush law's seven coefficients last; a left-out mass
+    """The kernel's parameter list, then the crush law's seven coefficients and the unloading
+    variant (0 the macro's, 1 continuous); the caller appends the bound. A left-out mass
     (reduced model) gets a stand-in of 1 kg.
 
     Its spring is 0, so the stand-in moves freely and exerts no force (c = 2 zeta sqrt(0) = 0).
@@ -181,7 +206,8 @@ def kernel_params(p):
         values["m33"] = 1.0
     if p.bird_masses < 2:
         values["m32"] = 1.0
-    return [values[name] for name in KERNEL_PARAMS] + list(p.crush_law.coefficients)
+    return ([values[name] for name in KERNEL_PARAMS] + list(p.crush_law.coefficients)
+            + [float(p.unloading == "continuous")])
 
 
 def blank_left_out(history, p):

@@ -31,20 +31,19 @@ def _fmt(dt):
 def stability(p, integrator="legacy"):
     """The critical steps of the chosen scheme and its finding (None when comfortably stable).
 
-    Newmark is implicit in the OBR chain; only the mitigator's unloading stiffness, which it
-    treats explicitly, bounds its step. Two tiers (:mod:`airgun_xl.engine.stability`): an
-    error above the step stable at the mitigator's full length; a warning, with the crush
-    past which the step is unstable, between that and the fully compacted one.
+    Only the springs that act on every step, the OBR chain's, can refuse a step (Newmark is
+    implicit in them). The mitigator's unloading spring acts only while it unloads: a step
+    unstable for it is a warning here, and the run is watched (:func:`unloading_diverged`).
     """
     crit = critical_time_step(p, chain=integrator == "legacy")
-    safe = f"the largest safe time step is {_fmt(crit.dt_crit)}"
     if crit.ratio > 1:
         return crit, Finding("error", "E2", f"{_fmt(p.delta)} is {crit.ratio:.3g} x the "
                                             f"critical time step of the {integrator} scheme, "
-                                            f"set by {crit.limiting}; {safe}")
-    if crit.unstable_crush is not None:
-        return crit, Finding("warning", "E2", unstable_crush_message(p, crit, integrator)
-                             + "; the run stops if it crushes that far")
+                                            f"set by {crit.limiting}; the largest safe time "
+                                            f"step is {_fmt(crit.dt_crit)}")
+    if crit.unstable_length is not None:
+        return crit, Finding("warning", "E2", unloading_limit(p, crit, integrator)
+                             + "; the run is watched and stops where it diverges")
     if crit.ratio > WARN_RATIO:
         return crit, Finding("warning", "E2", f"{_fmt(p.delta)} is {crit.ratio:.2f} x the "
                                               f"critical time step ({_fmt(crit.dt_crit)}) of "
@@ -52,24 +51,32 @@ def stability(p, integrator="legacy"):
     return crit, None
 
 
-def unstable_crush_message(p, crit, integrator="legacy"):
-    """The second tier in words: how far the shot may crush before its step is unstable."""
-    return (f"{_fmt(p.delta)} is stable for the {integrator} scheme until the mitigator is "
-            f"crushed by {crit.unstable_crush:.4g} m (remaining length "
-            f"{crit.unstable_length:.4g} m of E16 + E19 = {full_length(p):.4g} m): shorter, "
-            "its unloading stiffness needs a step below "
-            f"{_fmt(crit.dt_compacted)} (fully compacted)")
+def unloading_limit(p, crit, integrator="legacy"):
+    """Where the shot's step is unstable for the unloading spring, in words."""
+    where = ("at any length" if crit.unstable_length >= full_length(p) else
+             f"once crushed by {crit.unstable_crush:.4g} m (remaining length below "
+             f"{crit.unstable_length:.4g} m of E16 + E19 = {full_length(p):.4g} m)")
+    return (f"{_fmt(p.delta)} is stable for the OBR chain under the {integrator} scheme, but "
+            f"not for the mitigator's unloading spring (E13, E31, E16, E19) while it unloads "
+            f"{where}: that needs a step below {_fmt(crit.dt_unloading)} at full length, "
+            f"{_fmt(crit.dt_compacted)} fully compacted")
 
 
-def crush_reached(result, crit, integrator="legacy"):
-    """The error for a run whose largest crush passed the second tier's limit, or None."""
-    stats = result.history.stats
-    if crit.unstable_crush is None or stats is None or not (
-            stats.max_crush > crit.unstable_crush):
+def unloading_diverged(result, crit, integrator="legacy"):
+    """The error for a run whose unloading spring diverged (:mod:`airgun_xl.engine.watch`),
+    naming the row; None when it did not (or cannot: the step is stable unloading)."""
+    from ..engine.watch import DIVERGING_STEPS, unloading_divergence
+
+    if crit.unstable_length is None:
         return None
-    return Finding("error", "E2", unstable_crush_message(result.params, crit, integrator)
-                   + f"; the run crushed it by {stats.max_crush:.4g} m, where the step is "
-                   "unstable and its numbers are not to be trusted")
+    k = unloading_divergence(result.history)
+    if k is None:
+        return None
+    return Finding("error", "E2", f"the run diverges at row {k + 2:,} (t = "
+                   f"{result.history.time[k] * 1e3:.4g} ms): while the mitigator unloads, its "
+                   f"deflection has oscillated with growing amplitude, alternating every step, "
+                   f"for {DIVERGING_STEPS} steps; "
+                   + unloading_limit(result.params, crit, integrator))
 
 
 def impact_speed_finding(p):
@@ -158,4 +165,26 @@ def after_run(result):
                              f"{p.mmitigator:.4g} kg: more mass than the MEM can give"))
     if not math.isfinite(result.peak_kg):
         found.append(Finding("warning", "E6", "no acceleration rows: the run is too short"))
+    found += quirk_findings(result)
+    if stats.max_crush > length:
+        found.append(Finding("warning", "E19", f"the mitigator is crushed by "
+                             f"{stats.max_crush:.4g} m, more than its length E16 + E19 = "
+                             f"{length:.4g} m: the final length {length - stats.max_crush:.4g} m "
+                             "is negative, which no real mitigator reaches"))
+    return found
+
+
+def quirk_findings(result):
+    """The macro's quirks a run met, named (:mod:`airgun_xl.engine.watch`)."""
+    from ..engine.watch import unloading_quirk
+
+    p, stats, found = result.params, result.history.stats, []
+    quirk = unloading_quirk(result.history) if p.unloading == "macro" else None
+    if quirk is not None:
+        found.append(Finding("warning", "E31", str(quirk)))
+    if stats is not None and stats.past_bound is not None:
+        found.append(Finding("warning", "E2", f"from row {stats.past_bound + 2:,} the "
+                             "displacements pass what any physical run reaches (the unloading "
+                             "quirk's force): the run goes on as the macro's does, and its "
+                             "figures are not to be trusted"))
     return found

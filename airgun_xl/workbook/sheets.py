@@ -147,6 +147,13 @@ DISPLAY = {
 }
 
 
+def variant_name(result):
+    """How a compared run is named: its model, or its unloading force."""
+    if result.params.unloading == "continuous":
+        return "continuous unloading"
+    return f"{result.model} model"
+
+
 def _summary_rows(result, summary, timings):
     """(label, value in SI, unit code of :data:`DISPLAY`, definition) per Summary row."""
     p = result.params
@@ -182,9 +189,12 @@ def _summary_rows(result, summary, timings):
                          if i == 0 and label == "initial" else ""))
     compared = timings.get("compared")
     if compared is not None:
-        rows += [(f"Peak acceleration, {compared.model} model", compared.peak_kg, "kG",
+        name = variant_name(compared)
+        rows += [(f"Peak acceleration, {name}", compared.peak_kg, "kG",
+                  "the same shot without the macro's unloading quirk (--unloading "
+                  "continuous)" if compared.params.unloading == "continuous" else
                   "the same shot with the other model"),
-                 (f"Time of peak, {compared.model} model", compared.time_of_peak, "s", "")]
+                 (f"Time of peak, {name}", compared.time_of_peak, "s", "")]
     rows += [
         ("Model", p.model + (" - the rigid-body model" if result.model == "rigid" else ""),
          "", ""),
@@ -243,6 +253,27 @@ def write_summary(wb, result, summary, timings, name="Summary"):
             ws.write_string(row, 2, unit)
         if note:
             ws.write_string(row, 3, note)
-    one_page(ws, len(rows), 3)
+    last = write_warnings(wb, ws, len(rows) + 2, timings.get("warnings", []), 3)
+    one_page(ws, last, 3)
     ws.freeze_panes(1, 0)
     return ws
+
+
+#: Characters a line of a merged warning row holds, across the Summary's printed width.
+WARNING_LINE_CHARS = 130
+
+
+def write_warnings(wb, ws, row, warnings, last_col):
+    """The run's warnings from ``row`` down, each across columns 0..``last_col`` with its text
+    wrapped, under a bold heading that counts them; returns the last row written. Every
+    warning the terminal showed is on the printed page."""
+    bold = wb.add_format({"bold": True, "font_color": "#9C0006" if warnings else "#000000"})
+    wrap = wb.add_format({"text_wrap": True, "valign": "top"})
+    ws.write_string(row, 0, f"Warnings ({len(warnings)})" if warnings else
+                    "Warnings: none", bold)
+    for i, text in enumerate(warnings, 1):
+        ws.merge_range(row + i, 0, row + i, last_col, "", wrap)
+        ws.write_string(row + i, 0, text, wrap)
+        lines = -(-len(text) // WARNING_LINE_CHARS)
+        ws.set_row(row + i, 15 * max(1, lines))
+    return row + len(warnings)

@@ -49,6 +49,7 @@ from .safe_text import (
 )
 from .sheets import (
     Ref,
+    variant_name,
     write_chart_data,
     write_number_columns,
     write_spectrum,
@@ -344,8 +345,10 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
                                   budget=len(keep))  # --every N thins the copies too
         labels = None
         if compared is not None:
-            labels = {"compared_kg": f"Acceleration, {compared.model} model",
-                      "accel_kg": f"Acceleration, {result.model} model"}
+            labels = {"compared_kg": f"Acceleration, {variant_name(compared)}",
+                      "accel_kg": "Acceleration, the macro's unloading (quirk)"
+                      if compared.params.unloading == "continuous" else
+                      f"Acceleration, {variant_name(result)}"}
         add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]), labels)
     if source is not None and source.outputs_block:
         outputs_ws = wb.add_worksheet(names[SHEET_NAME], worksheet_class=ColumnsWorksheet)
