@@ -171,6 +171,7 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
     summary = summarize(result) if needs_summary else None
     info = {"version": __version__, "command": " ".join(options.command), "warnings": record,
             "dt_crit": crit.dt_crit, "dt_compacted": crit.dt_compacted,
+            "dt_unloading": crit.dt_unloading,
             "dt_ratio": crit.ratio, "compared": compared}
     if shot.source is not None:
         info.update(input=str(shot.source.path), sha256=shot.source.sha256)

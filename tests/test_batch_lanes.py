@@ -2,6 +2,7 @@
 selects); every lane equals the single-shot kernel bit for bit, on the legacy cases and on
 random batches, and a lane that diverges stops alone."""
 import json
+import zlib
 
 import numpy as np
 import pytest
@@ -46,12 +47,15 @@ def _random_shots(seed, n, base=SHOT_A):
 def test_each_legacy_case_in_a_batch_equals_its_single_shot_run(name):
     """The case in lane 3 of a batch of 11 (its neighbours differ), against legacy_kernel."""
     p = airgun_xl.load(REFERENCE / name).params
-    others = _random_shots(hash(name) % 1000, 10, base=p)
+    others = _random_shots(zlib.crc32(name.encode()) % 1000, 10, base=p)  # fixed, not hash()
     _, y, finals = _batch(others[:3] + [p] + others[3:], last=p.bird_masses)
     try:
         solo = run_legacy(p, track=())
     except airgun_xl.DivergenceError as caught:  # chain_just_unstable: it stops at that row
         assert finals[3, 2] == caught.row
+        return
+    if solo.stats.past_bound is not None:  # the unloading quirk's run: the lane stops there
+        assert finals[3, 2] == solo.stats.past_bound
         return
     assert np.array_equal(y[3], (solo.y31, solo.y32, solo.y33)[p.bird_masses - 1])
     assert (finals[3, 0], finals[3, 1], finals[3, 2]) == (solo.final_m1, solo.final_m31, -1)

@@ -37,6 +37,14 @@ class KernelStats:
     past_bound: int = None  # first row index past displacement_bound (the quirk's run), or None
 
 
+def _chain_stable(p, integrator):
+    """Whether the OBR chain is stable at the shot's step (an unstable chain oscillates its
+    way through loading and unloading, and no quirk is to blame)."""
+    from .stability import critical_time_step
+
+    return critical_time_step(p, chain=integrator == "legacy").ratio <= 1
+
+
 def divergence_error(integrator, p, row, arrays):
     """The :class:`~airgun_xl.errors.DivergenceError` for a run stopped at ``row``; when the
     macro's unloading-force quirk fired before it, the quirk is named as the cause."""
@@ -51,7 +59,7 @@ def divergence_error(integrator, p, row, arrays):
              f"{names[worst]} = {values[worst]:.3g} m, beyond the {displacement_bound(p):.3g} m "
              "no physical run reaches")
     quirk = (unloading_quirk(History(*arrays, np.nan, np.nan, 0.0), stop=row)
-             if p.unloading == "macro" else None)
+             if p.unloading == "macro" and _chain_stable(p, integrator) else None)
     if quirk is not None:
         return DivergenceError(
             f"{where}; the cause is {quirk}; expected --unloading continuous (the same shot "

@@ -203,12 +203,16 @@ def _summary_rows(result, summary, timings):
          f"fitted, {p.crush_law.v_range[0]:.4g} to {p.crush_law.v_range[1]:.4g} m/s",
          "", "" if p.crush_law.is_legacy else "the Crush law sheet (airgun-xl calibrate)"),
         ("Time step", p.delta, "step", "E2"),
-        ("Critical time step", timings.get("dt_crit"), "step",
-         "largest step stable from the first step, mitigator at full length (airgun-xl "
-         "check)"),
+        ("Critical time step", timings.get("dt_crit")
+         if timings.get("dt_crit") != float("inf") else "none: implicit in the OBR chain",
+         "step", "largest step stable for the OBR chain, the springs that always act "
+         "(airgun-xl check)"),
+        ("Critical time step, unloading", timings.get("dt_unloading"), "step",
+         "largest step stable while the mitigator unloads at full length"),
         ("Critical time step, compacted", timings.get("dt_compacted"), "step",
-         "largest step stable with the mitigator fully compacted"),
-        ("Time step / critical", timings.get("dt_ratio"), "ratio", "above 1 the run diverges"),
+         "largest step stable while the mitigator unloads fully compacted"),
+        ("Time step / critical", timings.get("dt_ratio"), "ratio",
+         "above 1 the run diverges from its first steps"),
         ("Rows", result.rows, "count", "time rows of the run"),
         ("Rows on the sheets", timings.get("sheet_rows"), "count", ""),
         ("Every N-th row", timings.get("every"), "count", "1: every row is on the sheets"),
