@@ -3,7 +3,7 @@ stretched past what it was built for. Each finding names the cell that causes it
 import math
 from dataclasses import dataclass
 
-from ..cells import BY_ADDRESS
+from ..cells import BY_ADDRESS, CELLS
 from ..engine.stability import WARN_RATIO, critical_time_step, full_length
 
 #: Bird masses differing by this factor or more make a stiff, badly scaled system.
@@ -136,7 +136,33 @@ def before_run(p, integrator="legacy"):
                              "mass: a stiff, badly scaled system (see the critical time step)"))
     if p.zeta == 0:
         found.append(Finding("note", "E43", "zeta = 0: the OBR chain is undamped"))
+    found += plausibility(p)
+    if p.bird_masses < 3:
+        cells = "D2 and C6 are" if p.bird_masses == 2 else "C2, D2, B6 and C6 are"
+        found.append(Finding("warning", "D2" if p.bird_masses == 2 else "C2",
+                             f"{cells} blank: airgun-xl runs the {p.model.split(' (')[0]} "
+                             "model, where the macro itself stops with 'Division by zero', so "
+                             "there is no legacy output to compare with"))
     return crit, found
+
+
+def plausibility(p):
+    """A warning for each cell whose non-zero value lies outside the magnitudes of a real air
+    gun shot (:data:`airgun_xl.cells.CELLS`, ``plausible``): a value in another unit, such as
+    E40 typed in psi, or a slip of a few orders of magnitude."""
+    found = []
+    for cell in CELLS:
+        value = getattr(p, cell.name)
+        if not cell.plausible or value == 0:
+            continue
+        lo, hi = cell.plausible
+        if not lo <= abs(value) <= hi:
+            side = "below" if abs(value) < lo else "above"
+            found.append(Finding("warning", cell.address, f"{value:.4g} {cell.unit} is {side} "
+                                 f"the {lo:g}..{hi:g} {cell.unit} of a real shot's "
+                                 f"{cell.meaning.split(',')[0]}: an implausible order of "
+                                 "magnitude (a value in another unit?)"))
+    return found
 
 
 def after_run(result):

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import limits
-from ..cells import CELLS, PARAMETER_COLUMNS, TIME_HEADER
+from ..cells import BY_ADDRESS, CELLS, PARAMETER_COLUMNS, TIME_HEADER, UNUSED_K1
 from ..errors import AirgunXlError, CellError, WorkbookError
 from ..params import Found, ShotParams, describe
 from . import guard
@@ -179,6 +179,7 @@ def _read_xls(path, data):
 
 
 def _address(cell):
+    """(row, column), 1-based, of a cell of the map."""
     from openpyxl.utils.cell import coordinate_to_tuple
 
     return coordinate_to_tuple(cell.address)
@@ -273,6 +274,11 @@ def read_params(path):
     source = read_source(path)
     check_time_header(source)
     raw, warnings = parameter_values(source)
+    k1 = source.block.get(_address(BY_ADDRESS[UNUSED_K1]), (None, None))
+    if k1[0] not in (None, "") or k1[1] is not None:
+        warnings.append(f"{UNUSED_K1} (K1): holds {describe(k1[0])}, which the macro never "
+                        "reads (it computes k1 from E13, E31, E16 and E19): this value has no "
+                        "effect on the run")
     params = ShotParams.from_cells(raw)
     if source.law_block is not None:
         params = params.replace(crush_law=law_from_cells(source.law_block))

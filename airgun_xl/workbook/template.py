@@ -30,7 +30,9 @@ CELLS = (
     ("A2", 680.388555), ("B2", 4.8761179775), ("C2", 5.488467677), ("D2", 5.5111472955),
     ("E2", 5e-07),
     ("A5", "K1"), ("B5", "K2"), ("C5", "K3"), ("E5", "Max Time"),
-    ("A6", -2.00e8), ("B6", -6.084e9), ("C6", -1.2084e10), ("E6", 0.006),
+    ("B6", -6.084e9), ("C6", -1.2084e10), ("E6", 0.006),
+    # K1 (A6, -2e8 on the report's page) is left blank: the macro never reads it
+    ("A7", "K1 (A6) is not used: the macro computes k1 from E13, E31, E16, E19"),
     ("E9", "Density of Honeycomb"),
     ("A10", "Mass Matrix"), ("E10", 385),
     ("A11", "=A2+E25"), ("B11", 0), ("C11", 0), ("D11", 0),
