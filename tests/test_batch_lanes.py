@@ -9,6 +9,7 @@ import pytest
 from conftest import CASES, REFERENCE
 
 import airgun_xl
+from airgun_xl.engine.batch import N_FINALS
 from airgun_xl.engine.integrators import displacement_bound, kernel_params, run_legacy
 
 compiled = pytest.importorskip("airgun_xl.engine._artsim")
@@ -21,7 +22,7 @@ SHOT_A = airgun_xl.load(REFERENCE / CASES["shot_a_appendix_5us"]["input"]).param
 def _batch(shots, lanes=True, last=3):
     rows = shots[0].rows
     matrix = np.array([kernel_params(p) + [displacement_bound(p)] for p in shots])
-    t, y, finals = np.empty(rows), np.empty((len(shots), rows)), np.empty((len(shots), 8))
+    t, y, finals = np.empty(rows), np.empty((len(shots), rows)), np.empty((len(shots), N_FINALS))
     compiled.batch_kernel(matrix, rows, 0, last, t, y, finals, lanes)
     return t, y, finals
 

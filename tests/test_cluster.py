@@ -32,7 +32,7 @@ def _shots(n, **changes):
 
 def _same(a, b):
     return np.array_equal(a.figures, b.figures, equal_nan=True) and np.array_equal(
-        a.diverged, b.diverged)
+        a.diverged, b.diverged) and a.stats == b.stats  # the flags' statistics come back too
 
 
 @pytest.mark.parametrize("chunk", [1, 7, 64, 1000])

@@ -16,6 +16,7 @@ from conftest import (
 
 import airgun_xl
 from airgun_xl.engine import _reference as ref
+from airgun_xl.engine.batch import N_FINALS
 from airgun_xl.engine.integrators import displacement_bound, kernel_params
 
 compiled = pytest.importorskip("airgun_xl.engine._artsim")
@@ -66,7 +67,7 @@ def test_batch_bit_for_bit(integrator):
     matrix = np.array([kernel_params(p) + [displacement_bound(p)] for p in shots])
     results = []
     for module in (compiled, ref):
-        t, y, finals = np.empty(base.rows), np.empty((3, base.rows)), np.empty((3, 8))
+        t, y, finals = np.empty(base.rows), np.empty((3, base.rows)), np.empty((3, N_FINALS))
         module.batch_kernel(matrix, base.rows, integrator, 3, t, y, finals)
         results.append((t, y, finals))
     for x, z in zip(*results):

@@ -53,6 +53,13 @@ def test_indices_rank_the_inputs_of_shot_a(tmp_path, capsys):
         charts = [z.read(n).decode() for n in z.namelist() if n.startswith("xl/charts/chart")]
     bars = [c for c in charts if "Sobol indices" in c]
     assert len(bars) == 3 and all("<c:errBars>" in c for c in bars)
+    # issue 18.6: the error bars point at the +/- cells (columns C and E of each block), not
+    # literal numbers; the peak's block is rows 4-6 of the sheet
+    peak = next(c for c in bars if "Peak acceleration" in c)
+    for column in ("C", "E"):
+        ref = f"<c:f>'Sensitivity'!${column}$4:${column}$6</c:f>"
+        assert peak.count(ref) == 2, column  # plus and minus
+    assert "<c:numLit>" not in peak
     assert "Sobol indices of the peak: E40 S1" in capsys.readouterr().out
 
 

@@ -140,3 +140,16 @@ def test_chain_unstable_is_still_refused_first(capsys, tmp_path):
     case = json.loads((REFERENCE / "unstable_cases.json").read_text())["chain_just_unstable"]
     assert main(["fill", str(REFERENCE / case["input"]), "-o", str(tmp_path / "o.xlsx")]) == 2
     assert "set by the OBR chain's stiffest mode" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_kernel_counts_the_onsets_the_watch_finds(name):
+    """The kernel's own count of unloading phases and the row of the second (for sweeps, whose
+    batch keeps no deflection column) equal what the watch reads from the columns."""
+    try:
+        h = airgun_xl.load(REFERENCE / CASES[name]["input"]).run().history
+    except airgun_xl.AirgunXlError:
+        return
+    onsets = unloading_onsets(h.deflection)
+    assert h.stats.unloading_onsets == len(onsets)
+    assert h.stats.second_onset == (onsets[1] if len(onsets) > 1 else -1)

@@ -115,6 +115,13 @@ def run(args):
           f"{int(result.invalid.sum())} invalid")
     print(f"  peak {stats['mean']:.4f} kG mean, sd {stats['sd']:.4f}, 5-95% "
           f"{stats['p5']:.4f}-{stats['p95']:.4f} kG")
+    flagged, cells = result.flagged()
+    if flagged:
+        from . import warn
+
+        warn([f"{flagged:,} of {total:,} shots have warnings, naming "
+              + ", ".join(f"{cell} ({n:,} shots)" for cell, n in sorted(cells.items()))
+              + f": see the Warnings column and sheet of {output}"])
     if sensitivity is not None:
         found = sensitivity.indices["peak_kg"]
         print("  Sobol indices of the peak: " + ", ".join(

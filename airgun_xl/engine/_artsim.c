@@ -16,7 +16,8 @@
  *     the other arguments: writable, C-contiguous float64 buffers of length >= rows. The
  *     tracked columns from crush on may be None: they are then neither computed nor stored.
  *     Returns (final M1, final m31, first diverged row or -1, final x_plastic, max and min
- *     relative velocity while loading, largest crushed mass). The GIL is released while
+ *     relative velocity while loading, largest crushed mass, largest deflection, unloading
+ *     phases begun, row index of the second or -1). The GIL is released while
  *     stepping, which stops at the first row whose displacement is not finite or passes
  *     params[21], the bound no physical run exceeds.
  *   newmark_kernel(...): the same, with the average-acceleration Newmark scheme.
@@ -59,8 +60,9 @@ static double crush_factor_poly(const double *c, double Vobr)
 typedef struct {
     double M1, m31, vcone, xPlastic, maxmitdef, mitigatordeflection, forceCounter, dforce;
     double Force, crushFactor;
-    /* statistics for the checks (not in the macro) */
-    double max_Vobr, min_Vobr, max_temp;
+    /* statistics for the checks (not in the macro): the unloading phases begun, the step of
+     * the second (where the macro's force jumps) or -1, the step now, and the last branch */
+    double max_Vobr, min_Vobr, max_temp, onsets, second_onset, step, was_unloading;
 } Mitigator;
 
 static void mitigator_start(Mitigator *s, const double *p)
@@ -74,6 +76,10 @@ static void mitigator_start(Mitigator *s, const double *p)
     s->max_Vobr = -INFINITY;
     s->min_Vobr = INFINITY;
     s->max_temp = 0;
+    s->onsets = 0;
+    s->second_onset = -1;
+    s->step = 1; /* the first call is step (row index) 2 */
+    s->was_unloading = 0;
 }
 
 /* One step of the mitigator force law, from the MEM and OBR front plate positions now (y1,
@@ -91,6 +97,13 @@ static double mitigator_force(Mitigator *s, const double *p, double y1, double y
     if (cPlastic >= 0)
         s->xPlastic = s->xPlastic + (cPlastic * delta);
     s->mitigatordeflection = y31 - y1;
+    s->step = s->step + 1;
+    if (s->mitigatordeflection < s->maxmitdef && s->was_unloading == 0) {
+        s->onsets = s->onsets + 1;
+        if (s->onsets == 2)
+            s->second_onset = s->step;
+    }
+    s->was_unloading = s->mitigatordeflection < s->maxmitdef;
     if (s->mitigatordeflection < s->maxmitdef) {
         /* Unloading: elastic over the full area; the masses stay frozen. */
         Area = PI_MACRO * rcone * rcone;
@@ -184,9 +197,11 @@ static void finish_run(const Mitigator *s, Py_ssize_t bad, double *out)
     out[5] = s->min_Vobr;
     out[6] = s->max_temp;
     out[7] = s->maxmitdef; /* the largest deflection: the maximum crush */
+    out[8] = s->onsets;
+    out[9] = s->second_onset;
 }
 
-#define N_FINALS 8
+#define N_FINALS 10
 
 /* ArtSim's scheme: central differences with backward-difference damping velocities. */
 static void legacy_steps(const double *p, Py_ssize_t rows, Columns c, double *out)
@@ -361,8 +376,8 @@ static PyObject *run_kernel(PyObject *args, Stepper steps)
     for (i = 0; i < N_COLUMNS; i++)
         if (views[i].obj != NULL)
             PyBuffer_Release(&views[i]);
-    return Py_BuildValue("ddnddddd", finals[0], finals[1], (Py_ssize_t)finals[2], finals[3],
-                         finals[4], finals[5], finals[6], finals[7]);
+    return Py_BuildValue("ddnddddddd", finals[0], finals[1], (Py_ssize_t)finals[2], finals[3],
+                         finals[4], finals[5], finals[6], finals[7], finals[8], finals[9]);
 fail:
     for (i = 0; i < got; i++)
         if (views[i].obj != NULL)
@@ -413,6 +428,7 @@ typedef struct {
     double y33[LANES], yn33[LANES];
     double M1[LANES], m31[LANES], vcone[LANES], xP[LANES], maxdef[LANES], defl[LANES];
     double fcount[LANES], dforce[LANES], maxV[LANES], minV[LANES], maxT[LANES];
+    double wasU[LANES], ons[LANES], second[LANES], step; /* statistics, as Mitigator's */
     double ny1[LANES], ny31[LANES], ny32[LANES], ny33[LANES];
 } LaneState;
 
@@ -420,6 +436,7 @@ typedef struct {
 LANE_CLONES static void lane_step(const LaneParams *restrict q, LaneState *restrict s)
 {
     int i;
+    s->step = s->step + 1;
 #pragma GCC ivdep
     for (i = 0; i < LANES; i++) {
         double y1 = s->y1[i], yn1 = s->yn1[i], y31 = s->y31[i], yn31 = s->yn31[i];
@@ -436,6 +453,7 @@ LANE_CLONES static void lane_step(const LaneParams *restrict q, LaneState *restr
         double AreaFull = PI_MACRO * q->rcone[i] * q->rcone[i];
         double k1 = -((AreaFull * q->E[i]) / (L));
         int first = unload & (s->fcount[i] == 0);
+        int onset = unload & (s->wasU[i] == 0);
         double Ffirst = -k1 * (d - hcone);
         double dfFirst = Ffirst - s->dforce[i];
         double dfu = first ? dfFirst : s->dforce[i];
@@ -469,6 +487,9 @@ LANE_CLONES static void lane_step(const LaneParams *restrict q, LaneState *restr
         s->xP[i] = xPn;
         s->defl[i] = d;
         s->fcount[i] = first ? 0 + 1 : (loading & (q->unload[i] != 0)) ? 0 : s->fcount[i];
+        s->ons[i] = onset ? s->ons[i] + 1 : s->ons[i];
+        s->second[i] = (onset & (s->ons[i] == 2)) ? s->step : s->second[i];
+        s->wasU[i] = unload;
         s->dforce[i] = unload ? dfu : Fl;
         s->maxdef[i] = unload ? s->maxdef[i] : d;
         s->vcone[i] = (loading & wedge) ? tw : s->vcone[i];
@@ -492,6 +513,7 @@ static void lane_finals(const LaneState *s, int i, Py_ssize_t bad, double *f)
 {
     f[0] = s->M1[i]; f[1] = s->m31[i]; f[2] = (double)bad; f[3] = s->xP[i];
     f[4] = s->maxV[i]; f[5] = s->minV[i]; f[6] = s->maxT[i]; f[7] = s->maxdef[i];
+    f[8] = s->ons[i]; f[9] = s->second[i];
 }
 
 static void legacy_lanes(const double *params, int n, Py_ssize_t rows, double **out_rows,
@@ -518,6 +540,7 @@ static void legacy_lanes(const double *params, int n, Py_ssize_t rows, double **
         s.vcone[i] = p[P_VCONE];
         s.xP[i] = s.maxdef[i] = s.defl[i] = s.fcount[i] = s.dforce[i] = 0;
         s.maxV[i] = -INFINITY; s.minV[i] = INFINITY; s.maxT[i] = 0;
+        s.wasU[i] = 0; s.ons[i] = 0; s.second[i] = -1;
         q.c2[i] = 2 * p[P_ZETA] * sqrt(-p[P_K2] * (s.m31[i] + p[P_M32]));
         q.c3[i] = 2 * p[P_ZETA] * sqrt(-p[P_K3] * (p[P_M32] + p[P_M33]));
         s.yn1[i] = -p[P_DELTA] * p[P_V1]; s.yn31[i] = -p[P_DELTA] * p[P_V31];
@@ -525,6 +548,7 @@ static void legacy_lanes(const double *params, int n, Py_ssize_t rows, double **
         s.y1[i] = s.y31[i] = s.y32[i] = s.y33[i] = 0;
         alive[i] = i < n;
     }
+    s.step = 1; /* the first lane_step is step (row index) 2 */
     for (i = 0; i < n; i++) {
         if (rows > 0) out_rows[i][0] = last == 1 ? s.yn31[i] : last == 2 ? s.yn32[i] : s.yn33[i];
         if (rows > 1) out_rows[i][1] = 0;

@@ -20,7 +20,7 @@ PI_MACRO = 3.141592653
  P_VCONE, P_E, P_EC, P_SIGMAY, P_ZETA, P_V1, P_V31, P_V32, P_V33, P_LAW0, P_LAW1, P_LAW2,
  P_LAW3, P_LAW4, P_LAW5, P_LAW6, P_UNLOAD, P_BOUND) = range(30)
 P_COUNT = 30
-N_FINALS = 8
+N_FINALS = 10
 
 
 def _div(a, b):
@@ -47,7 +47,7 @@ class Mitigator:
 
     __slots__ = ("M1", "m31", "vcone", "xPlastic", "maxmitdef", "mitigatordeflection",
                  "forceCounter", "dforce", "Force", "crushFactor", "max_Vobr", "min_Vobr",
-                 "max_temp")
+                 "max_temp", "onsets", "second_onset", "step", "was_unloading")
 
     def __init__(self, p):
         self.M1 = p[P_M1] + p[P_MMIT]
@@ -59,6 +59,7 @@ class Mitigator:
         self.max_Vobr = -math.inf
         self.min_Vobr = math.inf
         self.max_temp = 0.0
+        self.onsets, self.second_onset, self.step, self.was_unloading = 0.0, -1.0, 1.0, False
 
     def force(self, p, y1, yn1, y31, yn31):
         """One step of the force law (the macro's loop body down to "If (Force < 0)")."""
@@ -69,6 +70,12 @@ class Mitigator:
         if cPlastic >= 0:  # the front advances only on a non-negative increment
             self.xPlastic = self.xPlastic + (cPlastic * delta)
         self.mitigatordeflection = y31 - y1
+        self.step += 1
+        if self.mitigatordeflection < self.maxmitdef and not self.was_unloading:
+            self.onsets += 1  # an unloading phase begins (statistics, not in the macro)
+            if self.onsets == 2:
+                self.second_onset = self.step
+        self.was_unloading = self.mitigatordeflection < self.maxmitdef
         if self.mitigatordeflection < self.maxmitdef:
             # unloading: elastic over the full area; the masses stay frozen
             Area = PI_MACRO * rcone * rcone
@@ -112,7 +119,7 @@ class Mitigator:
 
     def finals(self, bad):
         return [self.M1, self.m31, float(bad), self.xPlastic, self.max_Vobr, self.min_Vobr,
-                self.max_temp, self.maxmitdef]
+                self.max_temp, self.maxmitdef, self.onsets, self.second_onset]
 
 
 class _Rows:

@@ -12,7 +12,7 @@ import numpy as np
 
 from .derived import KG_DIVISOR
 from .filtered import filter_stencils, filtered_values
-from .integrators import displacement_bound, kernel_params
+from .integrators import KernelStats, displacement_bound, kernel_params
 from .kernel import batch_kernel
 from .summary import KG, PULSE_FRACTION
 
@@ -20,6 +20,7 @@ from .summary import KG, PULSE_FRACTION
 FIGURES = ("peak_kg", "time_of_peak", "filtered_peak_kg", "pulse_duration", "max_crush")
 
 _INTEGRATOR_ID = {"legacy": 0, "newmark": 1}
+N_FINALS = 10  # the kernel's finals a shot (_artsim.c, finish_run)
 BLOCK = 128  # shots a block: bounds memory at rows x 128 doubles (12 MB for shot A)
 
 
@@ -30,6 +31,7 @@ class Batch:
 
     figures: np.ndarray
     diverged: np.ndarray
+    stats: list = None  # each shot's KernelStats (None where it diverged)
 
     def column(self, name):
         return self.figures[:, FIGURES.index(name)]
@@ -54,6 +56,7 @@ def run_batch(params, integrator="legacy", host="excel", threads=2, progress=Non
     n = len(params)
     figures = np.full((n, len(FIGURES)), np.nan)
     diverged = np.zeros(n, dtype=bool)
+    stats = [None] * n
     groups = {}
     for i, p in enumerate(params):
         groups.setdefault(_grid_key(p), []).append(i)
@@ -64,15 +67,24 @@ def run_batch(params, integrator="legacy", host="excel", threads=2, progress=Non
             stencils = filter_stencils(first.rows, first.samplerate, host)
             for start in range(0, len(indices), BLOCK):
                 block = indices[start:start + BLOCK]
-                figs, bad = _run_block([params[i] for i in block], integrator, stencils, pool)
+                figs, bad, finals = _run_block([params[i] for i in block], integrator,
+                                               stencils, pool)
                 figures[block] = figs
                 diverged[block] = bad
+                for i, row, stopped in zip(block, finals, bad, strict=True):
+                    stats[i] = None if stopped else kernel_stats(row)
                 if progress is not None:
                     progress(len(block))
     finally:
         if pool is not None:
             pool.shutdown()
-    return Batch(figures, diverged)
+    return Batch(figures, diverged, stats)
+
+
+def kernel_stats(finals):
+    """The :class:`~airgun_xl.engine.integrators.KernelStats` of one shot's finals row."""
+    return KernelStats(float(finals[3]), float(finals[4]), float(finals[5]), float(finals[6]),
+                       float(finals[7]), None, int(finals[8]), int(finals[9]))
 
 
 def _run_block(block, integrator, stencils, pool):
@@ -84,14 +96,14 @@ def _run_block(block, integrator, stencils, pool):
     def work(half):  # kernel and figures of half the block, on one thread
         a, b = half
         y = np.empty((b - a, rows))
-        finals = np.empty((b - a, 8))
+        finals = np.empty((b - a, N_FINALS))
         t = np.empty(rows)
         batch_kernel(matrix[a:b], rows, _INTEGRATOR_ID[integrator], p0.bird_masses, t, y,
                      finals)
-        return _figures(y, t, finals, p0, stencils)
+        return (*_figures(y, t, finals, p0, stencils), finals)
 
     parts = list(pool.map(work, halves)) if len(halves) > 1 else [work(halves[0])]
-    return (np.concatenate([f for f, _ in parts]), np.concatenate([b for _, b in parts]))
+    return tuple(np.concatenate([part[j] for part in parts]) for j in range(3))
 
 
 def _figures(y, t, finals, p0, stencils):

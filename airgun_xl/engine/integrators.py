@@ -35,6 +35,8 @@ class KernelStats:
     max_crushed_mass: float
     max_crush: float
     past_bound: int = None  # first row index past displacement_bound (the quirk's run), or None
+    unloading_onsets: int = 0  # unloading phases begun
+    second_onset: int = -1  # row index of the second (where the macro's force jumps), or -1
 
 
 def _chain_stable(p, integrator):
@@ -146,8 +148,8 @@ def _run(kernel, name, p, track):
         np.full(rows, np.nan) if key in track else None for key in TRACKED]
     values = kernel_params(p) + [displacement_bound(p)]
     started = time.perf_counter()
-    final_m1, final_m31, bad, x_plastic, max_v, min_v, max_crushed, max_crush = kernel(
-        values, rows, *arrays)
+    (final_m1, final_m31, bad, x_plastic, max_v, min_v, max_crushed, max_crush, onsets,
+     second) = kernel(values, rows, *arrays)
     elapsed = time.perf_counter() - started
     if bad >= 0 and p.hcone == 0 and not x_plastic > 0:
         raise no_wedge_error(p, bad)
@@ -159,14 +161,15 @@ def _run(kernel, name, p, track):
         # the macro's quirk threw the run past the physical bound: run on as the macro
         # does, stopping only where a value stops being finite (the checks name the quirk)
         values[-1] = math.inf
-        final_m1, final_m31, bad, x_plastic, max_v, min_v, max_crushed, max_crush = kernel(
-            values, rows, *arrays)
+        (final_m1, final_m31, bad, x_plastic, max_v, min_v, max_crushed, max_crush, onsets,
+         second) = kernel(values, rows, *arrays)
         elapsed = time.perf_counter() - started
         if bad >= 0:
             raise divergence_error(name, p, bad, arrays)
         past_bound = error.row
     history = History(*arrays, final_m1, final_m31, elapsed)
-    history.stats = KernelStats(x_plastic, max_v, min_v, max_crushed, max_crush, past_bound)
+    history.stats = KernelStats(x_plastic, max_v, min_v, max_crushed, max_crush, past_bound,
+                                int(onsets), int(second))
     return blank_left_out(history, p)
 
 

@@ -168,9 +168,20 @@ def plausibility(p):
 def after_run(result):
     """Findings from what the kernel saw during the run."""
     p, stats = result.params, result.history.stats
-    found = []
     if stats is None:
-        return found
+        return []
+    found = stats_findings(p, stats, quirk=False)
+    if not math.isfinite(result.peak_kg):
+        found.append(Finding("warning", "E6", "no acceleration rows: the run is too short"))
+    return found + quirk_findings(result)
+
+
+def stats_findings(p, stats, quirk=True):
+    """Findings from the kernel's statistics of a run alone (what a sweep's batch keeps):
+    the crush law's range, a mitigator crushed past its end, more crushed mass than it has,
+    and, with ``quirk``, the unloading quirk's row (:func:`quirk_findings` says more from the
+    columns)."""
+    found = []
     lo, hi = p.crush_law.v_range
     said = p.v31 - p.v1 > hi  # before_run already warned about the impact speed
     if not said and (stats.max_relative_velocity > hi or stats.min_relative_velocity < lo):
@@ -189,15 +200,27 @@ def after_run(result):
         found.append(Finding("warning", "E25", f"the crushed honeycomb joining m31 reached "
                              f"{stats.max_crushed_mass:.4g} kg, more than the mitigator's "
                              f"{p.mmitigator:.4g} kg: more mass than the MEM can give"))
-    if not math.isfinite(result.peak_kg):
-        found.append(Finding("warning", "E6", "no acceleration rows: the run is too short"))
-    found += quirk_findings(result)
     if stats.max_crush > length:
         found.append(Finding("warning", "E19", f"the mitigator is crushed by "
                              f"{stats.max_crush:.4g} m, more than its length E16 + E19 = "
                              f"{length:.4g} m: the final length {length - stats.max_crush:.4g} m "
                              "is negative, which no real mitigator reaches"))
+    if quirk and p.unloading == "macro" and stats.second_onset >= 0:
+        found.append(Finding("warning", "E31", f"the macro's unloading-force quirk: the "
+                             f"mitigator unloads again after reloading at row "
+                             f"{stats.second_onset + 2:,}, where its force jumps; the figures "
+                             "follow the quirk, not the physics"))
     return found
+
+
+def shot_findings(p, stats):
+    """The warnings of one shot of a study, from its parameters and its kernel statistics
+    (no eigen-solve: a study's shots share the base shot's stability verdict)."""
+    found = plausibility(p)
+    speed = impact_speed_finding(p)
+    if speed is not None:
+        found.append(speed)
+    return found + stats_findings(p, stats)
 
 
 def quirk_findings(result):

@@ -23,11 +23,11 @@ CONNECT_TIMEOUT = "5s"
 
 def run_chunk(params, integrator, host):
     """One chunk on a worker: the batch kernel on one thread (the worker's threads run other
-    chunks); returns (figures, diverged) only."""
+    chunks); returns (figures, diverged, kernel statistics) only."""
     from ..engine.batch import run_batch
 
     batch = run_batch(params, integrator, host, threads=1)
-    return batch.figures, batch.diverged
+    return batch.figures, batch.diverged, batch.stats
 
 
 class ClusterRunner:
@@ -52,7 +52,7 @@ class ClusterRunner:
 
         params = list(params)
         if not params:
-            return Batch(np.zeros((0, len(FIGURES))), np.zeros(0, dtype=bool))
+            return Batch(np.zeros((0, len(FIGURES))), np.zeros(0, dtype=bool), [])
         starts = range(0, len(params), self.chunk)
         futures = [self.client.submit(run_chunk, params[i:i + self.chunk], integrator, host,
                                       pure=False) for i in starts]
@@ -64,8 +64,9 @@ class ClusterRunner:
             future.release()
             if progress is not None:
                 progress(min(self.chunk, len(params) - starts[n]))
-        return Batch(np.concatenate([f for f, _ in parts]),
-                     np.concatenate([d for _, d in parts]))
+        return Batch(np.concatenate([f for f, _, _ in parts]),
+                     np.concatenate([d for _, d, _ in parts]),
+                     [s for _, _, stats in parts for s in stats])
 
 
 def connect(scheduler=None, workers=None):

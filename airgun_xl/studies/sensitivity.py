@@ -14,7 +14,7 @@ import numpy as np
 
 from ..engine.batch import FIGURES
 from ..errors import OptionError
-from .sweep import SweepResult, _evaluate
+from .sweep import SweepResult, _evaluate, check_spreads
 
 #: The figures whose sensitivity is estimated (names of ``FIGURES``).
 SENSITIVITY_FIGURES = ("peak_kg", "pulse_duration", "max_crush")
@@ -76,11 +76,12 @@ def sobol(p, sds, n, seed=None, integrator="legacy", model="4-mass", progress=No
     if n < 2 or n & (n - 1):
         raise OptionError(f"--sobol: found {n}, expected a power of 2 (Sobol sequence), "
                           "such as 256")
+    check_spreads(p, sds)
     problem = _problem(p, sds)
     samples = sample.sample(problem, n, calc_second_order=False, seed=seed)
     varied = [(cell, fields) for cell, fields, _, _ in sds]
-    figures, diverged, invalid = _evaluate(p, varied, samples, integrator, model, progress,
-                                           runner)
+    figures, diverged, invalid, flags = _evaluate(p, varied, samples, integrator, model,
+                                                  progress, runner)
     bad = int(diverged.sum() + invalid.sum())
     if bad:
         raise OptionError(f"--sobol: {bad:,} of the {len(samples):,} sampled shots were not "
@@ -93,7 +94,7 @@ def sobol(p, sds, n, seed=None, integrator="legacy", model="4-mass", progress=No
                                 print_to_console=False)
         indices[name] = {k: np.asarray(found[k], dtype=float)
                          for k in ("S1", "S1_conf", "ST", "ST_conf")}
-    shots = SweepResult(problem["names"], samples, figures, diverged, invalid)
+    shots = SweepResult(problem["names"], samples, figures, diverged, invalid, flags)
     return Sensitivity(problem["names"], indices, shots)
 
 

@@ -11,6 +11,7 @@ from ..cells import BY_ADDRESS, CELLS
 from ..engine.batch import FIGURES, run_batch
 from ..errors import AirgunXlError, OptionError
 from ..models import apply_model
+from .check import shot_findings
 
 #: Cells whose value moves several fields: the bird's velocity goes to A28..A30 together.
 GROUPED = {"A28": ("v31", "v32", "v33")}
@@ -53,6 +54,23 @@ def parse_sd(text):
     return cell, fields, sd / 100 if match.group(3) else sd, bool(match.group(3))
 
 
+#: An absolute --sd below this fraction of its cell's value is refused: a percentage that lost
+#: its "%" (E40=3 is 3 Pa on 2.7e7 Pa), whose spread would be zero to every digit shown.
+SD_FLOOR = 1e-6
+
+
+def check_spreads(p, sds):
+    """Refuse an absolute deviation too small to move its cell (see :data:`SD_FLOOR`)."""
+    for cell, fields, sd, relative in sds:
+        mean = getattr(p, fields[0])
+        if not relative and 0 < sd < SD_FLOOR * abs(mean):
+            unit = BY_ADDRESS[cell].unit if cell in BY_ADDRESS else ""
+            raise OptionError(f"--sd: found {cell}={sd:g}, a deviation of {sd:g} {unit} on "
+                              f"{cell}'s {mean:.4g} {unit} ({sd / abs(mean):.2g} of it); "
+                              f"expected a percentage such as {cell}={sd:g}% or a deviation "
+                              f"in {unit or 'its unit'} of a size that moves it")
+
+
 @dataclass
 class SweepResult:
     cells: list  # the varied cells
@@ -60,6 +78,15 @@ class SweepResult:
     figures: np.ndarray  # shots x FIGURES
     diverged: np.ndarray
     invalid: np.ndarray  # shots whose sampled values were not a valid shot
+    flags: list = None  # each shot's warnings (str), as a fill of it would say them
+
+    def flagged(self):
+        """How many shots have a warning, and how often each cell is named: (n, {cell: n})."""
+        cells = {}
+        for found in self.flags or []:
+            for cell in sorted({text.split(" ", 1)[0] for text in found}):
+                cells[cell] = cells.get(cell, 0) + 1
+        return sum(1 for found in self.flags or [] if found), cells
 
 
 def _set(p, fields, value):
@@ -71,7 +98,7 @@ def _evaluate(p, varied, rows_values, integrator, model, progress, runner=None):
     for i, row in enumerate(rows_values):
         q = p
         try:
-            for (cell, fields), value in zip(varied, row):
+            for (cell, fields), value in zip(varied, row, strict=True):
                 q = _set(q, fields, value)
             params.append(apply_model(q, model))
         except AirgunXlError:
@@ -81,7 +108,10 @@ def _evaluate(p, varied, rows_values, integrator, model, progress, runner=None):
     diverged = np.zeros(len(rows_values), dtype=bool)
     figures[~invalid] = batch.figures
     diverged[~invalid] = batch.diverged
-    return figures, diverged, invalid
+    flags = [[] for _ in rows_values]
+    for i, q, stats in zip(np.flatnonzero(~invalid), params, batch.stats, strict=True):
+        flags[i] = ([] if stats is None else [str(f) for f in shot_findings(q, stats)])
+    return figures, diverged, invalid, flags
 
 
 def grid(p, varies, integrator="legacy", model="4-mass", progress=None, runner=None):
@@ -91,15 +121,16 @@ def grid(p, varies, integrator="legacy", model="4-mass", progress=None, runner=N
     default, or a :class:`~airgun_xl.studies.cluster.ClusterRunner`."""
     varied = [(cell, fields) for cell, fields, _ in varies]
     combos = np.array(list(itertools.product(*(v for _, _, v in varies))))
-    figures, diverged, invalid = _evaluate(p, varied, combos, integrator, model, progress,
-                                           runner)
-    return SweepResult([c for c, _ in varied], combos, figures, diverged, invalid)
+    figures, diverged, invalid, flags = _evaluate(p, varied, combos, integrator, model,
+                                                  progress, runner)
+    return SweepResult([c for c, _ in varied], combos, figures, diverged, invalid, flags)
 
 
 def monte_carlo(p, sds, n, seed=None, integrator="legacy", model="4-mass", progress=None,
                 runner=None):
     """``n`` shots with the ``sds`` cells drawn from normal distributions around the sheet's
     values (a draw that is not a valid shot, e.g. a negative mass, is counted as invalid)."""
+    check_spreads(p, sds)
     rng = np.random.default_rng(seed)
     columns = []
     for cell, fields, sd, relative in sds:
@@ -107,9 +138,9 @@ def monte_carlo(p, sds, n, seed=None, integrator="legacy", model="4-mass", progr
         columns.append(rng.normal(mean, sd * abs(mean) if relative else sd, n))
     samples = np.column_stack(columns) if columns else np.zeros((n, 0))
     varied = [(cell, fields) for cell, fields, _, _ in sds]
-    figures, diverged, invalid = _evaluate(p, varied, samples, integrator, model, progress,
-                                           runner)
-    return SweepResult([c for c, _ in varied], samples, figures, diverged, invalid)
+    figures, diverged, invalid, flags = _evaluate(p, varied, samples, integrator, model,
+                                                  progress, runner)
+    return SweepResult([c for c, _ in varied], samples, figures, diverged, invalid, flags)
 
 
 def spread(values):

@@ -1,6 +1,7 @@
 """The sweep workbook: one row a shot, charts of the peak against each varied parameter, and
 for a Monte Carlo the spread and a histogram."""
 import numpy as np
+from xlsxwriter.utility import xl_range_abs
 
 from ..cells import BY_ADDRESS
 from ..engine.batch import FIGURES
@@ -31,16 +32,24 @@ def write_sweep(result, path, force, stats=None, sensitivity=None):
         ws = wb.add_worksheet("Sweep", worksheet_class=ColumnsWorksheet)
         bold = wb.add_format({"bold": True})
         headers = ([_label(c) for c in result.cells]
-                   + [FIGURE_HEADERS[f] for f in FIGURES] + ["Diverged", "Invalid"])
+                   + [FIGURE_HEADERS[f] for f in FIGURES]
+                   + ["Diverged", "Invalid", "Warnings (count)", "Warnings"])
         ws.write_row(0, 0, headers, bold)
-        ws.set_column(0, len(headers), 16)
+        ws.set_column(0, len(headers) - 2, 16)
+        ws.set_column(len(headers) - 1, len(headers) - 1, 120)
         k = len(result.cells)
         columns = {i: result.values[:, i] for i in range(k)}
         columns.update({k + j: result.figures[:, j] for j in range(len(FIGURES))})
         columns[k + len(FIGURES)] = result.diverged.astype(float)
         columns[k + len(FIGURES) + 1] = result.invalid.astype(float)
+        flags = result.flags or [[] for _ in result.values]
+        columns[k + len(FIGURES) + 2] = np.array([len(f) for f in flags], dtype=float)
         write_number_columns(ws, 1, columns)
+        for r, found in enumerate(flags, start=1):  # text stays text: never a formula
+            if found:
+                ws.write_string(r, len(headers) - 1, " | ".join(found))
         not_printed(ws)
+        _write_warnings(wb, result, bold)
         n = len(result.values)
         charts = wb.add_worksheet("Charts")
         for i, cell in enumerate(result.cells):
@@ -65,6 +74,37 @@ def write_sweep(result, path, force, stats=None, sensitivity=None):
         if sensitivity is not None:
             _write_sensitivity(wb, sensitivity, bold)
         close_workbook(wb, path)
+
+
+def _write_warnings(wb, result, bold):
+    """The Warnings sheet: how many shots have a warning, how often each cell is named, and
+    every distinct warning with its count; printed on one page."""
+    ws = wb.add_worksheet("Warnings")
+    ws.set_column(0, 0, 14)
+    ws.set_column(1, 1, 120)
+    flagged, cells = result.flagged()
+    ws.write_string(0, 0, "Shots", bold)
+    ws.write_string(0, 1, f"{flagged:,} of {len(result.values):,} shots have warnings (the "
+                          "Sweep sheet's Warnings column names them, shot by shot)")
+    ws.write_row(2, 0, ["Cell", "Shots whose warnings name it"], bold)
+    row = 3
+    for cell, n in sorted(cells.items()):
+        ws.write_string(row, 0, cell)
+        ws.write_string(row, 1, f"{n:,}")
+        row += 1
+    counts = {}
+    for found in result.flags or []:
+        for text in found:
+            key = text if len(text) < 200 else text[:200] + "..."
+            counts[key] = counts.get(key, 0) + 1
+    ws.write_row(row + 1, 0, ["Shots", "Warning (as the first shot with it says it)"], bold)
+    row += 2
+    wrap = wb.add_format({"text_wrap": True, "valign": "top"})
+    for text, n in sorted(counts.items(), key=lambda item: -item[1])[:40]:
+        ws.write_number(row, 0, n, wb.add_format({"num_format": "#,##0"}))
+        ws.write_string(row, 1, text, wrap)
+        row += 1
+    one_page(ws, row, 1)
 
 
 def _write_spread(wb, result, stats, bold):
@@ -117,15 +157,15 @@ def _write_sensitivity(wb, sensitivity, bold):
                 ws.write_number(row + 1 + i, 1 + j, float(found[key][i]))
         chart = wb.add_chart({"type": "column"})
         for col, key, color in ((1, "S1", "#1f4e79"), (3, "ST", "#c00000")):
+            half_widths = "='Sensitivity'!" + xl_range_abs(row + 1, col + 1, row + k, col + 1)
             chart.add_series({
                 "name": key, "categories": ["Sensitivity", row + 1, 0, row + k, 0],
                 "values": ["Sensitivity", row + 1, col, row + k, col],
                 "fill": {"color": color},
+                # custom error bars take a formula: a list would be literal numbers
                 "y_error_bars": {"type": "custom",
-                                 "plus_values": ["Sensitivity", row + 1, col + 1, row + k,
-                                                 col + 1],
-                                 "minus_values": ["Sensitivity", row + 1, col + 1, row + k,
-                                                  col + 1]}})
+                                 "plus_values": half_widths,
+                                 "minus_values": half_widths}})
         chart.set_title({"name": f"Sobol indices: {SENSITIVITY_TITLES[name]}"})
         chart.set_x_axis({"name": "Uncertain input"})
         chart.set_y_axis({"name": "Index", "min": 0.0, "max": 1.2})
