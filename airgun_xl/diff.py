@@ -228,7 +228,8 @@ def _compare(col, header, x, y, times, rtol, atol):
     first = None
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        first = {"row": i + 2, "time": float(times[i]) if i < len(times) else None,
+        time = float(times[i]) if i < len(times) else math.nan
+        first = {"row": i + 2, "time": None if math.isnan(time) else time,  # final masses: none
                  "legacy": None if math.isnan(x[i]) else float(x[i]),
                  "new": None if math.isnan(y[i]) else float(y[i])}
     return ColumnDiff(_letter(col), header, int(np.isfinite(x).sum()),

@@ -276,3 +276,27 @@ def test_a_fill_killed_at_random_moments_leaves_the_archive_whole(tmp_path):
     assert len(a.entries()) == before + 1 and a.verify() == []
     assert not [p for p in (archive / SCRATCH).iterdir()]
     assert _owned_leftovers(tmp_path) == []
+
+
+def test_a_final_mass_outside_has_no_time_not_an_error_cell(tmp_path, capsys, appendix_pair):
+    """Issue 18.8: a final mass (below column I) that differs has no time: the terminal says
+    so without 't=nan', and the report writes "n/a" where it wrote =#NUM! (a NaN number)."""
+    import zipfile
+
+    legacy, new = appendix_pair
+    perturbed = tmp_path / "perturbed.xlsx"
+    wb = openpyxl.load_workbook(legacy)
+    rows = max(r for r in range(1, wb.active.max_row + 1) if wb.active[f"H{r}"].value is not None)
+    wb.active[f"I{rows + 2}"] = wb.active[f"I{rows + 2}"].value * 1.001  # the final M1
+    wb.save(perturbed)
+    capsys.readouterr()
+    report = tmp_path / "r.xlsx"
+    assert main(["diff", str(perturbed), str(new), "--report", str(report)]) == 1
+    out = capsys.readouterr().out
+    line = next(x for x in out.splitlines() if x.strip().startswith(f"I{rows + 2}"))
+    assert "nan" not in line and f"row {rows + 2}:" in line
+    table = list(openpyxl.load_workbook(report)["Diff"].iter_rows(values_only=True))
+    final = next(r for r in table if r[0] == f"I{rows + 2}")
+    assert final[7] == rows + 2 and final[8] == "n/a"
+    with zipfile.ZipFile(report) as z:
+        assert "#NUM!" not in z.read("xl/worksheets/sheet1.xml").decode()

@@ -106,14 +106,30 @@ def test_every_shrinks_chartdata_and_keeps_the_peak(tmp_path):
     assert len(values) <= 1_201 and max(values) == airgun_xl.load(TEMPLATE).run().peak_kg
 
 
-def test_spectrum_chart_from_1_khz_with_natural_frequency_marks(tmp_path):
+def test_spectrum_chart_from_the_lobe_end_with_its_dominant_and_natural_marks(tmp_path):
+    """Issue 18.9: the chart starts where the pulse's own lobe ends (shot A: 1.83 kHz, past
+    the 1.33 kHz shoulder that used to be its tallest peak) and marks the Summary's dominant
+    frequencies, the same numbers as the Summary's rows."""
     out = tmp_path / "o.xlsx"
     assert main(["fill", str(TEMPLATE), "-o", str(out)]) == 0
     with zipfile.ZipFile(out) as z:
         xml = next(z.read(n).decode() for n in z.namelist()
                    if n.startswith("xl/charts/chart") and b"FFT" in z.read(n))
-    assert '<c:min val="1000.0"/>' in xml and '<c:max val="15000.0"/>' in xml
+    assert '<c:min val="1800.0"/>' in xml and '<c:max val="15000.0"/>' in xml
     assert "OBR chain natural frequencies (initial masses)" in xml
+    assert "Dominant frequencies (the Summary's)" in xml
+    summary = {r[0]: r[1] for r in openpyxl.load_workbook(out, read_only=True)[
+        "Summary"].iter_rows(values_only=True) if r and r[0]}
+    reported = [round(summary[f"Dominant frequency {i}"], 2) for i in (1, 2, 3)]  # kHz
+    data = openpyxl.load_workbook(out, read_only=True)["ChartData"]
+    rows = list(data.iter_rows(min_row=2, values_only=True))
+    col = rows[0].index("dominant")
+    marked = [r[col - 1] for r in rows[1:] if r[col - 1] is not None]
+    assert [round(f / 1e3, 2) for f in marked] == reported == [5.33, 4.83, 9.0]
+    spectrum = summarize(airgun_xl.load(TEMPLATE).run()).spectrum
+    shown = spectrum.frequency >= 1800
+    tallest = spectrum.frequency[shown][np.argmax(spectrum.amplitude[shown])]
+    assert tallest > 2000  # the lobe's 1.33 kHz shoulder is off the chart
     ws = openpyxl.load_workbook(out, read_only=True)["ChartData"]
     rows = list(ws.iter_rows(min_row=2, values_only=True))
     col = rows[0].index("natural")

@@ -82,12 +82,15 @@ class Spectrum:
     amplitude : numpy.ndarray
         2|FFT|/N of the acceleration in kG [kG] (the DC bin is |FFT|/N, the mean).
     peaks : list of float
-        Dominant frequencies [Hz], strongest first.
+        Dominant frequencies [Hz], most prominent first, from ``band_start`` on.
+    band_start : float
+        Where the pulse's own lobe ends (:func:`lobe_end`) [Hz]: peaks and the chart from here.
     """
 
     frequency: np.ndarray
     amplitude: np.ndarray
     peaks: list = field(default_factory=list)
+    band_start: float = PEAK_MIN_HZ
 
 
 def amplitude_spectrum(accel_kg, delta, max_hz=SPECTRUM_MAX_HZ, n_peaks=3):
@@ -117,11 +120,32 @@ def amplitude_spectrum(accel_kg, delta, max_hz=SPECTRUM_MAX_HZ, n_peaks=3):
     freq = np.fft.rfftfreq(len(a), delta)
     keep = freq <= max_hz
     freq, amp = freq[keep], amp[keep]
+    start = lobe_end(freq, amp)
     inner = np.arange(1, len(amp) - 1)
     is_peak = (amp[inner] > amp[inner - 1]) & (amp[inner] >= amp[inner + 1])
-    candidates = inner[is_peak & (freq[inner] >= PEAK_MIN_HZ)]
+    candidates = inner[is_peak & (freq[inner] >= start)]
     order = np.argsort(-log_prominences(amp, candidates), kind="stable")
-    return Spectrum(freq, amp, [float(freq[candidates[i]]) for i in order[:n_peaks]])
+    return Spectrum(freq, amp, [float(freq[candidates[i]]) for i in order[:n_peaks]], start)
+
+
+def lobe_end(freq, amp, min_hz=PEAK_MIN_HZ):
+    """Where the pulse's own spectrum (the lobe from 0 Hz) ends [Hz]: past ``min_hz``, each
+    local maximum whose nearest higher ground to its left lies below ``min_hz`` is a shoulder
+    of that lobe, not a mode (shot A's 1.33 kHz); the band starts at the first local minimum
+    after the last of them. Dominant frequencies are sought, and the chart drawn, from there.
+    """
+    start = min_hz
+    inner = np.arange(1, len(amp) - 1)
+    peaks = inner[(amp[inner] > amp[inner - 1]) & (amp[inner] >= amp[inner + 1])
+                  & (freq[inner] >= min_hz)]
+    for i in peaks:
+        higher = np.flatnonzero(amp[:i] > amp[i])
+        if len(higher) and freq[higher[-1]] < min_hz:  # a shoulder of the lobe from 0 Hz
+            after = np.flatnonzero((amp[i + 1:-1] <= amp[i:-2]) & (amp[i + 1:-1] < amp[i + 2:]))
+            start = float(freq[i + 1 + after[0]]) if len(after) else float(freq[-1])
+        elif freq[i] > start:
+            break
+    return start
 
 
 def pulse(time, accel_kg, fraction=PULSE_FRACTION):

@@ -52,9 +52,10 @@ CHARTS = (
               (Series("accel_kg", "Acceleration"),
                Series("filtered_kg", "Filtered samples", markers=True),
                Series("compared_kg", "Other model", dash=True))),
-    ChartSpec("spectrum", "FFT of the test-item acceleration (Figs. 14-15), from "
-              f"{SPECTRUM_MIN_HZ / 1000:g} kHz", "Frequency (Hz)", "Amplitude (kG)",
+    ChartSpec("spectrum", "FFT of the test-item acceleration (Figs. 14-15), from the end of "
+              "the pulse's own lobe", "Frequency (Hz)", "Amplitude (kG)",
               (Series("spectrum", "Amplitude"),
+               Series("dominant", "Dominant frequencies (the Summary's)", markers=True),
                Series("natural", "OBR chain natural frequencies (initial masses)",
                       dash=True)),
               (SPECTRUM_MIN_HZ, SPECTRUM_MAX_HZ)),
@@ -100,8 +101,12 @@ def series_data(result, spectrum, compared=None, natural=()):
         "y1": (t, h.y1), "y31": (t, h.y31),
         "y32_rel": (t, (h.y32 - h.y31) * 1e3), "y33_rel": (t, (h.y33 - h.y31) * 1e3),
     }
-    shown = (spectrum.frequency >= SPECTRUM_MIN_HZ) & (spectrum.frequency <= SPECTRUM_MAX_HZ)
-    marks = [f for f in natural if SPECTRUM_MIN_HZ <= f <= SPECTRUM_MAX_HZ]
+    lo = spectrum.band_start
+    shown = (spectrum.frequency >= lo) & (spectrum.frequency <= SPECTRUM_MAX_HZ)
+    marks = [f for f in natural if lo <= f <= SPECTRUM_MAX_HZ]
+    if spectrum.peaks:  # the Summary's dominant frequencies, marked where they are
+        at = np.searchsorted(spectrum.frequency, spectrum.peaks)
+        data["dominant"] = (spectrum.frequency[at], spectrum.amplitude[at])
     if marks and shown.any():
         data["natural"] = natural_marks(marks, float(np.max(spectrum.amplitude[shown])))
     if compared is not None:
@@ -183,7 +188,7 @@ def _in_range(x, y, x_range):
 CHART_ROWS, CHART_COLS = 19, 10
 
 
-def add_charts(workbook, sheet, refs, data, max_time, labels=None):
+def add_charts(workbook, sheet, refs, data, max_time, labels=None, x_ranges=None):
     """Insert the charts on ``sheet``, two a row; the sheet prints as one landscape page.
 
     Parameters
@@ -198,6 +203,9 @@ def add_charts(workbook, sheet, refs, data, max_time, labels=None):
         End of the time axis [s].
     labels : dict, optional
         Series key -> legend name, overriding the chart's own.
+    x_ranges : dict, optional
+        Chart key -> (min, max) of its x axis, overriding the chart's own (the spectrum's
+        band starts where the pulse's own lobe ends).
 
     Returns
     -------
@@ -234,13 +242,14 @@ def add_charts(workbook, sheet, refs, data, max_time, labels=None):
         if decimated:
             title += f"\n(decimated to {decimated[0]}, peaks kept)"
         chart.set_title({"name": title, "name_font": {"size": 11}})
-        xlo, xhi = spec.x_range or (0.0, max_time)
+        x_range = (x_ranges or {}).get(spec.key, spec.x_range)
+        xlo, xhi = x_range or (0.0, max_time)
         chart.set_x_axis(_axis(spec.x_title, xlo, xhi))
         for secondary in (False, True):
             on_axis = [s for s in present if s.y2 == secondary]
             if not on_axis:
                 continue
-            ys = np.concatenate([_in_range(*data[s.key], spec.x_range) for s in on_axis])
+            ys = np.concatenate([_in_range(*data[s.key], x_range) for s in on_axis])
             ylo, yhi = nice_range(ys, include_zero=True)
             if secondary:
                 chart.set_y2_axis(_axis(spec.y2_title, ylo, yhi, gridlines=False))

@@ -47,6 +47,8 @@ def write_diff_report(report, path, force=False):
                 for k, key in enumerate(("row", "time", "legacy", "new")):
                     if f[key] is not None:
                         ws.write_number(row, 7 + k, f[key])
+                    else:  # a final mass has no time; an empty cell of the macro's no value
+                        ws.write_string(row, 7 + k, "n/a")
         for label, names in (("Only in legacy", report.only_legacy),
                              ("Only in new", report.only_new)):
             if names:

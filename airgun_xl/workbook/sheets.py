@@ -180,8 +180,10 @@ def _summary_rows(result, summary, timings):
     for i in range(3):
         value = s.spectrum.peaks[i] if i < len(s.spectrum.peaks) else None
         rows.append((f"Dominant frequency {i + 1}", value, "Hz",
-                     f"local maxima of the amplitude spectrum above {PEAK_MIN_HZ:,.0f} Hz, "
-                     "most prominent first (log prominence)" if i == 0 else ""))
+                     "local maxima of the amplitude spectrum past the pulse's own lobe "
+                     f"(from {s.spectrum.band_start:,.0f} Hz; shoulders of it above "
+                     f"{PEAK_MIN_HZ:,.0f} Hz left out), most prominent first (log prominence); "
+                     "marked on the FFT chart" if i == 0 else ""))
     for label, freqs in (("initial", s.natural_initial), ("final", s.natural_final)):
         for i, f in enumerate(freqs):
             rows.append((f"OBR chain natural frequency {i + 1} ({label} masses)", f, "Hz",

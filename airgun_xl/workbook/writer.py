@@ -30,7 +30,7 @@ import xlsxwriter
 from xlsxwriter.utility import xl_rowcol_to_cell
 
 from ..cells import PARAMETER_COLUMNS
-from ..engine.summary import summarize
+from ..engine.summary import SPECTRUM_MAX_HZ, summarize
 from ..errors import OutputError
 from ..outputs import SHEET_NAME, Outputs
 from ..transaction import atomic_path, check_output, display
@@ -349,7 +349,9 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
                       "accel_kg": "Acceleration, the macro's unloading (quirk)"
                       if compared.params.unloading == "continuous" else
                       f"Acceleration, {variant_name(result)}"}
-        add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]), labels)
+        add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]), labels,
+                   {"spectrum": (np.floor(summary.spectrum.band_start / 100) * 100,
+                                 SPECTRUM_MAX_HZ)})
     if source is not None and source.outputs_block:
         outputs_ws = wb.add_worksheet(names[SHEET_NAME], worksheet_class=ColumnsWorksheet)
         warnings += write_cells(outputs_ws, source.outputs_block)
