@@ -36,7 +36,13 @@ def test_the_spectrum_of_a_known_shot_gives_back_its_speed(tmp_path, capsys):
     v0 = float(text.split("A28..A30 = ")[1].split()[0])
     assert v0 == pytest.approx(200.0, abs=0.01)  # brentq to 1e-10; the CSV keeps 17 digits
     assert "least margin of +0.00%" in text
+    # issue 18.10: a design said to envelop never has a negative margin ("-0.00%")
+    from airgun_xl.studies.design import srs_margin, variable
+
+    spectrum = np.array(FREQUENCIES), _srs_at(200.0)
     ws = openpyxl.load_workbook(out).worksheets[0]
+    solved = variable("A28").apply(SHOT.params, ws["A28"].value)  # the design's own value
+    assert srs_margin(solved, *spectrum, 10.0)[0] >= 0
     assert ws["A28"].value == pytest.approx(200.0, abs=0.01)
     assert (_srs_at(v0 + 0.05) >= _srs_at(200.0)).all()  # enveloped just above
 

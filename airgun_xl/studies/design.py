@@ -230,6 +230,18 @@ def srs_margin(p, frequencies, required, q, integrator="legacy", model="4-mass")
     return float(ratio[k] - 1), k
 
 
+def _enveloping_side(x, bracket, margin):
+    """``x`` moved, by steps doubling from 1e-12 of it, to where the margin is >= 0: brentq's
+    root may sit a rounding below it, and a design said to envelop must (no "-0.00 %")."""
+    a, b = bracket
+    toward = b if margin(b)[0] >= 0 else a
+    step = 1e-12 * max(abs(x), abs(toward - x))
+    while margin(x)[0] < 0 and step < abs(toward - x):
+        x = x + math.copysign(step, toward - x)
+        step *= 2
+    return x if margin(x)[0] >= 0 else toward
+
+
 def solve_srs(p, frequencies, required, var, q=10.0, integrator="legacy", model="4-mass",
               bounds=None):
     """The least value of ``var`` whose shock response spectrum envelops ``required``.
@@ -280,6 +292,7 @@ def solve_srs(p, frequencies, required, var, q=10.0, integrator="legacy", model=
                 f"{1 + ms[best]:.1%} of it at {frequencies[k]:,.0f} Hz (the governing "
                 f"frequency; {required[k]:.4g} kG required)")
         x = brentq(lambda v: margin(v)[0], *bracket, xtol=1e-10, rtol=1e-10, maxiter=100)
+        x = _enveloping_side(x, bracket, margin)
     solved = var.apply(p, x)
     m, k = margin(x)
     from ..engine.batch import run_batch
