@@ -19,8 +19,9 @@ from conftest import (
 from airgun_xl.cli import main
 
 #: Calc ignores a fractional Offset argument (README of legacy_reference): cases whose
-#: 1/(E2*E34) is fractional are compared with the Calc reproduction of column AB.
-CALC_HOST_CASES = {"samplerate_non_integer", "ab_third_row"}
+#: 1/(E2*E34) is fractional, and the random ones, carry "host": "calc" in cases.json and are
+#: compared with the Calc reproduction of column AB (fill --host calc).
+CALC_HOST_CASES = {name for name, case in CASES.items() if case.get("host") == "calc"}
 
 
 @pytest.fixture(scope="module", params=sorted(CASES))
