@@ -48,6 +48,9 @@ MAX_EVERY = 10**9
 #: Most shots of one sweep or Monte Carlo run.
 MAX_SHOTS = 10**7
 
+#: Most samples a measured recording may hold: 40 s at 50 kHz, 32 MB as two float columns.
+MAX_SAMPLES = 2_000_000
+
 
 # -- memory, estimated before a run -------------------------------------------------------------
 #: Environment variable that sets the memory a command may plan to use, e.g. ``2GB``; by default

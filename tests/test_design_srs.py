@@ -11,6 +11,7 @@ from airgun_xl.studies.shock import srs
 
 SHOT = airgun_xl.load(TEMPLATE)
 FREQUENCIES = np.array([200.0, 500.0, 1000.0, 2000.0, 4000.0])
+G_PER_KG = 9800.0 / 9.80665  # the macro's kG in standard g
 
 
 def _spec(path, frequencies, levels_g):
@@ -29,7 +30,7 @@ def _srs_at(v0):
 def test_the_spectrum_of_a_known_shot_gives_back_its_speed(tmp_path, capsys):
     """The requirement is the SRS of shot A at 200 m/s: the least v0 that envelops it is 200
     m/s (the SRS grows with v0 at every frequency here), with a least margin of 0."""
-    spec = _spec(tmp_path / "req.csv", FREQUENCIES, _srs_at(200.0) * 1000)  # kG -> g
+    spec = _spec(tmp_path / "req.csv", FREQUENCIES, _srs_at(200.0) * G_PER_KG)  # kG -> g
     out = tmp_path / "d.xlsx"
     assert main(["design", str(TEMPLATE), "--target-srs", str(spec), "-o", str(out)]) == 0
     text = capsys.readouterr().out
@@ -48,7 +49,7 @@ def test_the_spectrum_of_a_known_shot_gives_back_its_speed(tmp_path, capsys):
 
 
 def test_an_infeasible_spectrum_is_explained(tmp_path, capsys):
-    spec = _spec(tmp_path / "req.csv", FREQUENCIES, _srs_at(200.0) * 1000 * [1, 1, 1, 1, 20])
+    spec = _spec(tmp_path / "req.csv", FREQUENCIES, _srs_at(200.0) * G_PER_KG * [1, 1, 1, 1, 20])
     assert main(["design", str(TEMPLATE), "--target-srs", str(spec), "-o",
                  str(tmp_path / "d.xlsx")]) == 2
     err = capsys.readouterr().err
@@ -62,7 +63,7 @@ def test_an_infeasible_spectrum_is_explained(tmp_path, capsys):
                                                  "frequencies, increasing"),
     ("frequency [Hz],srs [g]\n200,-10\n", "row 2: level -10, expected a positive SRS level"),
     ("frequency [rpm],srs [g]\n200,10\n", "names no unit I know (rpm)"),
-    ("frequency [Hz],srs [g]\n200,ten\n", "row 2 holds ['200', 'ten'], expected two numbers"),
+    ("frequency [Hz],srs [g]\n200,ten\n", "line 2 holds ['200', 'ten'], expected two numbers"),
 ])
 def test_a_bad_specification_is_one_line(tmp_path, capsys, body, message):
     (tmp_path / "req.csv").write_text(body)

@@ -4,6 +4,7 @@ from pathlib import Path
 
 from ..choices import INTEGRATORS
 from ..errors import OptionError
+from .recording_options import add_recording_options
 
 
 def add_parser(sub):
@@ -30,19 +31,17 @@ def add_parser(sub):
     p.add_argument("--objective", choices=("l2", "iso18571"), default="l2",
                    help="what the least squares minimise: the filtered pulses' difference "
                         "(default) or 1 - the ISO/TS 18571 rating")
-    p.add_argument("--cfc", type=int, default=None,
-                   help="filter both pulses: SAE J211 class 60, 180, 600 or 1000 (recommended "
-                        "for the law: the recorder's ringing; it hides zeta)")
     p.add_argument("--degree", type=int, default=6, help="of the law's polynomial (1-6, "
                                                           "default 6 as Eq. 8)")
-    p.add_argument("--channel", metavar="GROUP/CHANNEL",
-                   help="TDMS only: the channel of every measured file (default: the first "
-                        "waveform channel)")
-    p.add_argument("--sign", type=float, default=1.0, choices=(1.0, -1.0))
-    p.add_argument("--time-unit", help="s, ms or us (default: from the header)")
-    p.add_argument("--accel-unit", help="g, kG or m/s^2 (default: from the header)")
+    add_recording_options(p, "TDMS only: the channel of every measured file (default: the "
+                             "first waveform channel)")
     p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
     p.set_defaults(run=run)
+
+
+#: The exit status of a calibration that was written but cannot be vouched for (a value at a
+#: bound or not identified, a law not converged, a residual made worse): its warnings say why.
+UNTRUSTED = 3
 
 
 def _pairs(values):
@@ -80,7 +79,8 @@ def run(args):
               for _, m in files]
     cal = calibrate([s.params for s in shots], traces, law=law, fit=names, cfc=args.cfc,
                     degree=args.degree, objective=args.objective,
-                    integrator=args.integrator)
+                    integrator=args.integrator, anti_alias=args.anti_alias)
+    cal.warnings[:0] = [w for s in shots for w in s.warnings]
     write_calibration(output, shots[0], cal, files, args, args.force)
     print(f"wrote {output}: calibrated on {len(files)} shot{'s' * (len(files) > 1)} "
           f"({cal.runs} runs, {cal.seconds:.2f} s)")
@@ -89,10 +89,23 @@ def run(args):
         lo, hi = cal.params[0].crush_law.v_range
         print(f"  crush law: {'converged' if lc.converged else 'NOT converged'} in "
               f"{len(lc.iterations)} iterations (last change {lc.iterations[-1].change:.2%}), "
-              f"then least squares; valid {lo:.1f} to {hi:.1f} m/s")
+              f"then least squares; valid {lo:.1f} to {hi:.1f} m/s (the samples' span)")
     for name, value in cal.fitted.items():
-        print(f"  {name}: {cal.start[name]:.6g} -> {value:.6g}")
-    for i, (before, after) in enumerate(zip(cal.before, cal.after), start=1):
+        print(f"  {name}: {cal.start[name]:.6g} -> {value:.6g} +/- {cal.errors[name]:.3g} "
+              f"(1 standard error; 95 %: {value - 1.96 * cal.errors[name]:.6g} to "
+              f"{value + 1.96 * cal.errors[name]:.6g})")
+    for i, (before, after) in enumerate(zip(cal.before, cal.after, strict=True), start=1):
         print(f"  shot {i}: RMS error {before.rms:.2%} -> {after.rms:.2%}; ISO/TS 18571 "
               f"{before.iso:.3f} -> {after.iso:.3f}")
+    for text in cal.notes:
+        print(f"  note: {text}")
+    if cal.warnings:
+        from . import warn
+
+        warn(cal.warnings)
+        print(f"  verdict: NOT TRUSTED ({len(cal.warnings)} warning"
+              f"{'s' * (len(cal.warnings) > 1)}, also in {output}); exit {UNTRUSTED}")
+        return UNTRUSTED
+    print("  verdict: every fitted value identified, within its bounds, and every shot's "
+          "residual improved")
     return 0

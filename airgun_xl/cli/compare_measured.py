@@ -2,6 +2,7 @@
 from pathlib import Path
 
 from ..choices import INTEGRATORS, MODELS
+from .recording_options import add_recording_options
 
 
 def add_parser(sub):
@@ -17,20 +18,14 @@ def add_parser(sub):
     p.add_argument("measured", metavar="MEASURED",
                    help="the measured pulse: a CSV (time, acceleration, units in the header), "
                         "a workbook's columns (trace.xlsx:Sheet1!A:B) or a LabVIEW TDMS file")
-    p.add_argument("--channel", metavar="GROUP/CHANNEL",
-                   help="TDMS only: the channel (default: the first waveform channel)")
     p.add_argument("-o", "--output", metavar="OUT.xlsx",
                    help="scores and traces (default: SHOT.measured.xlsx)")
     p.add_argument("--force", action="store_true")
-    p.add_argument("--cfc", type=int, help="filter both traces: SAE J211 class 60, 180, 600 "
-                                           "or 1000")
+    add_recording_options(p)
     p.add_argument("--align", default="threshold", choices=("threshold", "xcorr"),
-                   help="impact instant: first crossing of 5%% of the peak (default), or the "
-                        "cross-correlation's best lag")
-    p.add_argument("--sign", type=float, default=1.0, choices=(1.0, -1.0),
-                   help="-1 when the recorder's axis is opposite to the macro's")
-    p.add_argument("--time-unit", help="s, ms or us (default: from the header)")
-    p.add_argument("--accel-unit", help="g, kG or m/s^2 (default: from the header)")
+                   help="impact instant: where the zeroed pulse first holds 5%% of its peak "
+                        "(or 5 sigma of its pre-trigger noise, if more) for 0.05 ms (default),"
+                        " or the cross-correlation's best lag; each checks the other")
     p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
     p.add_argument("--model", choices=MODELS, default="4-mass")
     p.set_defaults(run=run)
@@ -43,11 +38,13 @@ def run(args):
 
     from ..models import apply_model
     from ..shot import Shot
-    from ..studies.measured import compare
+    from ..studies.check import after_run
+    from ..studies.measured import ANTI_ALIAS_ORDER, compare
     from ..studies.shock import CFC_CLASSES, cfc_coefficients
     from ..transaction import check_output
     from ..workbook.measured import write_comparison
     from ..workbook.trace import input_file, read_trace
+    from . import warn
 
     if args.cfc is not None and args.cfc not in CFC_CLASSES:
         cfc_coefficients(args.cfc, 1.0)  # its one-line error, before the run
@@ -66,11 +63,16 @@ def run(args):
         integrator=args.integrator, track=())
     ok = np.isfinite(rigid.accel_kg)
     c = compare(result.history.time[finite], result.accel_kg[finite], trace, args.cfc,
-                args.align, rigid=(rigid.history.time[ok], rigid.accel_kg[ok]))
+                args.align, rigid=(rigid.history.time[ok], rigid.accel_kg[ok]),
+                anti_alias=args.anti_alias)
+    c.warnings[:0] = shot.warnings + [str(f) for f in after_run(result)]
     about = [("Shot", str(args.shot)), ("Measured", trace.name),
              ("Units read", f"time {trace.units[0]}, acceleration {trace.units[1]}"),
              ("Filter", f"CFC {args.cfc}" if args.cfc else "none"),
-             ("Alignment", args.align)]
+             ("Alignment", f"{args.align} (cross-checked against the other)"),
+             ("Anti-alias model", "none" if c.anti_alias is None else
+              f"{ANTI_ALIAS_ORDER}-pole Butterworth at {c.anti_alias:,.0f} Hz on the prediction"),
+             ("Warnings", f"{len(c.warnings)} (below the scores)" if c.warnings else "none")]
     write_comparison(output, c, about, args.force, models=(args.model, other))
     print(f"wrote {output}: {trace.name} against {args.shot} ({len(c.time):,} samples, "
           f"aligned by {args.align}, shift {c.shift * 1e3:.4f} ms)")
@@ -80,6 +82,11 @@ def run(args):
     print(f"  velocity change {c.predicted.delta_v:.3f} m/s, {c.measured.delta_v:.3f} "
           f"({c.errors['delta_v']:+.2%}); correlation r = {c.correlation:.4f}")
     r = c.iso
-    print(f"  ISO/TS 18571 rating {r.overall:.3f} ({r.grade}): corridor {r.corridor:.3f}, "
-          f"phase {r.phase:.3f}, magnitude {r.magnitude:.3f}, slope {r.slope:.3f}")
+    if r is not None:
+        print(f"  ISO/TS 18571 rating {r.overall:.3f} ({r.grade}): corridor {r.corridor:.3f}, "
+              f"phase {r.phase:.3f}, magnitude {r.magnitude:.3f}, slope {r.slope:.3f}")
+    print(f"  baseline {c.baseline.offset:.4g} kG removed, pre-trigger noise "
+          f"{c.baseline.noise:.3g} kG; impact at {c.level:.1%} of the peak; anti-alias model "
+          + (f"{c.anti_alias:,.0f} Hz" if c.anti_alias else "none"))
+    warn(c.warnings)
     return 0

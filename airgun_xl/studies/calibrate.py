@@ -28,7 +28,6 @@ import numpy as np
 from ..crush_law import DEGREE, CrushLaw
 from ..errors import OptionError
 from .measured import KG_MS2, on_measured_grid, threshold_shift
-from .shock import cfc_filter
 
 #: The iteration stops when the law moves less than this over the samples' velocities (the
 #: report's 1 %).
@@ -92,6 +91,8 @@ class FitResult:
     cost: float
     evaluations: int
     params: list = field(default_factory=list)  # each shot's ShotParams, fitted
+    errors: dict = field(default_factory=dict)  # standard error of each value (Jacobian)
+    bounds: dict = field(default_factory=dict)  # (low, high) each value was held to
 
 
 def _run(p, integrator):
@@ -100,23 +101,24 @@ def _run(p, integrator):
     return Shot(p).run(integrator=integrator, track=TRACK)
 
 
-def align(result, trace, cfc=None):
-    """The run's pulse on the measured trace's grid, both filtered alike (``cfc``) and aligned
-    at the impact instant (where each first reaches
-    :data:`~airgun_xl.studies.measured.IMPACT_FRACTION` of its peak).
+def align(result, rec):
+    """The run's pulse on the measured :class:`~airgun_xl.studies.measured.Recording`'s grid,
+    both filtered alike (its CFC class, and its anti-alias model on the run) and aligned at
+    the impact instant (where each first holds the recording's level, a fraction of its peak
+    above the noise).
 
     Every measured sample is kept (the run is at rest before it starts and holds its last
     value after), so the residuals of two runs have the same length."""
     h = result.history
     ok = np.isfinite(result.accel_kg)
     t_run, a_run = h.time[ok], result.accel_kg[ok]
-    meas = cfc_filter(trace.accel_kg, trace.dt, cfc) if cfc else trace.accel_kg
-    shift = threshold_shift(t_run, a_run, trace, meas, cfc)[0]
+    trace = rec.trace
+    shift = threshold_shift(t_run, a_run, rec, rec.anti_alias)[0]
     t = trace.time + shift
     if ((t >= t_run[0]) & (t <= t_run[-1])).sum() < 16:
         raise OptionError("the aligned traces overlap in fewer than 16 samples, expected the "
                           "measured pulse to cover the simulated one")
-    sim = on_measured_grid(t, t_run, a_run, trace.dt, cfc)
+    sim = on_measured_grid(t, t_run, a_run, trace.dt, rec.cfc, rec.anti_alias)
     rows = h.time[2:]
     cf = np.interp(t, rows, h.crush_factor[2:])
     prev = np.interp(t - result.params.delta, rows, h.deflection[2:])
@@ -126,7 +128,7 @@ def align(result, trace, cfc=None):
     p = result.params
     mass = np.interp(t, rows, h.m31[2:]) + p.m32 + p.m33
     v = np.interp(t, h.time[1:-1], (h.v31 - h.v1)[1:-1])
-    return Aligned(t, sim, meas, shift, cf, v, loading, mass)
+    return Aligned(t, sim, rec.filtered, shift, cf, v, loading, mass)
 
 
 def rms_error(a):
@@ -165,11 +167,17 @@ def fit_law(v, x, degree=DEGREE, v_range=None):
     return CrushLaw(tuple(poly.coef), span, "fitted")
 
 
+#: The law is valid over the velocities its samples cover, between these percentiles: the
+#: first and last 1 % (the rise's first samples, smeared by any filter) pin nothing.
+SPAN_PERCENTILES = (1, 99)
+
+
 def shots_range(pairs, v):
-    """The velocities the shots' pulses cover: from rest (or the least sample below it) to
-    the highest impact speed (the first sample is already a step past the impact)."""
-    impact = max(p.v31 - p.v1 for p, _ in pairs)
-    return (min(0.0, float(v.min())), max(float(impact), float(v.max())))
+    """The velocities the shots' samples cover [m/s] (:data:`SPAN_PERCENTILES`): the fitted
+    law claims no more; a shot faster than its top meets the extrapolation warning of any
+    run of it (:func:`airgun_xl.studies.check.impact_speed_finding`)."""
+    lo, hi = np.percentile(v, SPAN_PERCENTILES)
+    return (float(lo), float(hi))
 
 
 def calibrate_law(pairs, cfc=None, degree=DEGREE, integrator="legacy",
@@ -196,7 +204,7 @@ def calibrate_law(pairs, cfc=None, degree=DEGREE, integrator="legacy",
     for number in range(1, max_iterations + 1):
         vs, xs, errors = [], [], []
         for p, trace in pairs:
-            a = align(_run(p.replace(crush_law=law), integrator), trace, cfc)
+            a = align(_run(p.replace(crush_law=law), integrator), trace)
             v, x = law_samples(a)
             vs.append(v)
             xs.append(x)
@@ -226,13 +234,20 @@ def law_through(v_nodes, x_nodes, v_range):
     return CrushLaw(tuple(poly.coef), v_range, "fitted")
 
 
-def refine_law(pairs, law, cfc=None, objective="l2", integrator="legacy", degree=DEGREE):
+def refine_law(pairs, law, integrator="legacy", degree=DEGREE):
     """Least squares on the law itself: its values at ``degree + 1`` Chebyshev velocities of
-    its range, moved until the filtered pulses agree (scipy.optimize.least_squares).
+    its range, moved until the filtered pulses agree (scipy.optimize.least_squares, on their
+    L2 difference: the ISO/TS 18571 rating is jagged in the law, so it only rates).
 
     The iteration's fixed point is where the samples' ratio is orthogonal to the polynomials;
     with a filter that smears the pulse's rise, that is not always where the pulses agree.
     This step finishes the job from the iteration's law.
+
+    Returns
+    -------
+    (CrushLaw, int, numpy.ndarray, numpy.ndarray)
+        The law, the runs it took, the nodes [m/s] and the standard errors of the law's values
+        there [-] (from the Jacobian, :func:`standard_errors`).
     """
     from scipy.optimize import least_squares
 
@@ -243,12 +258,29 @@ def refine_law(pairs, law, cfc=None, objective="l2", integrator="legacy", degree
     def residuals(x):
         evaluations[0] += 1
         trial = law_through(nodes, x, law.v_range)
-        aligned = [align(_run(p.replace(crush_law=trial), integrator), trace, cfc)
+        aligned = [align(_run(p.replace(crush_law=trial), integrator), trace)
                    for p, trace in pairs]
-        return _objective_residuals(aligned, objective)
+        return _objective_residuals(aligned, "l2")
 
     fit = least_squares(residuals, x0, x_scale=np.abs(x0), diff_step=1e-4, max_nfev=100)
-    return law_through(nodes, fit.x, law.v_range), evaluations[0]
+    return (law_through(nodes, fit.x, law.v_range), evaluations[0], nodes,
+            standard_errors(fit))
+
+
+def standard_errors(fit):
+    """Standard errors of a least-squares fit's parameters from its Jacobian: the square roots
+    of the diagonal of s^2 (J^T J)^-1, s^2 = 2 cost / (residuals - parameters). A singular
+    J^T J (a parameter the residuals do not see) gives an infinite error."""
+    J = np.asarray(fit.jac, dtype=float)
+    m, n = J.shape
+    dof = max(m - n, 1)
+    s2 = 2 * float(fit.cost) / dof
+    try:
+        cov = np.linalg.inv(J.T @ J) * s2
+        out = np.sqrt(np.clip(np.diag(cov), 0, None))
+    except np.linalg.LinAlgError:
+        out = np.full(n, np.inf)
+    return np.where(np.isfinite(out), out, np.inf)
 
 
 def _objective_residuals(aligned, objective):
@@ -300,7 +332,7 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
     -------
     FitResult
     """
-    from scipy.optimize import least_squares
+    from scipy.optimize import least_squares, minimize
 
     names = check_fit(names, objective)
     p0 = pairs[0][0]
@@ -314,7 +346,7 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
     evaluations = [0]
 
     def shots(x):
-        values = dict(zip(names, x))
+        values = dict(zip(names, x, strict=True))
         out = []
         for p, _ in pairs:
             changes = {}
@@ -327,18 +359,32 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
             out.append(p.replace(**changes))
         return out
 
-    def residuals(x):
+    def residuals(x, objective="l2"):
         evaluations[0] += 1
-        aligned = [align(_run(p, integrator), trace, cfc)
-                   for p, (_, trace) in zip(shots(x), pairs)]
+        aligned = [align(_run(p, integrator), trace)
+                   for p, (_, trace) in zip(shots(x), pairs, strict=True)]
         return _objective_residuals(aligned, objective)
 
     x0 = np.clip(x0, lo, hi)
     scale = np.where(np.asarray(x0) > 0, np.abs(x0), 0.01)
     fit = least_squares(residuals, x0, bounds=(lo, hi), x_scale=scale, diff_step=1e-4,
                         xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=200)
-    return FitResult(dict(zip(names, map(float, fit.x))), {n: start[n] for n in names},
-                     float(fit.cost), evaluations[0], shots(fit.x))
+    x, errors, cost = fit.x, standard_errors(fit), float(fit.cost)
+    if objective == "iso18571":
+        # the rating is jagged in the parameters (its DTW and phase search move in steps), so
+        # a finite-difference slope can point the wrong way: a derivative-free search (Powell,
+        # bounded) from the L2 fit; the L2 fit's standard errors stand for it
+        def worse(y):
+            return float(np.sum(residuals(y, "iso18571")))
+
+        found = minimize(worse, x, method="Powell", bounds=list(zip(lo, hi, strict=True)),
+                         options={"xtol": 1e-4, "ftol": 1e-6, "maxfev": 200})
+        if found.fun < worse(x):
+            x, cost = found.x, float(found.fun)
+    return FitResult(dict(zip(names, map(float, x), strict=True)),
+                     {n: start[n] for n in names}, cost, evaluations[0], shots(x),
+                     dict(zip(names, map(float, errors), strict=True)),
+                     {n: (float(a), float(b)) for n, a, b in zip(names, lo, hi, strict=True)})
 
 
 @dataclass
@@ -349,7 +395,8 @@ class Score:
 
 @dataclass
 class Calibration:
-    """What :func:`calibrate` found: each shot's fitted parameters, and the way there."""
+    """What :func:`calibrate` found: each shot's fitted parameters, the way there, and the
+    verdict: ``warnings`` name what cannot be vouched for, and ``trusted`` is False then."""
 
     params: list
     law_calibration: LawCalibration | None
@@ -360,33 +407,124 @@ class Calibration:
     aligned: list  # each shot's pulses after calibration
     runs: int = 0
     seconds: float = 0.0
+    errors: dict = field(default_factory=dict)  # standard error of each fitted value
+    bounds: dict = field(default_factory=dict)  # (low, high) of each fitted value
+    law_nodes: np.ndarray = None  # [m/s] where the law's standard errors are
+    law_errors: np.ndarray = None  # [-] standard errors of the law's values there
+    law_span: tuple = None  # [m/s] the velocities the law's samples cover (1st-99th pct)
+    recordings: list = field(default_factory=list)  # each shot's measured Recording
+    warnings: list = field(default_factory=list)
+    notes: list = field(default_factory=list)  # said with the figures; no verdict on them
+
+    @property
+    def trusted(self):
+        return not self.warnings
 
 
 def score(a):
     """RMS error and ISO/TS 18571 rating of an aligned pair, over the measured pulse widened by
-    a tenth of its duration each side, from the impact on (as compare-measured rates it)."""
+    a tenth of its duration each side, from the impact on (as compare-measured rates it); the
+    rating is NaN where it cannot be computed (too short a pulse)."""
     from ..engine.summary import pulse
     from .iso18571 import rating
 
     start, end, duration = pulse(a.time, a.measured_kg)
     lo, hi = max(0.0, start - 0.1 * duration), min(a.time[-1], end + 0.1 * duration)
-    return Score(rms_error(a), rating(a.time, a.measured_kg, a.simulated_kg, lo, hi).overall)
+    try:
+        iso = rating(a.time, a.measured_kg, a.simulated_kg, lo, hi).overall
+    except ValueError:
+        iso = float("nan")
+    return Score(rms_error(a), iso)
+
+
+#: A fitted value whose standard error passes this fraction of it is not identified.
+UNIDENTIFIED = 0.5
+
+#: A calibrated shot whose RMS error stays above this fraction of its peak is not described
+#: by the model (the recorder model's 3 % noise leaves about 3 %).
+POOR_FIT = 0.10
+
+#: A value within this fraction of its range from a bound is at the bound.
+AT_BOUND = 1e-3
+
+
+def verdict(cal, cfc, objective, p0):
+    """(warnings, notes) of a calibration. Warnings: a value at a bound or with a standard
+    error past :data:`UNIDENTIFIED` of it; zeta fitted through a filter that removes the modes it damps;
+    the law used past the velocities its samples cover; a law that did not converge; a shot
+    whose residual (or, for the ISO objective, rating) got worse. Notes: a law measured below
+    the shots' impact speed (the law claims only its samples' span)."""
+    from ..engine.summary import natural_frequencies
+
+    found, notes = [], []
+    for name, value in cal.fitted.items():
+        lo, hi = cal.bounds[name]
+        error = cal.errors.get(name, np.inf)
+        if min(value - lo, hi - value) <= AT_BOUND * (hi - lo):
+            found.append(f"--fit {name}: {value:.6g} is at its bound ({lo:.4g}..{hi:.4g}): "
+                         "not identified by these pulses")
+        elif not error <= UNIDENTIFIED * abs(value):
+            found.append(f"--fit {name}: {value:.6g} +/- {error:.3g} (1 standard error): the "
+                         "pulses do not pin it down (not identified)")
+    if "E43" in cal.fitted and cfc:
+        chain = (p0.m31, p0.m32, p0.m33)[:p0.bird_masses]
+        springs = (-p0.k2, -p0.k3)[:p0.bird_masses - 1]
+        lowest = min(natural_frequencies(chain, springs), default=np.inf)
+        corner = 1.65 * cfc  # the J211 class's -3 dB frequency
+        if lowest > corner:
+            found.append(f"--fit E43: zeta damps the OBR modes (from {lowest:,.0f} Hz), which "
+                         f"the CFC {cfc} filter (-3 dB at {corner:,.0f} Hz) takes out of both "
+                         "pulses: not identified through it (fit unfiltered, or with a higher "
+                         "class)")
+    lc = cal.law_calibration
+    if lc is not None:
+        if not lc.converged:
+            found.append(f"crush law: not converged in {len(lc.iterations)} iterations (last "
+                         f"change {lc.iterations[-1].change:.2%})")
+        lo, hi = cal.params[0].crush_law.v_range
+        fastest = max(p.v31 - p.v1 for p in cal.params)
+        if fastest > hi:
+            notes.append(f"crush law: measured from {lo:.1f} to {hi:.1f} m/s (its samples' "
+                         f"{SPAN_PERCENTILES[0]}th to {SPAN_PERCENTILES[1]}th percentile), "
+                         f"below the shots' impact speed of {fastest:.1f} m/s: a run of them "
+                         "extrapolates it at first (fill warns); the law itself is not "
+                         "claimed there")
+        if cal.law_errors is not None and np.any(
+                cal.law_errors > UNIDENTIFIED * np.abs(cal.params[0].crush_law.poly(
+                    cal.law_nodes))):
+            found.append("crush law: a value of the law has a standard error over "
+                         f"{UNIDENTIFIED:.0%} of it: the pulses do not pin the law down there")
+    for i, (before, after) in enumerate(zip(cal.before, cal.after, strict=True), start=1):
+        if after.rms > POOR_FIT:
+            found.append(f"shot {i}: after calibration the model still misses the measured "
+                         f"pulse by {after.rms:.1%} RMS of its peak (over {POOR_FIT:.0%}): the "
+                         "model does not describe this recording, whatever the fitted values")
+        if after.rms > before.rms * (1 + 1e-9):
+            found.append(f"shot {i}: the calibration made its RMS error worse ({before.rms:.2%} "
+                         f"-> {after.rms:.2%})")
+        if objective == "iso18571" and after.iso < before.iso - 1e-9:
+            found.append(f"shot {i}: the calibration made its ISO/TS 18571 rating worse "
+                         f"({before.iso:.3f} -> {after.iso:.3f})")
+    return found, notes
 
 
 def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objective="l2",
-              integrator="legacy"):
+              integrator="legacy", anti_alias="auto"):
     """Calibrate the model on measured shots: the crush-factor law (the report's iteration,
     then least squares on the law's values, :func:`refine_law`), then the named parameters
-    (:func:`fit_parameters`).
+    (:func:`fit_parameters`), and its :func:`verdict`.
 
     Parameters
     ----------
     params : list of ShotParams
     traces : list of Trace
-        The measured pulse of each shot.
+        The measured pulse of each shot (zeroed, filtered and its impact level set by
+        :func:`~airgun_xl.studies.measured.prepare`).
     law : bool
     fit : sequence of str
         Names from :data:`FIT_PARAMETERS`.
+    anti_alias : float, "auto" or "none"
+        The recorders' anti-alias filter, modelled on the runs.
 
     Returns
     -------
@@ -394,51 +532,60 @@ def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objecti
     """
     import time
 
+    from .measured import alignment_shift, prepare
+
     started = time.perf_counter()
     counter = {"runs": 0}
-    pairs = list(zip(params, traces))
+    recs = [prepare(t, cfc, anti_alias, p.delta) for p, t in zip(params, traces, strict=True)]
+    pairs = list(zip(params, recs, strict=True))
 
     def run_all(ps):
         counter["runs"] += len(ps)
-        return [align(_run(p, integrator), t, cfc) for p, t in zip(ps, traces)]
+        return [align(_run(p, integrator), r) for p, r in zip(ps, recs, strict=True)]
 
     before = [score(a) for a in run_all(params)]
-    law_cal = None
+    law_cal, nodes, law_errors, span = None, None, None, None
     if law:
         law_cal = calibrate_law(pairs, cfc, degree, integrator)
         counter["runs"] += len(law_cal.iterations) * len(pairs)
-        refined, evaluations = refine_law(pairs, law_cal.law, cfc, objective, integrator,
-                                          degree)
+        refined, evaluations, nodes, law_errors = refine_law(pairs, law_cal.law, integrator,
+                                                             degree)
         counter["runs"] += evaluations * len(pairs)
         params = [p.replace(crush_law=refined) for p in params]
-        pairs = list(zip(params, traces))
-    fitted, start = {}, {}
+        pairs = list(zip(params, recs, strict=True))
+        span = refined.v_range
+    fitted, start, errors, bounds = {}, {}, {}, {}
     if fit:
         result = fit_parameters(pairs, fit, cfc, objective, integrator)
         counter["runs"] += result.evaluations * len(pairs)
         params, fitted, start = result.params, result.values, result.start
+        errors, bounds = result.errors, result.bounds
     aligned = run_all(params)
     after = [score(a) for a in aligned]
-    return Calibration(params, law_cal, fitted, start, before, after, aligned,
-                       counter["runs"], time.perf_counter() - started)
+    cal = Calibration(params, law_cal, fitted, start, before, after, aligned,
+                      counter["runs"], time.perf_counter() - started, errors, bounds, nodes,
+                      law_errors, span, recs)
+    for rec, p in zip(recs, params, strict=True):
+        cal.warnings += [f"{rec.trace.name}: {w}" for w in rec.warnings]
+        run = _run(p, integrator)
+        ok = np.isfinite(run.accel_kg)
+        said = alignment_shift(run.history.time[ok], run.accel_kg[ok], rec, "threshold",
+                               rec.anti_alias)[3]
+        cal.warnings += [f"{rec.trace.name}: {w}" for w in said]
+    found, cal.notes = verdict(cal, cfc, objective, params[0])
+    cal.warnings += found
+    return cal
 
 
 def synthetic_measurement(p, dt=1e-5, noise=0.01, ringing_hz=8000.0, ringing=0.1, seed=0,
                           integrator="legacy", name="synthetic"):
-    """A "measured" pulse made from known parameters ``p``: the run's test-item deceleration
-    sampled every ``dt`` [s], plus white noise (``noise`` x the peak, standard deviation) and
-    a decaying ringing at ``ringing_hz`` (``ringing`` x the peak, starting at the impact), as
-    a recorder's mount adds. Starts 0.5 ms before the impact, so the pre-trigger is seen."""
-    from ..workbook.trace import Trace
+    """A "measured" pulse made from known parameters ``p`` by the recorder model
+    (:class:`~airgun_xl.studies.recorder.Recorder`): sampled every ``dt`` [s] through a
+    4-pole anti-alias filter at a fifth of the rate, with white noise (``noise`` x the peak)
+    and a decaying mount ringing at ``ringing_hz`` (``ringing`` x the peak); 0.5 ms of
+    pre-trigger, no offset, the macro's sign, on a clock 2 ms ahead."""
+    from .recorder import Recorder
 
-    r = _run(p, integrator)
-    ok = np.isfinite(r.accel_kg)
-    t_run, a_run = r.history.time[ok], r.accel_kg[ok]
-    time = np.arange(-5e-4, t_run[-1], dt)
-    accel = np.interp(time, t_run, a_run, left=0.0)
-    peak = accel.max()
-    rng = np.random.default_rng(seed)
-    after = np.clip(time, 0, None)
-    ring = ringing * peak * np.sin(2 * np.pi * ringing_hz * after) * np.exp(-after / 1e-3)
-    accel = accel + np.where(time > 0, ring, 0.0) + noise * peak * rng.standard_normal(len(time))
-    return Trace(time + 0.002, accel, dt, name, ("s", "kG"))  # a recorder's own clock
+    rec = Recorder(rate=1 / dt, noise=noise, offset_g=0.0, pre_trigger=5e-4, sign=1.0,
+                   ringing=ringing, ringing_hz=ringing_hz)
+    return rec.record(_run(p, integrator), seed=seed, name=name)

@@ -51,7 +51,8 @@ class Rating:
 
     @property
     def grade(self):
-        return next(name for limit, name in GRADES if self.overall > limit)
+        """excellent, good, fair or poor; "n/a" for a rating that is not a number."""
+        return next((name for limit, name in GRADES if self.overall > limit), "n/a")
 
 
 def resample(time, values, start, end):

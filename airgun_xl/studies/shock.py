@@ -42,6 +42,33 @@ def cfc_coefficients(cfc, dt):
     return np.array([a0, 2 * a0, a0]), np.array([1.0, -b1, -b2])
 
 
+#: The J211 biquad's design frequency is 2.0775 x the class; its bilinear prewarp tan(wd dt/2)
+#: passes pi/2, and the poles leave the unit circle, below a sample rate of twice that.
+UNSTABLE_BELOW = 2 * 2.0775
+
+#: The sample rate J211-1 asks for a class, as analysis tools quote it: 10 x the class (about
+#: 6 x its -3 dB frequency, 1.65 x the class): 10 kHz for CFC 1000, 6 kHz for CFC 600.
+RECOMMENDED_RATE = 10.0
+
+
+def check_cfc(cfc, dt):
+    """Refuse a channel class whose J211 filter is unstable at step ``dt`` [s]; return the
+    warning (a list of one, or none) when the rate is below J211's recommendation."""
+    if cfc not in CFC_CLASSES:
+        cfc_coefficients(cfc, dt)  # its one-line error
+    rate = 1 / dt
+    if not rate > UNSTABLE_BELOW * cfc:
+        raise OptionError(f"--cfc: found {cfc} for a record sampled at {rate:,.0f} Hz, where "
+                          f"the J211 filter is unstable (below {UNSTABLE_BELOW:g} x the class,"
+                          f" {UNSTABLE_BELOW * cfc:,.0f} Hz); expected a lower class or a "
+                          "faster record")
+    if rate < RECOMMENDED_RATE * cfc:
+        return [f"--cfc: {cfc} on a record sampled at {rate:,.0f} Hz, below the "
+                f"{RECOMMENDED_RATE * cfc:,.0f} Hz J211 asks for the class: the filtered "
+                "pulse is rounded off more than the standard's corridor allows"]
+    return []
+
+
 def cfc_filter(values, dt, cfc):
     """``values`` filtered by channel class ``cfc``, forward and backward (phaseless).
 
@@ -50,15 +77,13 @@ def cfc_filter(values, dt, cfc):
     values : numpy.ndarray
         Samples at a constant step.
     dt : float
-        Sample step [s]; the CFC's 5/3 point must lie below half the sample rate.
+        Sample step [s]; the rate must pass :data:`UNSTABLE_BELOW` x ``cfc`` (:func:`check_cfc`).
     cfc : int
         60, 180, 600 or 1000 [Hz].
     """
     from scipy.signal import filtfilt
 
-    if not 2 * cfc * 5 / 3 < 1 / dt:
-        raise OptionError(f"--cfc: found {cfc}, expected a class below a third of the sample "
-                          f"rate ({1 / dt:,.0f} Hz)")
+    check_cfc(cfc, dt)
     b, a = cfc_coefficients(cfc, dt)
     return filtfilt(b, a, np.asarray(values, dtype=float))
 

@@ -15,7 +15,7 @@ from .charts import line_series, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
 from .law_sheet import write_law_sheet
 from .page_setup import not_printed, one_page
-from .sheets import write_about, write_number_columns
+from .sheets import write_about, write_number_columns, write_warnings
 from .writer import close_workbook, new_workbook, sheet_names, write_cells
 
 #: Fitted name -> (parameter cell (row, col), ShotParams field).
@@ -87,9 +87,31 @@ def write_calibration(path, shot, cal, files, options, force=False):
         ws.set_column(1, 5, 15)
         about = [(f"Shot {i}", f"{s} against {m}") for i, (s, m) in enumerate(files, start=1)]
         about += [("Filter", f"CFC {options.cfc}" if options.cfc else "none"),
-                  ("Objective", options.objective),
-                  ("Runs", f"{cal.runs} in {cal.seconds:.2f} s")]
+                  ("Objective", options.objective + (" (derivative-free from the L2 fit; the "
+                                                     "law by L2, rated by ISO)"
+                                                     if options.objective == "iso18571"
+                                                     else "")),
+                  ("Anti-alias model", "none" if not cal.recordings or
+                   cal.recordings[0].anti_alias is None else
+                   f"4-pole Butterworth at {cal.recordings[0].anti_alias:,.0f} Hz"),
+                  ("Runs", f"{cal.runs} in {cal.seconds:.2f} s"),
+                  ("Verdict", "trusted: every fitted value identified, within its bounds, "
+                   "and every residual improved" if cal.trusted else
+                   f"NOT TRUSTED: {len(cal.warnings)} warning"
+                   f"{'s' * (len(cal.warnings) > 1)} below")]
         row = write_about(ws, about, bold) + 1
+        row = write_warnings(wb, ws, row, cal.warnings, 5) + 2
+        for text in cal.notes:
+            ws.write_string(row - 1, 0, f"Note: {text}")
+            row += 1
+        for i, rec in enumerate(cal.recordings, start=1):
+            ws.write_string(row, 0, f"Shot {i}: baseline removed, pre-trigger noise")
+            ws.write_number(row, 1, rec.base.offset, num)
+            if rec.base.noise == rec.base.noise:
+                ws.write_number(row, 2, rec.base.noise, num)
+            ws.write_string(row, 3, "kG")
+            row += 1
+        row += 1
         lc = cal.law_calibration
         if lc is not None:
             ws.write_string(row, 0, "Crush-law iteration (report, section 3.2)", bold)
@@ -113,14 +135,24 @@ def write_calibration(path, shot, cal, files, options, force=False):
             ws.write_number(row, 2, law.v_range[1], num)
             row += 2
         if cal.fitted:
-            ws.write_row(row, 0, ["Fitted", "Start", "Fitted", "Change"], bold)
+            ws.write_row(row, 0, ["Fitted", "Start", "Fitted", "Change", "Standard error",
+                                  "At a bound"], bold)
+            sci = wb.add_format({"num_format": "0.0000E+00"})
             for name, value in cal.fitted.items():
                 row += 1
+                lo, hi = cal.bounds[name]
                 ws.write_string(row, 0, name)
-                ws.write_number(row, 1, cal.start[name])
-                ws.write_number(row, 2, value)
+                ws.write_number(row, 1, cal.start[name], sci)
+                ws.write_number(row, 2, value, sci)
                 ws.write_number(row, 3, value / cal.start[name] - 1 if cal.start[name]
                                 else 0.0, pct)
+                error = cal.errors.get(name, float("inf"))
+                if error == error and error != float("inf"):
+                    ws.write_number(row, 4, error, sci)
+                else:
+                    ws.write_string(row, 4, "not identified")
+                ws.write_string(row, 5, "YES" if min(value - lo, hi - value)
+                                <= 1e-3 * (hi - lo) else "no")
             row += 2
         ws.write_row(row, 0, ["Shot", "RMS error before", "after", "ISO/TS 18571 before",
                               "after"], bold)
@@ -129,8 +161,11 @@ def write_calibration(path, shot, cal, files, options, force=False):
             ws.write_number(row, 0, i)
             ws.write_number(row, 1, b.rms, pct)
             ws.write_number(row, 2, a.rms, pct)
-            ws.write_number(row, 3, b.iso, num)
-            ws.write_number(row, 4, a.iso, num)
+            for col, iso in ((3, b.iso), (4, a.iso)):
+                if iso == iso:
+                    ws.write_number(row, col, iso, num)
+                else:
+                    ws.write_string(row, col, "n/a (too short a pulse)")
         row += 2
 
         # the law against the macro's, over its range; the last iteration's samples

@@ -6,7 +6,7 @@ from ..transaction import atomic_path, check_output
 from .charts import line_series, log_axis, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
 from .page_setup import not_printed, one_page
-from .sheets import write_about, write_number_columns
+from .sheets import write_about, write_number_columns, write_warnings
 from .writer import close_workbook, new_workbook
 
 ROWS = (("Peak acceleration", "peak_kg", "kG", 1.0, "0.000"),
@@ -62,24 +62,50 @@ def _write_scores(wb, ws, c, head, bold, models):
     ws.write_number(row, 2, float(c.measured_srs.max()), score)
     ws.write_string(row, 3, "kG")
     ws.write_number(row, 4, c.errors["srs_peak"], pct)
+    row += 1
+    ws.write_string(row, 0, "SRS of the record")
+    ws.write_string(row, 1, c.srs_record)
     row += 2
     r = c.iso
     ws.write_row(row, 0, ["ISO/TS 18571", "Score"], bold)
     row += 1
-    for label, key in ISO_ROWS:
-        ws.write_string(row, 0, label)
-        ws.write_number(row, 1, getattr(r, key), score)
+    if r is None:
+        ws.write_string(row, 0, "Rating")
+        ws.write_string(row, 1, "not computed (see the warnings)")
         row += 1
-    ws.write_string(row, 0, "Grade")
-    ws.write_string(row, 1, r.grade)
-    row += 1
-    for label, value in (("Evaluation interval from (ms)", c.interval[0] * 1e3),
-                         ("Evaluation interval to (ms)", c.interval[1] * 1e3),
-                         ("Phase shift n_eps (samples at 10 kHz)", float(r.shift)),
-                         ("Correlation (Pearson r)", c.correlation),
-                         ("Shift of the measured time (ms)", c.shift * 1e3)):
+    else:
+        for label, key in ISO_ROWS:
+            ws.write_string(row, 0, label)
+            ws.write_number(row, 1, getattr(r, key), score)
+            row += 1
+        ws.write_string(row, 0, "Grade")
+        ws.write_string(row, 1, r.grade)
+        row += 1
+    ms = wb.add_format({"num_format": "0.0000"})
+    kg = wb.add_format({"num_format": "0.0000"})
+    rows = [("Evaluation interval from", c.interval[0] * 1e3, "ms", ms),
+            ("Evaluation interval to", c.interval[1] * 1e3, "ms", ms)]
+    if r is not None:
+        rows.append(("Phase shift n_eps", float(r.shift), "samples at 10 kHz",
+                     wb.add_format({"num_format": "0"})))
+    rows += [("Correlation (Pearson r)", c.correlation, "", score),
+             ("Shift of the measured time (used)", c.shift * 1e3, "ms", ms)]
+    for method, value in sorted(c.shifts.items()):
+        rows.append((f"Shift by {method}", value * 1e3, "ms", ms))
+    if c.baseline is not None:
+        rows += [("Baseline offset removed (pre-trigger median)", c.baseline.offset, "kG", kg),
+                 ("Pre-trigger noise (1 sigma)", c.baseline.noise, "kG", kg),
+                 ("Pre-trigger noise after the filter", c.noise_filtered, "kG", kg),
+                 ("Pre-trigger samples", float(c.baseline.samples), "",
+                  wb.add_format({"num_format": "#,##0"})),
+                 ("Impact level (fraction of the peak)", c.level, "", pct)]
+    rows.append(("Anti-alias model on the prediction", c.anti_alias or 0.0,
+                 "Hz (0: none)", wb.add_format({"num_format": "#,##0"})))
+    for label, value, unit, form in rows:
         ws.write_string(row, 0, label)
-        ws.write_number(row, 1, value)
+        if value == value:  # NaN (no pre-trigger) stays an empty cell
+            ws.write_number(row, 1, value, form)
+        ws.write_string(row, 3, unit)
         row += 1
     if c.rigid_kg is not None:
         ws.write_string(row, 0, f"Peak of the {models[1]} model (kG)")
@@ -139,6 +165,7 @@ def write_comparison(path, comparison, about, force=False, models=("4-mass", "ri
         ws.set_column(1, 4, 14)
         head = write_about(ws, about, bold) + 1
         row = _write_scores(wb, ws, c, head, bold, models)
+        row = write_warnings(wb, ws, row + 1, c.warnings, 4) + 1
 
         data = wb.add_worksheet("Traces", worksheet_class=ColumnsWorksheet)
         names = ["Time after impact (s)", "Predicted (kG)", "Measured (kG)"]

@@ -19,13 +19,16 @@ import numpy as np
 from .. import limits
 from ..errors import AirgunXlError, OptionError, WorkbookError
 from ..transaction import display
+from ..units import KG_MS2, G
 from .guard import read_bytes
 
 #: Time units [s per unit].
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
 
-#: Acceleration units [kG per unit]. 1 kG is 9800 m/s^2, as the macro's Acceleration (kG's).
-ACCEL_UNITS = {"g": 1e-3, "kg": 1.0, "m/s^2": 1 / 9800, "m/s2": 1 / 9800}
+#: Acceleration units [kG per unit]: a recorder's g is standard gravity (units.G, 9.80665
+#: m/s^2); the kG is the macro's, 9800 m/s^2 (its Acceleration (kG's) column), so 1 g is
+#: 1.000679e-3 kG. The macro's 9800 applies to the macro's columns only.
+ACCEL_UNITS = {"g": G / KG_MS2, "kg": 1.0, "m/s^2": 1 / KG_MS2, "m/s2": 1 / KG_MS2}
 
 #: A step may differ from the median step by this fraction before it is a gap.
 GAP_TOLERANCE = 0.01
@@ -73,8 +76,41 @@ def _unit(header, table, option, which):
     return key
 
 
+def _number(text, decimal_comma):
+    text = text.strip()
+    return float(text.replace(",", ".") if decimal_comma else text)
+
+
+def _is_pair(row, decimal_comma):
+    """Whether a row starts with two numbers."""
+    if len(row) < 2:
+        return False
+    try:
+        _number(row[0], decimal_comma)
+        _number(row[1], decimal_comma)
+    except ValueError:
+        return False
+    return True
+
+
+def _dialect(lines):
+    """(delimiter, decimal comma) of a data-acquisition export's data lines: ``;`` or a tab
+    with a decimal comma (``1,5;0,25``), or a comma, semicolon or tab with a point."""
+    sample = [line for line in lines if line.strip() and not line.lstrip().startswith("#")]
+    sample = sample[-50:]  # data lines, past any metadata and the header
+    for delimiter in (";", "\t", ","):
+        if sample and all(line.count(delimiter) >= 1 for line in sample):
+            comma = delimiter != "," and any("," in line for line in sample)
+            return delimiter, comma
+    return ",", False
+
+
 def _table(path, expected, columns):
-    """(shown name, header, n x 2 values) of a two-column CSV; every row checked."""
+    """(shown name, header, n x 2 values) of a two-column CSV; every row checked.
+
+    Data-acquisition exports are read as they come: ``#`` comment lines and other metadata
+    lines above the header are skipped (the header is the row above the first row of two
+    numbers); ``,``, ``;`` or tab delimiters; a decimal comma with ``;`` or tabs."""
     shown = display(Path(path))
     data = read_bytes(path, expected, "CSV")
     try:
@@ -82,27 +118,48 @@ def _table(path, expected, columns):
     except UnicodeDecodeError as exc:
         raise WorkbookError(f"{shown}: is not UTF-8 text (byte {exc.start}), {expected}") \
             from None
+    lines = text.splitlines()
+    if len(lines) > limits.MAX_SAMPLES + 1000:  # counted before any parsing: a bounded read
+        raise WorkbookError(f"{shown}: holds {len(lines):,} lines, expected at most "
+                            f"{limits.MAX_SAMPLES:,} samples")
+    delimiter, comma = _dialect(lines)
     try:
-        dialect = csv.Sniffer().sniff(text[:4096], delimiters=",;\t")
-    except csv.Error:
-        dialect = csv.excel
-    rows = list(csv.reader(io.StringIO(text), dialect))
-    rows = [r for r in rows if any(cell.strip() for cell in r)]
-    if len(rows) < 2 or len(rows[0]) < 2:
-        raise WorkbookError(f"{shown}: holds {len(rows)} rows of {len(rows[0]) if rows else 0} "
-                            f"columns, {expected}")
-    values = np.empty((len(rows) - 1, 2))
-    for i, row in enumerate(rows[1:], start=2):
+        rows = list(csv.reader(lines, delimiter=delimiter))
+    except csv.Error as exc:  # a field past csv's limit, a stray quote
+        raise WorkbookError(f"{shown}: is not a readable CSV ({exc}), {expected}") from None
+    numbered = [(i, r) for i, r in enumerate(rows, start=1)
+                if any(cell.strip() for cell in r) and not r[0].lstrip().startswith("#")]
+    first = next((k for k, (_, r) in enumerate(numbered) if _is_pair(r, comma)), None)
+    if first is None and len(numbered) >= 2:  # a header, then a row that is not two numbers
+        line, row = numbered[1]
+        raise WorkbookError(f"{shown}: line {line} holds {row[:2]!r}, expected two numbers "
+                            f"({columns[0]}, {columns[1]})")
+    if first is None or first == 0:
+        got = numbered[0] if numbered else (len(rows), [])
+        raise WorkbookError(f"{shown}: line {got[0]} holds {got[1][:3]!r}, {expected}; found "
+                            + ("no header row above the numbers" if first == 0 else
+                               f"no row of two numbers ({delimiter!r}-delimited"
+                               + (", decimal comma" if comma else "") + ")"))
+    header_line, header = numbered[first - 1]
+    if len(header) < 2:
+        raise WorkbookError(f"{shown}: line {header_line} (the header) holds {header!r}, "
+                            f"{expected}")
+    body = numbered[first:]
+    if len(body) > limits.MAX_SAMPLES:
+        raise WorkbookError(f"{shown}: holds {len(body):,} rows, expected at most "
+                            f"{limits.MAX_SAMPLES:,} samples")
+    values = np.empty((len(body), 2))
+    for k, (line, row) in enumerate(body):
         try:
-            a, b = float(row[0]), float(row[1])
+            a, b = _number(row[0], comma), _number(row[1], comma)
         except (ValueError, IndexError):
-            raise WorkbookError(f"{shown}: row {i} holds {row[:2]!r}, expected two numbers "
+            raise WorkbookError(f"{shown}: line {line} holds {row[:2]!r}, expected two numbers "
                                 f"({columns[0]}, {columns[1]})") from None
         if not (math.isfinite(a) and math.isfinite(b)):
-            raise WorkbookError(f"{shown}: row {i} holds {row[0].strip()}, {row[1].strip()}, "
-                                "expected finite numbers (no NaN or inf)")
-        values[i - 2] = a, b
-    return shown, rows[0], values
+            raise WorkbookError(f"{shown}: line {line} holds {row[0].strip()}, "
+                                f"{row[1].strip()}, expected finite numbers (no NaN or inf)")
+        values[k] = a, b
+    return shown, header, values
 
 
 #: ``FILE:SHEET!COL:COL``: a column range of a workbook.

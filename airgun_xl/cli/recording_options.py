@@ -1,0 +1,33 @@
+"""The options of a measured recording, defined once for every command that reads one
+(compare-measured, calibrate): its channel, units, sign, the CFC filter and the recorder's
+anti-alias model."""
+
+
+def anti_alias_value(text):
+    """``--anti-alias``: a frequency in Hz, ``auto`` or ``none`` (checked against the rates
+    once they are known: studies.measured.check_anti_alias)."""
+    lowered = str(text).strip().lower()
+    if lowered in ("auto", "none"):
+        return lowered
+    try:
+        return float(text)
+    except ValueError:
+        return text  # refused by check_anti_alias, naming the option
+
+
+def add_recording_options(p, channel_help="TDMS only: the channel (default: the first "
+                                          "waveform channel)"):
+    p.add_argument("--channel", metavar="GROUP/CHANNEL", help=channel_help)
+    p.add_argument("--cfc", type=int, default=None,
+                   help="filter both pulses: SAE J211 class 60, 180, 600 or 1000 (refused "
+                        "where the filter is unstable, below 4.155 x the class in samples a "
+                        "second; a warning below J211's 10 x)")
+    p.add_argument("--sign", type=float, default=1.0, choices=(1.0, -1.0),
+                   help="-1 when the recorder's axis is opposite to the macro's")
+    p.add_argument("--time-unit", help="s, ms or us (default: from the header)")
+    p.add_argument("--accel-unit", help="g, kG or m/s^2 (default: from the header); g is "
+                                        "standard gravity, 9.80665 m/s^2")
+    p.add_argument("--anti-alias", type=anti_alias_value, default="auto", metavar="HZ",
+                   help="the recorder's anti-alias filter, modelled on the prediction as a "
+                        "4-pole Butterworth at HZ: auto (a fifth of the record's rate, the "
+                        "default), a frequency, or none")
