@@ -101,11 +101,15 @@ def _run(p, integrator):
     return Shot(p).run(integrator=integrator, track=TRACK)
 
 
-def align(result, rec):
+def align(result, rec, nudge=0.0):
     """The run's pulse on the measured :class:`~airgun_xl.studies.measured.Recording`'s grid,
     both filtered alike (its CFC class, and its anti-alias model on the run) and aligned at
     the impact instant (where each first holds the recording's level, a fraction of its peak
     above the noise).
+
+    ``nudge`` [s] is added to the threshold's shift: the law's least squares fits it, as a
+    threshold crossing on a noisy rise can miss by a fraction of a sample, which the steep
+    rise turns into a large residual.
 
     Every measured sample is kept (the run is at rest before it starts and holds its last
     value after), so the residuals of two runs have the same length."""
@@ -113,7 +117,7 @@ def align(result, rec):
     ok = np.isfinite(result.accel_kg)
     t_run, a_run = h.time[ok], result.accel_kg[ok]
     trace = rec.trace
-    shift = threshold_shift(t_run, a_run, rec, rec.anti_alias)[0]
+    shift = threshold_shift(t_run, a_run, rec, rec.anti_alias)[0] + nudge
     t = trace.time + shift
     if ((t >= t_run[0]) & (t <= t_run[-1])).sum() < 16:
         raise OptionError("the aligned traces overlap in fewer than 16 samples, expected the "
@@ -252,29 +256,52 @@ def refine_law(pairs, law, integrator="legacy", degree=DEGREE):
     from scipy.optimize import least_squares
 
     nodes = _chebyshev_nodes(*law.v_range, degree + 1)
-    x0 = law.poly(nodes)
+    x0 = np.concatenate([law.poly(nodes), np.zeros(len(pairs))])
+    steps = np.array([rec.trace.dt for _, rec in pairs])
     evaluations = [0]
 
     def residuals(x):
         evaluations[0] += 1
-        trial = law_through(nodes, x, law.v_range)
-        aligned = [align(_run(p.replace(crush_law=trial), integrator), trace)
-                   for p, trace in pairs]
+        trial = law_through(nodes, x[:len(nodes)], law.v_range)
+        aligned = [align(_run(p.replace(crush_law=trial), integrator), rec, nudge * dt)
+                   for (p, rec), nudge, dt in zip(pairs, x[len(nodes):], steps, strict=True)]
         return _objective_residuals(aligned, "l2")
 
-    fit = least_squares(residuals, x0, x_scale=np.abs(x0), diff_step=1e-4, max_nfev=100)
-    return (law_through(nodes, fit.x, law.v_range), evaluations[0], nodes,
-            standard_errors(fit))
+    # the law's values, and each shot's alignment nudged within 2 samples of the threshold's
+    lo = np.concatenate([np.full(len(nodes), -np.inf), np.full(len(pairs), -2.0)])
+    hi = np.concatenate([np.full(len(nodes), np.inf), np.full(len(pairs), 2.0)])
+    scale = np.concatenate([np.abs(x0[:len(nodes)]), np.full(len(pairs), 0.1)])
+    fit = least_squares(residuals, x0, bounds=(lo, hi), x_scale=scale, diff_step=1e-4,
+                        max_nfev=150)
+    return (law_through(nodes, fit.x[:len(nodes)], law.v_range), evaluations[0], nodes,
+            standard_errors(fit)[:len(nodes)])
+
+
+def correlation_time(r):
+    """The integrated autocorrelation time of residuals ``r`` [samples]: 1 + 2 sum of their
+    autocorrelations, summed until it first turns negative. Filtered pulses' residuals are
+    correlated over the filter's length, so each carries less than a sample's information."""
+    r = np.asarray(r, dtype=float) - np.mean(r)
+    if len(r) < 4 or not np.any(r):
+        return 1.0
+    f = np.fft.rfft(r, 2 * len(r))
+    acf = np.fft.irfft(f * np.conj(f))[:len(r)]
+    acf /= acf[0]
+    stop = np.flatnonzero(acf[1:] < 0)
+    tail = acf[1:1 + (stop[0] if len(stop) else len(r) - 1)]
+    return float(max(1.0, 1 + 2 * tail.sum()))
 
 
 def standard_errors(fit):
     """Standard errors of a least-squares fit's parameters from its Jacobian: the square roots
-    of the diagonal of s^2 (J^T J)^-1, s^2 = 2 cost / (residuals - parameters). A singular
-    J^T J (a parameter the residuals do not see) gives an infinite error."""
+    of the diagonal of s^2 (J^T J)^-1, s^2 = 2 cost / (residuals - parameters), widened by the
+    residuals' :func:`correlation_time` (correlated residuals, as a filter leaves them, count
+    as fewer). A singular J^T J (a parameter the residuals do not see) gives an infinite
+    error."""
     J = np.asarray(fit.jac, dtype=float)
     m, n = J.shape
     dof = max(m - n, 1)
-    s2 = 2 * float(fit.cost) / dof
+    s2 = 2 * float(fit.cost) / dof * correlation_time(fit.fun)
     try:
         cov = np.linalg.inv(J.T @ J) * s2
         out = np.sqrt(np.clip(np.diag(cov), 0, None))
@@ -445,7 +472,7 @@ UNIDENTIFIED = 0.5
 POOR_FIT = 0.10
 
 #: A value within this fraction of its range from a bound is at the bound.
-AT_BOUND = 1e-3
+AT_BOUND = 0.01
 
 
 def verdict(cal, cfc, objective, p0):

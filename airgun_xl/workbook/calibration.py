@@ -10,6 +10,7 @@ and after, the law against the macro's (the report's Figs. 7-8) and the first sh
 import numpy as np
 
 from ..crush_law import LEGACY_LAW
+from ..studies.calibrate import AT_BOUND
 from ..transaction import atomic_path, check_output
 from .charts import line_series, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
@@ -152,7 +153,7 @@ def write_calibration(path, shot, cal, files, options, force=False):
                 else:
                     ws.write_string(row, 4, "not identified")
                 ws.write_string(row, 5, "YES" if min(value - lo, hi - value)
-                                <= 1e-3 * (hi - lo) else "no")
+                                <= AT_BOUND * (hi - lo) else "no")
             row += 2
         ws.write_row(row, 0, ["Shot", "RMS error before", "after", "ISO/TS 18571 before",
                               "after"], bold)
