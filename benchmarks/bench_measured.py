@@ -8,8 +8,8 @@ The "measured" pulses are recordings of the recorder model (studies/recorder.py:
 pre-trigger, the axis reversed, CSV in ms and g with metadata lines) of runs under known
 parameters. Each command runs in-process after a warm-up (medians of N) and once as a fresh
 process (imports included). Issue 19's targets: compare-measured <= 1 s; a calibration of
-three shots <= 10 s, in-process. A fresh process adds the imports: about 1.6 s of it is scipy.signal alone (it
-imports scipy.stats), whichever command uses it.
+three shots <= 10 s, in-process. A fresh process adds the imports: about 1.6 s of it is
+scipy.signal alone (it imports scipy.stats), whichever command uses it.
 """
 import contextlib
 import io

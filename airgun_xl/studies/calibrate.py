@@ -476,10 +476,12 @@ AT_BOUND = 0.01
 
 
 def verdict(cal, cfc, objective, p0):
-    """(warnings, notes) of a calibration. Warnings: a value at a bound or with a standard
-    error past :data:`UNIDENTIFIED` of it; zeta fitted through a filter that removes the modes it damps;
-    the law used past the velocities its samples cover; a law that did not converge; a shot
-    whose residual (or, for the ISO objective, rating) got worse. Notes: a law measured below
+    """(warnings, notes) of a calibration.
+
+    Warnings: a value at a bound, or with a standard error past :data:`UNIDENTIFIED` of it;
+    zeta fitted through a filter that removes the modes it damps; a law that did not converge
+    or whose values the pulses do not pin down; a shot whose residual (or, for the ISO
+    objective, rating) got worse, or stays past :data:`POOR_FIT`. Notes: a law measured below
     the shots' impact speed (the law claims only its samples' span)."""
     from ..engine.summary import natural_frequencies
 
