@@ -2,6 +2,7 @@
 import json
 import os
 import random
+import re
 import shutil
 import signal
 import subprocess
@@ -300,3 +301,27 @@ def test_a_final_mass_outside_has_no_time_not_an_error_cell(tmp_path, capsys, ap
     assert final[7] == rows + 2 and final[8] == "n/a"
     with zipfile.ZipFile(report) as z:
         assert "#NUM!" not in z.read("xl/worksheets/sheet1.xml").decode()
+
+
+def test_an_archived_run_keeps_its_warnings_and_show_prints_units(tmp_path, capsys):
+    """Issue 18.1 and 18.10: the warnings a fill prints are in the entry's summary.json and
+    in `show`; `show` prints each figure with its unit (no bare 0.00029000000000000044)."""
+    shot = tmp_path / "shot.xlsx"
+    shutil.copy(TEMPLATE, shot)
+    wb = openpyxl.load_workbook(shot)
+    wb["Sheet1"]["E6"] = 1e-3
+    wb["Sheet1"]["A28"] = 300  # past the crush law's 250 m/s
+    wb.save(shot)
+    archive = tmp_path / "archive"
+    assert main(["fill", str(shot), "--only", "summary", "--archive", str(archive)]) == 0
+    printed = [line.removeprefix("airgun-xl: warning: ")
+               for line in capsys.readouterr().err.splitlines()]
+    assert printed and all(line for line in printed)
+    entry = Archive(archive).entries()[0]
+    assert entry.load("summary.json")["warnings"] == printed
+    assert main(["show", entry.ref, "--archive", str(archive)]) == 0
+    out = capsys.readouterr().out
+    assert f"warnings: {len(printed)}" in out and all(f"  - {w}" in out for w in printed)
+    assert re.search(r"time_of_peak\s+0\.\d{4} ms", out)
+    assert re.search(r"peak_kg\s+[\d,]+\.\d{5} kG", out)
+    assert "0.00029000000000000044" not in out
