@@ -60,6 +60,15 @@ def test_yield_stress_in_psi_is_named_and_so_is_the_negative_length(tmp_path, ca
     ws_text = [k for k in summary if isinstance(k, str)]
     for line in warnings:
         assert line.removeprefix("airgun-xl: warning: ") in ws_text
+    # the figures those warnings doubt are flagged where they are shown
+    ws = openpyxl.load_workbook(tmp_path / "o.xlsx")["Summary"]
+    notes = {r[0].value: (r[3].value or "", r[1].fill.fgColor.rgb) for r in ws.iter_rows()
+             if r[0].value}
+    for label, cells in (("Final mitigator length", "E40, E19"), ("Maximum crush", "E40, E19"),
+                         ("Peak acceleration (raw)", "E40;")):  # E19 doubts the crush only
+        assert notes[label][0].startswith(f"DOUBTED: see the warnings on {cells}"), label
+        assert notes[label][1].endswith("FFC7CE")
+    assert not notes["OBR chain natural frequency 1 (initial masses)"][0].startswith("DOUBTED")
 
 
 @pytest.mark.parametrize("cell", [c for c in CELLS if c.plausible], ids=lambda c: c.address)

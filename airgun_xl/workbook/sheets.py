@@ -180,10 +180,9 @@ def _summary_rows(result, summary, timings):
     for i in range(3):
         value = s.spectrum.peaks[i] if i < len(s.spectrum.peaks) else None
         rows.append((f"Dominant frequency {i + 1}", value, "Hz",
-                     "local maxima of the amplitude spectrum past the pulse's own lobe "
-                     f"(from {s.spectrum.band_start:,.0f} Hz; shoulders of it above "
-                     f"{PEAK_MIN_HZ:,.0f} Hz left out), most prominent first (log prominence); "
-                     "marked on the FFT chart" if i == 0 else ""))
+                     "local maxima of the spectrum past the pulse's own lobe (from "
+                     f"{s.spectrum.band_start:,.0f} Hz), most prominent first; marked on the "
+                     "FFT chart" if i == 0 else ""))
     for label, freqs in (("initial", s.natural_initial), ("final", s.natural_final)):
         for i, f in enumerate(freqs):
             rows.append((f"OBR chain natural frequency {i + 1} ({label} masses)", f, "Hz",
@@ -237,7 +236,7 @@ def write_summary(wb, result, summary, timings, name="Summary"):
     ws.set_column(0, 0, 44)
     ws.set_column(1, 1, 16)
     ws.set_column(2, 2, 6)
-    ws.set_column(3, 3, 80)
+    ws.set_column(3, 3, 100)
     bold = wb.add_format({"bold": True})
     formats = {code: wb.add_format({"num_format": fmt, "align": "right"})
                for code, (_, _, fmt) in DISPLAY.items() if fmt}
@@ -245,12 +244,20 @@ def write_summary(wb, result, summary, timings, name="Summary"):
     for col, heading in enumerate(("Quantity", "Value", "Unit", "Definition")):
         ws.write_string(0, col, heading, bold)
     rows = _summary_rows(result, summary, timings)
+    flags = flagged_figures(timings.get("warnings", []))
+    flagged = {code: wb.add_format({"num_format": fmt, "align": "right", "bg_color": "#FFC7CE",
+                                    "font_color": "#9C0006"})
+               for code, (_, _, fmt) in DISPLAY.items() if fmt}
     for row, (label, value, code, note) in enumerate(rows, 1):
         unit, factor, _ = DISPLAY[code]
         ws.write_string(row, 0, label)
+        if label in flags:  # a figure the warnings below put in doubt, flagged where shown
+            note = f"DOUBTED: see the warnings on {', '.join(flags[label])}" + (
+                f"; {note}" if note else "")
         if isinstance(value, (float, int, np.floating, np.integer)) and not isinstance(value,
                                                                                          bool):
-            ws.write_number(row, 1, float(value) * factor, formats.get(code))
+            ws.write_number(row, 1, float(value) * factor,
+                            (flagged if label in flags else formats).get(code))
         elif isinstance(value, datetime.datetime):
             ws.write_string(row, 1, value.isoformat(), text)
         elif value is not None:
@@ -265,8 +272,33 @@ def write_summary(wb, result, summary, timings, name="Summary"):
     return ws
 
 
+#: The Summary's figures each warning puts in doubt, by the cell the warning names: the crush
+#: and the masses for the mitigator's own cells; every acceleration figure for the rest (the
+#: crush law's range, the unloading quirk, the step, an implausible input).
+_CRUSH_FIGURES = ("Maximum crush", "Final mitigator length", "Final M1", "Final m31")
+_PULSE_FIGURES = ("Peak acceleration (raw)", "Time of peak", "Peak acceleration (filtered)",
+                  "Time of filtered peak", "Pulse duration", "Pulse start", "Pulse end")
+_DOUBTED = {"E19": _CRUSH_FIGURES, "E25": _CRUSH_FIGURES[2:],
+            "E34": ("Peak acceleration (filtered)", "Time of filtered peak")}
+
+
+def flagged_figures(warnings):
+    """{Summary label: [cells of the warnings that doubt it]} for a run's warnings (each
+    starts with the cell it names, as ``E19 (...)``); a warning naming no cell doubts none."""
+    out = {}
+    for text in warnings:
+        cell = text.split(" ", 1)[0]
+        if not (cell[:1].isalpha() and cell[1:].isdigit()):
+            continue
+        for label in _DOUBTED.get(cell, _PULSE_FIGURES + _CRUSH_FIGURES):
+            out.setdefault(label, [])
+            if cell not in out[label]:
+                out[label].append(cell)
+    return out
+
+
 #: Characters a line of a merged warning row holds, across the Summary's printed width.
-WARNING_LINE_CHARS = 130
+WARNING_LINE_CHARS = 150
 
 
 def write_warnings(wb, ws, row, warnings, last_col):
