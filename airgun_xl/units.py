@@ -2,6 +2,7 @@
 us (or µs) and ns."""
 import math
 import re
+from decimal import Decimal
 
 from .errors import OptionError
 
@@ -32,7 +33,8 @@ def parse_duration(text, option="--target-duration"):
     if not match:
         raise OptionError(f"{option}: found {text!r}, expected a duration such as 5ms, 500us")
     unit = match.group(2) or "s"
-    value = float(match.group(1) + _TIME[unit]) if unit != "s" else float(match.group(1))
+    # the decimal product, rounded once: "5e0us" and "5us" give float("5e-6"), as typed in s
+    value = float(Decimal(match.group(1)) * Decimal("1" + _TIME[unit]))
     if not (value > 0 and math.isfinite(value)):
         raise OptionError(f"{option}: found {text!r}, expected a positive duration")
     return value

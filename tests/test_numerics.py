@@ -211,6 +211,8 @@ def test_damped_relative_motion_against_the_closed_form():
 def test_ladders_and_durations():
     assert parse_duration("500ns") == 5e-7 and parse_duration("2us") == 2e-6
     assert parse_duration("0.006") == 0.006
+    # issue 23.11: an exponent and a unit (it appended "e-6" to "5e0", a regression)
+    assert parse_duration("5e0us") == 5e-6 and parse_duration("4.5e0ms") == 0.0045
     with pytest.raises(OptionError):
         parse_duration("fast")
     assert default_ladder(5e-7) == [5e-7, 2e-7, 1e-7, 5e-8, 2e-8, 1e-8, 5e-9]
