@@ -165,3 +165,37 @@ def test_correlation_time_against_an_ar1_closed_form():
     for k in range(1, len(e)):
         x[k] = 0.5 * x[k - 1] + e[k]
     assert correlation_time(x) == pytest.approx(3.0, rel=0.1)
+
+
+def test_compare_warnings_are_in_its_workbook(tmp_path, capsys):
+    """Issue 18.1: what compare-measured warns (here: 0.5 ms of pre-trigger, too little for a
+    baseline, and CFC 1000 on an 8 kHz record, below the 10 x the class J211 asks for) is
+    listed under the scores of the Compared sheet too."""
+    rec = Recorder(rate=8_000.0, pre_trigger=5e-4)
+    trace = rec.record(airgun_xl.Shot(_shot(243.53532)).run(track=()), seed=2)
+    path = rec.csv(trace, tmp_path / "short.csv")
+    out = tmp_path / "c.xlsx"
+    assert main(["compare-measured", str(TEMPLATE), str(path), "--sign", "-1", "--cfc", "1000",
+                 "-o", str(out)]) == 0
+    printed = [line.removeprefix("airgun-xl: warning: ")
+               for line in capsys.readouterr().err.splitlines()]
+    assert any("before the pulse, fewer than 16" in w for w in printed)
+    assert any("below the 10,000 Hz J211 asks for" in w for w in printed)
+    cells = [c for r in openpyxl.load_workbook(out)["Compared"].iter_rows(values_only=True)
+             for c in r if isinstance(c, str)]
+    assert f"Warnings ({len(printed)})" in cells
+    assert all(w in cells for w in printed)
+
+
+def test_an_unstable_cfc_is_refused_in_one_line(tmp_path, capsys):
+    """Issue 19.3: the J211 biquad's poles leave the unit circle below 4.155 x the class; CFC
+    1000 on a 4 kHz record gave a step response of 8e11. It is refused, naming the limit."""
+    rec = Recorder(rate=4_000.0, anti_alias=800.0)
+    trace = rec.record(airgun_xl.Shot(_shot(243.53532)).run(track=()), seed=2)
+    path = rec.csv(trace, tmp_path / "slow.csv")
+    out = tmp_path / "c.xlsx"
+    assert main(["compare-measured", str(TEMPLATE), str(path), "--sign", "-1", "--cfc", "1000",
+                 "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "unstable (below 4.155 x the class, 4,155 Hz)" in err
+    assert not out.exists()
