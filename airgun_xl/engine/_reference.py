@@ -12,15 +12,17 @@ yPrime2) so that the three can be read side by side.
 """
 import math
 
+from .interface import FINAL_COUNT, PARAM_COUNT
+
 #: The macro's value of pi (3.141592653, not math.pi).
 PI_MACRO = 3.141592653
 
-# Parameter order: the C enum (P_M1 .. P_BOUND).
+# Parameter order: engine/interface.py's PARAMS, as the C enum (tests/test_kernel_interface.py).
 (P_M1, P_M31, P_M32, P_M33, P_K2, P_K3, P_DELTA, P_RHO, P_RCONE, P_HCONE, P_HCYL, P_MMIT,
  P_VCONE, P_E, P_EC, P_SIGMAY, P_ZETA, P_V1, P_V31, P_V32, P_V33, P_LAW0, P_LAW1, P_LAW2,
- P_LAW3, P_LAW4, P_LAW5, P_LAW6, P_UNLOAD, P_BOUND) = range(30)
-P_COUNT = 30
-N_FINALS = 10
+ P_LAW3, P_LAW4, P_LAW5, P_LAW6, P_UNLOAD, P_BOUND) = range(PARAM_COUNT)
+P_COUNT = PARAM_COUNT
+N_FINALS = FINAL_COUNT
 
 
 def _div(a, b):

@@ -12,7 +12,8 @@ import numpy as np
 
 from .derived import KG_DIVISOR
 from .filtered import filter_stencils, filtered_values
-from .integrators import KernelStats, displacement_bound, kernel_params
+from .integrators import displacement_bound, kernel_params, kernel_stats
+from .interface import FINAL_COUNT, FINALS, final
 from .kernel import batch_kernel
 from .summary import KG, PULSE_FRACTION
 
@@ -20,7 +21,7 @@ from .summary import KG, PULSE_FRACTION
 FIGURES = ("peak_kg", "time_of_peak", "filtered_peak_kg", "pulse_duration", "max_crush")
 
 _INTEGRATOR_ID = {"legacy": 0, "newmark": 1}
-N_FINALS = 10  # the kernel's finals a shot (_artsim.c, finish_run)
+N_FINALS = FINAL_COUNT  # the kernel's finals a shot (engine/interface.py)
 BLOCK = 128  # shots a block: bounds memory at rows x 128 doubles (12 MB for shot A)
 
 
@@ -72,19 +73,14 @@ def run_batch(params, integrator="legacy", host="excel", threads=2, progress=Non
                 figures[block] = figs
                 diverged[block] = bad
                 for i, row, stopped in zip(block, finals, bad, strict=True):
-                    stats[i] = None if stopped else kernel_stats(row)
+                    stats[i] = None if stopped else kernel_stats(
+                        dict(zip((name for name, _ in FINALS), row, strict=True)))
                 if progress is not None:
                     progress(len(block))
     finally:
         if pool is not None:
             pool.shutdown()
     return Batch(figures, diverged, stats)
-
-
-def kernel_stats(finals):
-    """The :class:`~airgun_xl.engine.integrators.KernelStats` of one shot's finals row."""
-    return KernelStats(float(finals[3]), float(finals[4]), float(finals[5]), float(finals[6]),
-                       float(finals[7]), None, int(finals[8]), int(finals[9]))
 
 
 def _run_block(block, integrator, stencils, pool):
@@ -109,7 +105,7 @@ def _run_block(block, integrator, stencils, pool):
 def _figures(y, t, finals, p0, stencils):
     """FIGURES of each row of ``y`` (the bird's last mass), as one shot's are computed."""
     m, rows = y.shape
-    bad = finals[:, 2] >= 0
+    bad = finals[:, final("bad_row")] >= 0
     out = np.full((m, len(FIGURES)), np.nan)
     if rows >= 3:
         # as derived.test_item_derivatives, one shot a row
@@ -127,6 +123,6 @@ def _figures(y, t, finals, p0, stencils):
     if inside.any():
         values = filtered_values(y, p0.delta, p0.samplerate, stencils)[:, inside]
         out[:, 2] = np.max(values / KG, axis=1)
-    out[:, 4] = finals[:, 7]
+    out[:, 4] = finals[:, final("max_crush")]
     out[bad] = np.nan
     return out, bad

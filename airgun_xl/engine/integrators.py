@@ -14,12 +14,11 @@ import numpy as np
 
 from .. import choices
 from ..errors import CellError, DivergenceError, OptionError
+from .interface import FINALS, SHOT_FIELDS
 from .kernel import legacy_kernel, newmark_kernel
 
-#: Order of the parameters the compiled kernel takes (``_artsim.c``, enum at its top).
-KERNEL_PARAMS = ("m1", "m31", "m32", "m33", "k2", "k3", "delta", "rho", "rcone", "hcone",
-                 "hcylinder", "mmitigator", "vcone", "E", "ec", "sigmay", "zeta", "v1", "v31",
-                 "v32", "v33")
+#: The shot's fields the kernels take, in their order (:mod:`~airgun_xl.engine.interface`).
+KERNEL_PARAMS = SHOT_FIELDS
 
 
 @dataclass
@@ -121,6 +120,16 @@ class History:
 TRACKED = choices.TRACKED
 
 
+def kernel_stats(finals, past_bound=None):
+    """The :class:`KernelStats` of a run's finals (a mapping by name of
+    :data:`~airgun_xl.engine.interface.FINALS`)."""
+    return KernelStats(float(finals["x_plastic"]), float(finals["max_relative_velocity"]),
+                       float(finals["min_relative_velocity"]),
+                       float(finals["max_crushed_mass"]), float(finals["max_crush"]),
+                       past_bound, int(finals["unloading_onsets"]),
+                       int(finals["second_onset"]))
+
+
 def displacement_bound(p):
     """Largest |displacement| a physical run can reach [m]: ten times the free flight at the
     fastest initial speed plus the mitigator length, plus 1 m. Beyond it the scheme diverged."""
@@ -148,10 +157,10 @@ def _run(kernel, name, p, track):
         np.full(rows, np.nan) if key in track else None for key in TRACKED]
     values = kernel_params(p) + [displacement_bound(p)]
     started = time.perf_counter()
-    (final_m1, final_m31, bad, x_plastic, max_v, min_v, max_crushed, max_crush, onsets,
-     second) = kernel(values, rows, *arrays)
+    f = dict(zip((name for name, _ in FINALS), kernel(values, rows, *arrays), strict=True))
     elapsed = time.perf_counter() - started
-    if bad >= 0 and p.hcone == 0 and not x_plastic > 0:
+    bad = f["bad_row"]
+    if bad >= 0 and p.hcone == 0 and not f["x_plastic"] > 0:
         raise no_wedge_error(p, bad)
     past_bound = None
     if bad >= 0:
@@ -161,15 +170,13 @@ def _run(kernel, name, p, track):
         # the macro's quirk threw the run past the physical bound: run on as the macro
         # does, stopping only where a value stops being finite (the checks name the quirk)
         values[-1] = math.inf
-        (final_m1, final_m31, bad, x_plastic, max_v, min_v, max_crushed, max_crush, onsets,
-         second) = kernel(values, rows, *arrays)
+        f = dict(zip((name for name, _ in FINALS), kernel(values, rows, *arrays), strict=True))
         elapsed = time.perf_counter() - started
-        if bad >= 0:
-            raise divergence_error(name, p, bad, arrays)
+        if f["bad_row"] >= 0:
+            raise divergence_error(name, p, f["bad_row"], arrays)
         past_bound = error.row
-    history = History(*arrays, final_m1, final_m31, elapsed)
-    history.stats = KernelStats(x_plastic, max_v, min_v, max_crushed, max_crush, past_bound,
-                                int(onsets), int(second))
+    history = History(*arrays, f["final_m1"], f["final_m31"], elapsed)
+    history.stats = kernel_stats(f, past_bound)
     return blank_left_out(history, p)
 
 

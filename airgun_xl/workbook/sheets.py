@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..engine.decimate import minmax_indices
-from ..engine.summary import PEAK_MIN_HZ, PULSE_FRACTION, SPECTRUM_MAX_HZ
+from ..engine.summary import PULSE_FRACTION, SPECTRUM_MAX_HZ
 from ..errors import OutputError
 from .charts import COPY_POINTS, POINT_BUDGET
 from .page_setup import not_printed, one_page
