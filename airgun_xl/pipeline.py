@@ -181,7 +181,9 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
     filled = Filled(result, summary, outputs.stride(rows), sidecar, compared, warnings=record)
     with Publication(options.force, options.force_word) as pub:
         progress("writing the workbook")
-        warn(render_workbook(result, pub.stage(output), outputs, summary, info, shown=output))
+        # what writing found (a parameter cell's text cut, say) reaches the archive entry too;
+        # the Summary was written before it was known
+        say(render_workbook(result, pub.stage(output), outputs, summary, info, shown=output))
         workbook = pub.files[0][0]
         if sidecar is not None:
             progress("writing the sidecar")
