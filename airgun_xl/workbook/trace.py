@@ -28,7 +28,7 @@ TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
 #: Acceleration units [kG per unit]: a recorder's g is standard gravity (units.G, 9.80665
 #: m/s^2); the kG is the macro's, 9800 m/s^2 (its Acceleration (kG's) column), so 1 g is
 #: 1.000679e-3 kG. The macro's 9800 applies to the macro's columns only.
-ACCEL_UNITS = {"g": G / KG_MS2, "kg": 1.0, "m/s^2": 1 / KG_MS2, "m/s2": 1 / KG_MS2}
+ACCEL_UNITS = {"g": G / KG_MS2, "kG": 1.0, "m/s^2": 1 / KG_MS2, "m/s2": 1 / KG_MS2}
 
 #: A step may differ from the median step by this fraction before it is a gap.
 GAP_TOLERANCE = 0.01
@@ -68,8 +68,13 @@ def _unit(header, table, option, which):
     found = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]", header)
     text = (found.group(1) if found else "").strip()
     key = text.replace("'s", "").replace("²", "^2").replace(" ", "")
-    key = key if key in table else key.lower() if key.lower() in table else None
-    if key is None:
+    near = [k for k in table if k.lower() == key.lower()]
+    if key not in table and near:  # units are case sensitive: [Kg] is kilograms, [MS] not ms
+        raise OptionError(f"{option}: the {which} header {header!r} names {text!r}, a case "
+                          f"away from {near[0]!r}; units are case sensitive (Kg is a mass, MS "
+                          f"megasiemens), expected exactly one of {', '.join(table)}, or "
+                          f"{option}")
+    if key not in table:
         raise OptionError(f"{option}: the {which} header {header!r} names no unit I know "
                           f"({text or 'none'}); expected one of {', '.join(table)} in the "
                           f"header, e.g. '{which} [{next(iter(table))}]', or {option}")
@@ -270,9 +275,16 @@ def _tdms_table(path, channel):
     else:
         raise WorkbookError(f"{shown}: has no waveform channel (wf_increment), "
                             f"{EXPECTED_TDMS}")
-    accel = np.asarray(chosen[:], dtype=float)
-    dt = float(chosen.properties["wf_increment"])
-    start = float(chosen.properties.get("wf_start_offset", 0.0))
+    try:  # a string, a timestamp or a complex channel is the file's fault: one line
+        raw = np.asarray(chosen[:])
+        if not np.issubdtype(raw.dtype, np.number) or np.iscomplexobj(raw):
+            raise TypeError(f"{raw.dtype} samples")
+        accel = raw.astype(float)
+        dt = float(chosen.properties["wf_increment"])
+        start = float(chosen.properties.get("wf_start_offset", 0.0))
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise WorkbookError(f"{shown}: channel {chosen.name!r} is not a waveform of numbers "
+                            f"({exc}), {EXPECTED_TDMS}") from None
     if not (math.isfinite(dt) and dt > 0):
         raise WorkbookError(f"{shown}: channel {chosen.name!r} has wf_increment {dt!r}, "
                             "expected a positive sample step [s]")
@@ -282,7 +294,9 @@ def _tdms_table(path, channel):
         raise WorkbookError(f"{shown}: channel {chosen.name!r} sample {k} is {accel[k]}, "
                             "expected finite numbers (no NaN or inf)")
     unit = str(chosen.properties.get("unit_string", ""))
-    header = ["time [s]", f"{chosen.name} [{unit}]" if unit else chosen.name]
+    # the header is built for the unit alone: a channel named 'accel (z)' or 'accel [z]' must
+    # not lend its brackets to the unit parser
+    header = ["time [s]", f"acceleration [{unit}]" if unit else "acceleration"]
     return shown, header, np.column_stack([start + dt * np.arange(len(accel)), accel])
 
 
