@@ -83,7 +83,8 @@ def parse_bytes(text):
         return None
     unit = (m.group(2) or "").upper().rstrip("B").rstrip("I")
     scale = {"": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}[unit]
-    return int(value * scale) if value > 0 else None
+    size = value * scale
+    return int(size) if 0 < size < 2**63 else None  # 1e999 is inf: not a size (23.14)
 
 
 def available_memory():

@@ -75,7 +75,7 @@ def test_srs_limits_and_bad_arguments():
     t = np.arange(0, 1e-3, dt)
     pulse = np.sin(np.pi * t / 1e-3)
     assert srs(pulse, dt, [50_000.0])[0] == pytest.approx(1.0, rel=0.01)
-    with pytest.raises(OptionError, match="a tenth of the sample rate"):
+    with pytest.raises(OptionError, match="a tenth of the pulse.s sample rate"):
         srs(pulse, dt, [200_000.0])
     with pytest.raises(OptionError, match="quality factor"):
         srs(pulse, dt, [1000.0], q=0.4)

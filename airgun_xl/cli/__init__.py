@@ -71,8 +71,8 @@ def main(argv=None):
             parser = build_parser()
             args = parser.parse_args(argv)
             args.argv = ["airgun-xl", *(sys.argv[1:] if argv is None else argv)]
-            if args.command is None:
-                parser.print_help()
+            if args.command is None:  # the usage goes with the exit status, to stderr (23.26)
+                parser.print_help(sys.stderr)
                 return 2
             code = args.run(args)
             if SIGNALS["pending"] is not None and SIGNALS["committed"]:

@@ -46,7 +46,7 @@ def run(args):
 
     if args.cfc is not None and args.cfc not in CFC_CLASSES:
         cfc_coefficients(args.cfc, 1.0)  # its one-line error, before the run
-    if not (0 < args.lo < args.hi):
+    if not (0 < args.lo < args.hi < float("inf")):
         raise OptionError(f"--from/--to: found {args.lo:g} and {args.hi:g} Hz, expected "
                           "0 < FROM < TO")
     shot = Shot.from_workbook(args.shot)

@@ -77,6 +77,14 @@ def sobol(p, sds, n, seed=None, integrator="legacy", model="4-mass", progress=No
         raise OptionError(f"--sobol: found {n}, expected a power of 2 (Sobol sequence), "
                           "such as 256")
     check_spreads(p, sds)
+    cells = [cell for cell, _, _, _ in sds]
+    twice = sorted({c for c in cells if cells.count(c) > 1})
+    if twice:  # SALib would stop with its own error (issue 23.13)
+        raise OptionError(f"--sd: found {twice[0]} twice, expected each uncertain input once")
+    flat = [cell for cell, _, sd, _ in sds if not sd > 0]
+    if flat:
+        raise OptionError(f"--sd: found {flat[0]} with a deviation of 0, expected a spread above "
+                          "0 for each input of the Sobol indices")
     problem = _problem(p, sds)
     samples = sample.sample(problem, n, calc_second_order=False, seed=seed)
     varied = [(cell, fields) for cell, fields, _, _ in sds]

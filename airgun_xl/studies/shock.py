@@ -19,6 +19,10 @@ from ..errors import OptionError
 #: The channel frequency classes of SAE J211 / ISO 6487 [Hz].
 CFC_CLASSES = (60, 180, 600, 1000)
 
+#: Most samples of rest the SRS appends to a pulse (1.5 periods of its lowest frequency):
+#: 160 MB of doubles; a lowest frequency of 1 mHz would ask for 22 GiB (issue 23.3).
+MAX_PADDING = 20_000_000
+
 #: The SRS's default quality factor (damping 5 %), as shock specifications are written.
 DEFAULT_Q = 10.0
 
@@ -133,14 +137,22 @@ def srs(values, dt, frequencies, q=DEFAULT_Q):
     from scipy.signal import lfilter
 
     frequencies = np.asarray(frequencies, dtype=float)
-    if not (len(frequencies) and np.all(frequencies > 0) and q > 0.5):
-        raise OptionError(f"--q: found {q!r} or frequencies {frequencies[:3]!r}..., expected "
-                          "positive frequencies and a quality factor above 0.5")
+    if not (len(frequencies) and np.all(np.isfinite(frequencies)) and np.all(frequencies > 0)
+            and q > 0.5):
+        raise OptionError(f"the SRS: found Q = {q!r} or frequencies {frequencies[:3]!r}..., "
+                          "expected finite positive frequencies and a quality factor above 0.5")
     if frequencies.max() > 0.1 / dt:
-        raise OptionError(f"--to: found {frequencies.max():,.0f} Hz, expected at most a tenth "
-                          f"of the sample rate ({0.1 / dt:,.0f} Hz)")
+        raise OptionError(f"the SRS: a natural frequency of {frequencies.max():,.0f} Hz, "
+                          f"expected at most a tenth of the pulse's sample rate "
+                          f"({0.1 / dt:,.0f} Hz)")
+    pad = 1.5 / (frequencies.min() * dt)  # samples of rest after the pulse, estimated first
+    if not pad <= MAX_PADDING:
+        raise OptionError(f"the SRS: a natural frequency of {frequencies.min():.3g} Hz needs "
+                          f"{pad:.3g} samples of rest after the pulse at its step, over the "
+                          f"{MAX_PADDING:,} allowed; expected a lowest frequency of at least "
+                          f"{1.5 / (MAX_PADDING * dt):.3g} Hz")
     x = np.asarray(values, dtype=float)
-    x = np.concatenate([x, np.zeros(int(math.ceil(1.5 / (frequencies.min() * dt))))])
+    x = np.concatenate([x, np.zeros(int(math.ceil(pad)))])
     out = np.empty(len(frequencies))
     for i, fn in enumerate(frequencies):
         b, a = smallwood_coefficients(fn, dt, q)

@@ -1,5 +1,5 @@
-"""Issue 23 (second hostile pass), the findings on measured recordings fixed in this pass: each
-test is named after its finding."""
+"""Issue 23 (second hostile pass): the findings fixed so far, each test named after its
+finding (23.N). Each bad input is one line on stderr, exit 2, and no file written."""
 import numpy as np
 import pytest
 from conftest import TEMPLATE
@@ -7,6 +7,17 @@ from conftest import TEMPLATE
 from airgun_xl.cli import main
 
 nptdms = pytest.importorskip("nptdms")
+
+
+def _refused(capsys, argv, naming, out=None):
+    assert main([str(a) for a in argv]) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and naming in lines[0], captured.err
+    assert "Traceback" not in captured.err
+    if out is not None:
+        assert not out.exists()
+    return lines[0]
 
 
 def _tdms(path, data, **properties):
@@ -68,3 +79,50 @@ def test_23_27_units_are_case_sensitive(tmp_path, capsys, header, message):
                  str(tmp_path / "c.xlsx")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err
+
+
+@pytest.mark.parametrize("args, naming", [
+    (["--to", "inf"], "--from/--to: found 100 and inf Hz"),
+    (["--from", "1e-300", "--to", "1000"], "needs 3e+306 samples of rest after the pulse"),
+    (["--from", "0.001"], "over the 20,000,000 allowed"),
+])
+def test_23_3_and_23_10_srs_frequencies_at_the_edge_of_floats(tmp_path, capsys, args, naming):
+    """--to inf and a lowest frequency that would pad the pulse to 22 GiB (or 1e303 samples)
+    are refused before anything is allocated."""
+    out = tmp_path / "s.xlsx"
+    _refused(capsys, ["srs", TEMPLATE, "-o", out, *args], naming, out)
+
+
+def test_23_25_design_names_no_option_the_user_did_not_type(tmp_path, capsys):
+    """A required spectrum with a row above a tenth of the sample rate: the message names the
+    SRS's limit, not srs's --to."""
+    spec = tmp_path / "req.csv"
+    spec.write_text("frequency [Hz],srs [g]\n1000,10\n1000000,10\n")
+    line = _refused(capsys, ["design", TEMPLATE, "--target-srs", spec, "-o",
+                             tmp_path / "d.xlsx"], "a natural frequency of 1,000,000 Hz")
+    assert "--to" not in line
+
+
+@pytest.mark.parametrize("sds, naming", [
+    (["E40=0%", "E37=0%"], "--sd: found E40 with a deviation of 0"),
+    (["E40=3%", "E40=5%"], "--sd: found E40 twice"),
+])
+def test_23_13_sobol_inputs_salib_rejects_are_checked_first(tmp_path, capsys, sds, naming):
+    out = tmp_path / "s.xlsx"
+    argv = ["sweep", TEMPLATE, "--sobol", "16", "-o", out]
+    for sd in sds:
+        argv += ["--sd", sd]
+    _refused(capsys, argv, naming, out)
+
+
+@pytest.mark.parametrize("value", ["1e999", "1e999GB"])
+def test_23_14_an_infinite_memory_budget_is_one_line(tmp_path, capsys, monkeypatch, value):
+    monkeypatch.setenv("AIRGUN_XL_MEMORY", value)
+    out = tmp_path / "o.xlsx"
+    _refused(capsys, ["fill", TEMPLATE, "-o", out], "$AIRGUN_XL_MEMORY: found", out)
+
+
+def test_23_26_bare_airgun_xl_puts_its_usage_on_stderr(capsys):
+    assert main([]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and "usage: airgun-xl" in captured.err
