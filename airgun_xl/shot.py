@@ -63,8 +63,9 @@ class Shot:
     warnings: list[str] = field(default_factory=list)
 
     @classmethod
-    def from_workbook(cls, path: str | os.PathLike[str]) -> Shot:
-        """Read a shot from a workbook in the report's layout.
+    def from_workbook(cls, path: str | os.PathLike[str], read_law: bool = True) -> Shot:
+        """Read a shot from a workbook in the report's layout; with ``read_law`` False, its
+        Crush law sheet is left unread and the macro's law runs.
 
         Raises
         ------
@@ -74,7 +75,7 @@ class Shot:
         """
         from .workbook.reader import read_params
 
-        params, source, warnings = read_params(path)
+        params, source, warnings = read_params(path, read_law)
         return cls(params, source, warnings)
 
     def with_params(self, **changes: float) -> Shot:

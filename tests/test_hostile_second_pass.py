@@ -126,3 +126,19 @@ def test_23_26_bare_airgun_xl_puts_its_usage_on_stderr(capsys):
     assert main([]) == 2
     captured = capsys.readouterr()
     assert captured.out == "" and "usage: airgun-xl" in captured.err
+
+
+def test_23_19_crush_law_legacy_runs_whatever_the_law_sheet_says(tmp_path, capsys):
+    """A Crush law sheet whose B1 says 'maybe': fill refuses it (naming the cell), and
+    --crush-law legacy runs the macro's law without reading it."""
+    import openpyxl
+
+    shot = tmp_path / "shot.xlsx"
+    wb = openpyxl.load_workbook(TEMPLATE)
+    law = wb.create_sheet("Crush law")
+    law["A1"], law["B1"] = "law", "maybe"
+    wb.save(shot)
+    _refused(capsys, ["fill", shot, "-o", tmp_path / "a.xlsx"], "'Crush law'!B1",
+             tmp_path / "a.xlsx")
+    assert main(["fill", str(shot), "-o", str(tmp_path / "b.xlsx"), "--crush-law", "legacy",
+                 "--only", "summary"]) == 0

@@ -111,9 +111,8 @@ def run(args):
 
     started = time.perf_counter()
     output = Path(args.output) if args.output else default_output(args.shot)
-    shot = Shot.from_workbook(args.shot)
-    if args.crush_law == "legacy":
-        shot = shot.with_law(None)
+    # --crush-law legacy runs the macro's law whatever the sheet says: the sheet is not read
+    shot = Shot.from_workbook(args.shot, read_law=args.crush_law != "legacy")
     if args.unloading != "macro":
         shot = shot.with_params(unloading=args.unloading)
     outputs = from_sheet(shot.source.outputs_block).with_flags(

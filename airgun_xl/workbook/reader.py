@@ -262,8 +262,9 @@ def check_time_header(source):
                         "'Time' or a blank cell (the result columns start at H1)")
 
 
-def read_params(path):
-    """Read and check a shot's parameters from a workbook.
+def read_params(path, read_law=True):
+    """Read and check a shot's parameters from a workbook; with ``read_law`` False its Crush
+    law sheet is not read (the macro's law runs, whatever the sheet holds).
 
     Returns
     -------
@@ -280,6 +281,6 @@ def read_params(path):
                         "reads (it computes k1 from E13, E31, E16 and E19): this value has no "
                         "effect on the run")
     params = ShotParams.from_cells(raw)
-    if source.law_block is not None:
+    if source.law_block is not None and read_law:
         params = params.replace(crush_law=law_from_cells(source.law_block))
     return params, source, warnings
