@@ -142,3 +142,24 @@ def test_23_19_crush_law_legacy_runs_whatever_the_law_sheet_says(tmp_path, capsy
              tmp_path / "a.xlsx")
     assert main(["fill", str(shot), "-o", str(tmp_path / "b.xlsx"), "--crush-law", "legacy",
                  "--only", "summary"]) == 0
+
+
+def test_23_7_a_shot_that_never_hits_and_an_all_zero_recording_are_one_line(tmp_path, capsys):
+    import openpyxl
+
+    t = np.arange(400) * 1e-5
+    rec = tmp_path / "m.csv"
+    rec.write_text("time [s],acceleration [g]\n" + "".join(
+        f"{float(a)!r},{float(b)!r}\n" for a, b in zip(t, _pulse(400), strict=True)))
+    zero = tmp_path / "zero.csv"
+    zero.write_text("time [s],acceleration [g]\n" + "".join(f"{float(a)!r},0.0\n" for a in t))
+    still = tmp_path / "still.xlsx"
+    wb = openpyxl.load_workbook(TEMPLATE)
+    wb["Sheet1"]["A28"] = 0
+    wb.save(still)
+    _refused(capsys, ["compare-measured", TEMPLATE, zero, "-o", tmp_path / "a.xlsx"],
+             "the recording is flat")
+    _refused(capsys, ["calibrate", TEMPLATE, zero, "--fit", "E40", "-o", tmp_path / "b.xlsx"],
+             "the recording is flat")
+    _refused(capsys, ["compare-measured", still, rec, "-o", tmp_path / "c.xlsx"],
+             "the shot's predicted pulse is zero everywhere")

@@ -251,11 +251,20 @@ def prepare(trace, cfc=None, anti_alias=None, dt_model=None):
                      warnings, hz)
 
 
+def check_prediction(pred_kg):
+    """Refuse a prediction with no pulse to align (issue 23.7: a shot whose bird never meets
+    the mitigator, A27 = A28 = 0)."""
+    if not np.any(np.asarray(pred_kg) > 0):
+        raise OptionError("the shot's predicted pulse is zero everywhere (nothing crushes the "
+                          "mitigator: A27..A30), expected a shot whose bird hits the MEM")
+
+
 def threshold_shift(pred_time, pred_kg, rec, anti_alias=None):
     """(shift, impact, filtered prediction): the shift [s] to add to the measured time so that
     both impact instants coincide (:func:`crossing` of each filtered pulse at the recording's
     level, held), the prediction's impact instant [s], and its filtered (time, values) from
     rest."""
+    check_prediction(pred_kg)
     pred_time, pred = filtered_from_rest(pred_time, pred_kg, rec.cfc, anti_alias)
     impact = crossing(pred_time, pred, rec.fraction)
     measured = crossing(rec.trace.time, rec.filtered, rec.fraction, rec.sustain)
