@@ -163,3 +163,22 @@ def test_23_7_a_shot_that_never_hits_and_an_all_zero_recording_are_one_line(tmp_
              "the recording is flat")
     _refused(capsys, ["compare-measured", still, rec, "-o", tmp_path / "c.xlsx"],
              "the shot's predicted pulse is zero everywhere")
+
+
+@pytest.mark.parametrize("address", ["tcp://127.0.0.1:notaport", "http://127.0.0.1:1", "",
+                                     "inproc://x", "ucx://127.0.0.1:1", "tcp://" + "a" * 500])
+def test_23_12_scheduler_addresses_distributed_rejects_are_one_line(tmp_path, capsys,
+                                                                     address):
+    pytest.importorskip("distributed")
+    out = tmp_path / "s.xlsx"
+    line = _refused(capsys, ["sweep", TEMPLATE, "--vary", "A28=100:200:3", "--scheduler",
+                             address, "-o", out], "--scheduler: found", out)
+    assert len(line) < 300  # a long address is cut in the echo
+
+
+def test_23_17_workers_are_bounded_by_the_machine(tmp_path, capsys):
+    import os
+
+    out = tmp_path / "s.xlsx"
+    _refused(capsys, ["sweep", TEMPLATE, "--vary", "A28=100:200:3", "--workers", "1000", "-o",
+                      out], f"expected 1 to {2 * (os.cpu_count() or 1)}", out)

@@ -9,6 +9,9 @@ counted once because each chunk's result is gathered once.
 
 ``distributed`` is imported only here, when a cluster is asked for (it costs 0.7 s).
 """
+import os
+import re
+
 import numpy as np
 
 from ..errors import OptionError
@@ -69,6 +72,11 @@ class ClusterRunner:
                      [s for _, _, stats in parts for s in stats])
 
 
+def max_workers():
+    """Most local workers ``--workers`` may start: twice the cores, each a process."""
+    return 2 * (os.cpu_count() or 1)
+
+
 def connect(scheduler=None, workers=None):
     """A Dask client: to the scheduler at ``scheduler``, or to a local cluster of ``workers``
     processes (one thread each). Returns (client, close) where ``close()`` shuts down what was
@@ -86,15 +94,21 @@ def connect(scheduler=None, workers=None):
         raise OptionError(f"{option}: needs dask.distributed, expected it installed "
                           "(pip install 'airgun-xl[cluster]')") from None
     if scheduler is not None:
+        shown = scheduler if len(scheduler) <= 80 else scheduler[:77] + "..."
+        if not re.fullmatch(r"(tcp|tls)://[^\s/:]+:\d{1,5}", scheduler):
+            raise OptionError(f"--scheduler: found {shown!r}, expected the address of a running "
+                              "`dask scheduler` as tcp://HOST:PORT, e.g. tcp://10.0.0.5:8786")
         try:
             client = Client(scheduler, timeout=CONNECT_TIMEOUT)
-        except (OSError, TimeoutError) as exc:
-            raise OptionError(f"--scheduler: found {scheduler!r}, which did not answer "
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:  # distributed's own
+            raise OptionError(f"--scheduler: found {shown!r}, which did not answer "
                               f"({type(exc).__name__}); expected the address of a running "
                               "`dask scheduler`, e.g. tcp://10.0.0.5:8786") from None
         return client, client.close
-    if workers < 1:
-        raise OptionError(f"--workers: found {workers!r}, expected a positive number")
+    most = max_workers()
+    if not 1 <= workers <= most:
+        raise OptionError(f"--workers: found {workers!r}, expected 1 to {most} (twice this "
+                          f"machine's {os.cpu_count() or 1} cores; each worker is a process)")
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                            dashboard_address=":0")  # any free port: never a clash
     client = Client(cluster)
