@@ -95,7 +95,8 @@ def connect(scheduler=None, workers=None):
                           "(pip install 'airgun-xl[cluster]')") from None
     if scheduler is not None:
         shown = scheduler if len(scheduler) <= 80 else scheduler[:77] + "..."
-        if not re.fullmatch(r"(tcp|tls)://[^\s/:]+:\d{1,5}", scheduler):
+        if not re.fullmatch(r"(tcp|tls)://([^\s/:\[\]]+|\[[0-9a-fA-F:.]+\]):\d{1,5}",
+                            scheduler):
             raise OptionError(f"--scheduler: found {shown!r}, expected the address of a running "
                               "`dask scheduler` as tcp://HOST:PORT, e.g. tcp://10.0.0.5:8786")
         try:
