@@ -182,3 +182,23 @@ def test_23_17_workers_are_bounded_by_the_machine(tmp_path, capsys):
     out = tmp_path / "s.xlsx"
     _refused(capsys, ["sweep", TEMPLATE, "--vary", "A28=100:200:3", "--workers", "1000", "-o",
                       out], f"expected 1 to {2 * (os.cpu_count() or 1)}", out)
+
+
+@pytest.mark.parametrize("far", ["XFD1048576", "XFD1000"])
+def test_23_1_a_recording_range_with_one_far_cell_is_refused_before_parsing(tmp_path, capsys,
+                                                                            far):
+    """One cell at XFD1048576 made calamine allocate 549,755,813,888 bytes (SIGABRT), and at
+    XFD1000 674 MB: the sheet's extent is scanned first, as diff does."""
+    import openpyxl
+
+    wb = openpyxl.Workbook()
+    ws = wb.active
+    ws.title = "Trace"
+    ws.append(["time [s]", "acceleration [g]"])
+    for t, a in zip(np.arange(400) * 1e-5, _pulse(400), strict=True):
+        ws.append([float(t), float(a)])
+    ws[far] = 1.0
+    wb.save(tmp_path / "trace.xlsx")
+    out = tmp_path / "c.xlsx"
+    _refused(capsys, ["compare-measured", TEMPLATE, f"{tmp_path / 'trace.xlsx'}:Trace!A:B", "-o",
+                      out], "sheet 'Trace' spans at least", out)

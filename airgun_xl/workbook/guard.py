@@ -194,6 +194,12 @@ def _defused(shown, zf, member):
 
 def first_sheet_member(path, zf):
     """The zip member of the workbook's first worksheet, from workbook.xml and its rels."""
+    return sheet_member(path, zf)
+
+
+def sheet_member(path, zf, title=None):
+    """The zip member of the worksheet named ``title`` (the first one for None), from
+    workbook.xml and its rels; None for a title the workbook does not have."""
     from defusedxml.ElementTree import fromstring
 
     shown = display(path)
@@ -203,7 +209,12 @@ def first_sheet_member(path, zf):
     except Exception:  # noqa: BLE001 - checked by open_zip; anything left is a broken package
         raise WorkbookError(f"{shown}: has no readable workbook.xml, expected an .xlsx "
                             "workbook") from None
-    sheet = next((e for e in book.iter() if e.tag.endswith("}sheet")), None)
+    sheets = [e for e in book.iter() if e.tag.endswith("}sheet")]
+    if title is not None:
+        sheets = [e for e in sheets if e.get("name") == title]
+        if not sheets:
+            return None
+    sheet = sheets[0] if sheets else None
     rid = None if sheet is None else next(
         (v for k, v in sheet.attrib.items() if k.endswith("}id")), None)
     target = next((e.get("Target") for e in rels if e.get("Id") == rid), None)
@@ -270,7 +281,7 @@ def _extent_parser(cap):
     return ExtentParser(forbid_dtd=True)
 
 
-def sheet_extent(path, zf, member, cap=None):
+def sheet_extent(path, zf, member, cap=None, what="its first sheet"):
     """``(rows, columns)`` spanned by the cells a worksheet really holds, from A1.
 
     Not the ``<dimension>`` tag, which may lie: one defusedxml pass over the ``<row>`` and
@@ -292,7 +303,7 @@ def sheet_extent(path, zf, member, cap=None):
         with zf.open(member) as fh:
             parser.parse(fh)
     except _PastCap:
-        raise WorkbookError(f"{display(path)}: its first sheet spans at least {parser.rows:,} "
+        raise WorkbookError(f"{display(path)}: {what} spans at least {parser.rows:,} "
                             f"rows x {parser.columns:,} columns, expected at most {cap:,} "
                             "cells") from None
     except defusedxml.DefusedXmlException as exc:

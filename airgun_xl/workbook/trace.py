@@ -213,7 +213,14 @@ def _range_table(found):
     shown = f"{display(path)}:{found['sheet']}!{found['a'].upper()}:{found['b'].upper()}"
     data, kind = guard.read_input(path)
     if kind == "zip":
-        guard.open_zip(path, data).close()  # sizes, ratios and entities, before any parser
+        zf = guard.open_zip(path, data)  # sizes, ratios and entities, before any parser
+        member = guard.sheet_member(path, zf, found["sheet"])
+        if member is not None:  # its extent, before calamine makes it dense (issue 23.1)
+            rows, columns = guard.sheet_extent(path, zf, member, cap=limits.MAX_DIFF_CELLS,
+                                               what=f"sheet {found['sheet']!r}")
+            guard.check_extent(path, f"sheet {found['sheet']!r}", rows, columns,
+                               limits.MAX_DIFF_CELLS)
+        zf.close()
     else:
         for k, (rows, columns) in enumerate(guard.xls_extents(path, data)):
             guard.check_extent(path, f"sheet {k + 1}", rows, columns, limits.MAX_XLS_CELLS)
