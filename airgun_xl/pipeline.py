@@ -129,10 +129,8 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
         Archive(options.archive.root, create=True, dry_run=True)  # a foreign folder: now
     record = []  # every warning, for the workbook and the archive entry as for the terminal
 
-    def say(messages):
-        messages = [str(m) for m in messages]
-        record.extend(messages)
-        warn(messages)
+    def say(messages):  # printed once the fill succeeds: a refusal stays one line (23.24)
+        record.extend(str(m) for m in messages)
 
     say(shot.warnings)
     crit, findings = before_run(model_shot.params, options.integrator)
@@ -202,4 +200,5 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
         progress("publishing")
         pub.commit()
     filled.entry = pending.entry if pending is not None else None
+    warn(record)
     return filled

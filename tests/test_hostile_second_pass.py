@@ -202,3 +202,18 @@ def test_23_1_a_recording_range_with_one_far_cell_is_refused_before_parsing(tmp_
     out = tmp_path / "c.xlsx"
     _refused(capsys, ["compare-measured", TEMPLATE, f"{tmp_path / 'trace.xlsx'}:Trace!A:B", "-o",
                       out], "sheet 'Trace' spans at least", out)
+
+
+def test_23_24_a_refusal_after_a_warning_is_still_one_line(tmp_path, capsys):
+    """A28 = 1e4 warns (an implausible speed, the law extrapolated) and then diverges: the
+    refusal is the only line; the warnings go with figures, and there are none."""
+    import openpyxl
+
+    shot = tmp_path / "fast.xlsx"
+    wb = openpyxl.load_workbook(TEMPLATE)
+    wb["Sheet1"]["A28"] = 1e4
+    wb.save(shot)
+    out = tmp_path / "o.xlsx"
+    assert main(["fill", str(shot), "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("airgun-xl: error: ") and not out.exists()
