@@ -217,3 +217,26 @@ def test_23_24_a_refusal_after_a_warning_is_still_one_line(tmp_path, capsys):
     assert main(["fill", str(shot), "-o", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("airgun-xl: error: ") and not out.exists()
+
+
+def test_23_23_library_warnings_become_the_tools_own_lines(tmp_path, capsys, monkeypatch):
+    """A RuntimeWarning a library raises during a command is said as one airgun-xl warning
+    line after it succeeds (none reaches stderr raw); a deprecation notice is not the user's;
+    a refusal drops them, staying one line."""
+    import warnings
+
+    import airgun_xl.cli.srs as srs_command
+
+    real = srs_command.run
+
+    def noisy(args):
+        warnings.warn("overflow encountered in multiply", RuntimeWarning, stacklevel=1)
+        warnings.warn("old API", DeprecationWarning, stacklevel=1)
+        return real(args)
+
+    monkeypatch.setattr(srs_command, "run", noisy)  # the parser is built per call of main
+    out = tmp_path / "s.xlsx"
+    assert main(["srs", str(TEMPLATE), "-o", str(out)]) == 0
+    assert capsys.readouterr().err.strip().splitlines() == [
+        "airgun-xl: warning: RuntimeWarning from a library: overflow encountered in multiply"]
+    _refused(capsys, ["srs", TEMPLATE, "-o", out], "exists")  # the output exists: one line

@@ -8,6 +8,7 @@ import contextlib
 import os
 import signal
 import sys
+import warnings
 
 from ..errors import AirgunXlError
 from ..transaction import SIGNALS, Interrupted, note_signal, on_signal, reset_signals
@@ -74,7 +75,15 @@ def main(argv=None):
             if args.command is None:  # the usage goes with the exit status, to stderr (23.26)
                 parser.print_help(sys.stderr)
                 return 2
-            code = args.run(args)
+            with warnings.catch_warnings(record=True) as caught:  # libraries' own (23.23)
+                warnings.simplefilter("always")
+                for developers in (DeprecationWarning, PendingDeprecationWarning, FutureWarning,
+                                   ImportWarning, ResourceWarning):  # not the user's business
+                    warnings.simplefilter("ignore", developers)
+                code = args.run(args)
+            # after a success, said as the tool's own warnings; a refusal drops them (one line)
+            warn(sorted({f"{w.category.__name__} from a library: {str(w.message)[:300]}"
+                         for w in caught}))
             if SIGNALS["pending"] is not None and SIGNALS["committed"]:
                 _say(f"airgun-xl: signal {SIGNALS['pending']} arrived after the outputs were "
                      "complete; nothing was lost")

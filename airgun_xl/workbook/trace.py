@@ -262,6 +262,9 @@ def _tdms_table(path, channel):
     except ImportError:
         raise OptionError(f"{display(Path(path))}: reading TDMS needs npTDMS, expected it "
                           "installed: pip install 'airgun-xl[tdms]'") from None
+    import logging
+
+    logging.getLogger("nptdms").setLevel(logging.CRITICAL)  # its lines before our one (23.23)
     shown = display(Path(path))
     data = read_bytes(path, EXPECTED_TDMS, "TDMS")
     try:
