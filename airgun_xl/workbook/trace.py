@@ -98,6 +98,50 @@ def _is_pair(row, decimal_comma):
     return True
 
 
+def _looks_like_data(row):
+    """A row that starts with a number: data, where the header should have been followed by
+    two numbers."""
+    try:
+        float(row[0].strip().replace(",", "."))
+    except (ValueError, IndexError):
+        return False
+    return True
+
+
+def _body(raw, delimiter, comma):
+    """The data lines (UTF-8 bytes) as an n x 2 float array by pandas' C parser (no Python
+    list a row), or None when a line is not two numbers (the slow path then names it)."""
+    import pandas as pd
+
+    try:
+        frame = pd.read_csv(io.BytesIO(raw), sep=delimiter, header=None, usecols=[0, 1],
+                            decimal="," if comma else ".", dtype=float, engine="c",
+                            comment="#", skip_blank_lines=True, skipinitialspace=True)
+    except (ValueError, IndexError, pd.errors.ParserError, pd.errors.EmptyDataError):
+        return None
+    return frame.to_numpy(dtype=float)
+
+
+def _find_bad_line(shown, text, first, delimiter, comma, columns):
+    """Raise the one line naming the first data line that is not two finite numbers."""
+    for number, line in enumerate(text.splitlines(), start=first):
+        try:
+            row = next(csv.reader([line], delimiter=delimiter), [])
+        except csv.Error as exc:
+            raise WorkbookError(f"{shown}: line {number} is not readable CSV ({exc})") from None
+        if not any(cell.strip() for cell in row) or row[0].lstrip().startswith("#"):
+            continue
+        try:
+            a, b = _number(row[0], comma), _number(row[1], comma)
+        except (ValueError, IndexError):
+            raise WorkbookError(f"{shown}: line {number} holds {row[:2]!r}, expected two "
+                                f"numbers ({columns[0]}, {columns[1]})") from None
+        if not (math.isfinite(a) and math.isfinite(b)):
+            raise WorkbookError(f"{shown}: line {number} holds {row[0].strip()}, "
+                                f"{row[1].strip()}, expected finite numbers (no NaN or inf)")
+    raise WorkbookError(f"{shown}: is not a readable CSV of two numbers a line")
+
+
 def _dialect(lines):
     """(delimiter, decimal comma) of a data-acquisition export's data lines: ``;`` or a tab
     with a decimal comma (``1,5;0,25``), or a comma, semicolon or tab with a point."""
@@ -123,47 +167,52 @@ def _table(path, expected, columns):
     except UnicodeDecodeError as exc:
         raise WorkbookError(f"{shown}: is not UTF-8 text (byte {exc.start}), {expected}") \
             from None
-    lines = text.splitlines()
-    if len(lines) > limits.MAX_SAMPLES + 1000:  # counted before any parsing: a bounded read
-        raise WorkbookError(f"{shown}: holds {len(lines):,} lines, expected at most "
+    count = text.count("\n") + 1
+    if count > limits.MAX_SAMPLES + 1000:  # counted before any parsing: a bounded read
+        raise WorkbookError(f"{shown}: holds {count:,} lines, expected at most "
                             f"{limits.MAX_SAMPLES:,} samples")
-    delimiter, comma = _dialect(lines)
-    try:
-        rows = list(csv.reader(lines, delimiter=delimiter))
-    except csv.Error as exc:  # a field past csv's limit, a stray quote
-        raise WorkbookError(f"{shown}: is not a readable CSV ({exc}), {expected}") from None
-    numbered = [(i, r) for i, r in enumerate(rows, start=1)
-                if any(cell.strip() for cell in r) and not r[0].lstrip().startswith("#")]
-    first = next((k for k, (_, r) in enumerate(numbered) if _is_pair(r, comma)), None)
-    if first is None and len(numbered) >= 2:  # a header, then a row that is not two numbers
-        line, row = numbered[1]
-        raise WorkbookError(f"{shown}: line {line} holds {row[:2]!r}, expected two numbers "
-                            f"({columns[0]}, {columns[1]})")
-    if first is None or first == 0:
-        got = numbered[0] if numbered else (len(rows), [])
+    delimiter, comma = _dialect(text[-20_000:].splitlines()[-50:])
+    header, start, numbered = None, None, []  # the lines above the data, parsed one by one
+    offset, number = 0, 0
+    while offset <= len(text) and start is None:
+        end = text.find("\n", offset)
+        end = len(text) if end < 0 else end
+        number += 1
+        line = text[offset:end].rstrip("\r")
+        try:
+            row = next(csv.reader([line], delimiter=delimiter), [])
+        except csv.Error as exc:  # a field past csv's limit, a stray quote
+            raise WorkbookError(f"{shown}: line {number} is not readable CSV ({exc}), "
+                                f"{expected}") from None
+        if any(cell.strip() for cell in row) and not row[0].lstrip().startswith("#"):
+            if _is_pair(row, comma):
+                start = (offset, number)
+                break
+            numbered.append((number, row))
+            if len(numbered) >= 2 and not _is_pair(numbered[-2][1], comma) and \
+                    _looks_like_data(numbered[-1][1]):
+                line_no, bad = numbered[-1]  # a header, then a row that is not two numbers
+                raise WorkbookError(f"{shown}: line {line_no} holds {bad[:2]!r}, expected two "
+                                    f"numbers ({columns[0]}, {columns[1]})")
+        offset = end + 1
+    if start is None or not numbered:
+        got = numbered[0] if numbered else (number, [])
         raise WorkbookError(f"{shown}: line {got[0]} holds {got[1][:3]!r}, {expected}; found "
-                            + ("no header row above the numbers" if first == 0 else
+                            + ("no header row above the numbers" if start is not None else
                                f"no row of two numbers ({delimiter!r}-delimited"
                                + (", decimal comma" if comma else "") + ")"))
-    header_line, header = numbered[first - 1]
+    header_line, header = numbered[-1]
     if len(header) < 2:
         raise WorkbookError(f"{shown}: line {header_line} (the header) holds {header!r}, "
                             f"{expected}")
-    body = numbered[first:]
-    if len(body) > limits.MAX_SAMPLES:
-        raise WorkbookError(f"{shown}: holds {len(body):,} rows, expected at most "
+    # the data from their first line, as bytes: pandas reads them without a str copy a row
+    head = len(text[:start[0]].encode("utf-8")) + (3 if data.startswith(b"\xef\xbb\xbf") else 0)
+    values = _body(data[head:], delimiter, comma)
+    if values is None or not np.isfinite(values).all():
+        _find_bad_line(shown, text[start[0]:], start[1], delimiter, comma, columns)
+    if len(values) > limits.MAX_SAMPLES:
+        raise WorkbookError(f"{shown}: holds {len(values):,} rows, expected at most "
                             f"{limits.MAX_SAMPLES:,} samples")
-    values = np.empty((len(body), 2))
-    for k, (line, row) in enumerate(body):
-        try:
-            a, b = _number(row[0], comma), _number(row[1], comma)
-        except (ValueError, IndexError):
-            raise WorkbookError(f"{shown}: line {line} holds {row[:2]!r}, expected two numbers "
-                                f"({columns[0]}, {columns[1]})") from None
-        if not (math.isfinite(a) and math.isfinite(b)):
-            raise WorkbookError(f"{shown}: line {line} holds {row[0].strip()}, "
-                                f"{row[1].strip()}, expected finite numbers (no NaN or inf)")
-        values[k] = a, b
     return shown, header, values
 
 
