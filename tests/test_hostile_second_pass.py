@@ -253,3 +253,22 @@ def test_23_2_csv_recordings_are_counted_before_parsing_and_read_into_arrays(tmp
     out = tmp_path / "c.xlsx"
     _refused(capsys, ["compare-measured", TEMPLATE, path, "-o", out],
              "lines, expected at most 2,000,000 samples", out)
+
+
+def test_23_4_a_very_long_formula_is_refused_before_parsing_and_echoed_cut(tmp_path, capsys):
+    """A 100,000-character formula in E43 (a 10 kB file) took 67-85 s and 1.5 GB, and its
+    refusal echoed all of it: now it is refused by its length (the reader keeps 32,767
+    characters), quoted in 80."""
+    import time
+
+    import openpyxl
+
+    shot = tmp_path / "long.xlsx"
+    wb = openpyxl.load_workbook(TEMPLATE)
+    wb["Sheet1"]["E43"] = "=" + "+".join(["0.001"] * 16_667)
+    wb.save(shot)
+    out = tmp_path / "o.xlsx"
+    began = time.perf_counter()
+    line = _refused(capsys, ["fill", shot, "-o", out], "E43", out)
+    assert time.perf_counter() - began < 30  # bounded, not 67-85 s (a loose guard, not speed)
+    assert len(line) < 400 and "characters, over Excel's 8,192" in line

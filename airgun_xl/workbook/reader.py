@@ -22,7 +22,7 @@ from ..cells import BY_ADDRESS, CELLS, PARAMETER_COLUMNS, TIME_HEADER, UNUSED_K1
 from ..errors import AirgunXlError, CellError, WorkbookError
 from ..params import Found, ShotParams, describe
 from . import guard
-from .formula_eval import Evaluator, FormulaFailure, SheetView
+from .formula_eval import Evaluator, FormulaFailure, SheetView, shown_formula
 from .law_sheet import KEY as LAW_KEY
 from .law_sheet import law_from_cells
 
@@ -242,15 +242,16 @@ def parameter_values(source):
                                 f"{cached!r}")
                 raw[cell.address] = cached
             else:
-                raw[cell.address] = Found(f"the formula {formula} ({exc})")
+                raw[cell.address] = Found(f"the formula {shown_formula(formula)} ({exc})")
             continue
         if isinstance(value, float) and (cached is not None) and _disagrees(cached, value):
             warnings.append(f"{cell.address} ({cell.label}): the cached value {describe(cached)} "
-                            f"disagrees with {formula} = {value!r}; using the evaluated value")
+                            f"disagrees with {shown_formula(formula)} = {value!r}; using the "
+                            "evaluated value")
         if isinstance(value, float):
             raw[cell.address] = value
         else:
-            raw[cell.address] = Found(f"{describe(value)} from {formula}")
+            raw[cell.address] = Found(f"{describe(value)} from {shown_formula(formula)}")
     return raw, warnings
 
 
