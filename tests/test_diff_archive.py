@@ -325,3 +325,23 @@ def test_an_archived_run_keeps_its_warnings_and_show_prints_units(tmp_path, caps
     assert re.search(r"time_of_peak\s+0\.\d{4} ms", out)
     assert re.search(r"peak_kg\s+[\d,]+\.\d{5} kG", out)
     assert "0.00029000000000000044" not in out
+
+
+def test_two_archives_created_at_once_both_succeed(tmp_path, monkeypatch):
+    """The race the two-process test met now and then: a second fill finds no archive folder,
+    then the first creates it before the second's mkdir. The second goes on with it (it used
+    to stop with "cannot be created (File exists)")."""
+    import os as os_module
+
+    from airgun_xl.archive import store
+
+    root = tmp_path / "archive"
+    real_mkdir = os_module.mkdir
+
+    def late_mkdir(path, *args, **kwargs):  # the other process wins between check and mkdir
+        real_mkdir(path, *args, **kwargs)
+        raise FileExistsError(17, "File exists", str(path))
+
+    monkeypatch.setattr(store.os, "mkdir", late_mkdir)
+    Archive(root, create=True)
+    assert (root / store.MARKER).is_file()

@@ -206,6 +206,8 @@ class Archive:
                                    "airgun-xl fill --archive")
             try:
                 os.mkdir(self.root)
+            except FileExistsError:
+                pass  # another fill created it a moment ago: it is checked below as any other
             except FileNotFoundError:
                 raise ArchiveError(f"{shown}: its folder {display(self.root.parent)} does not "
                                    "exist, expected an existing folder for the archive") from None
