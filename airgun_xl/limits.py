@@ -116,7 +116,29 @@ def available_memory():
                 found.append(int(text) - int(fh.read().strip()))
     except (OSError, ValueError):
         pass
+    found += address_space_left()
     return min(found) if found else None
+
+
+def address_space_left():
+    """[bytes] the process may still map under ``ulimit -v`` (RLIMIT_AS), less what it has
+    mapped; [] where there is no such limit (or no ``resource`` module: Windows)."""
+    try:
+        import resource
+    except ImportError:
+        return []
+    soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+    if soft == resource.RLIM_INFINITY or soft <= 0:
+        return []
+    mapped = 0
+    try:
+        with open("/proc/self/statm") as fh:  # Linux: pages mapped now
+            import os
+
+            mapped = int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError, AttributeError):
+        pass
+    return [max(0, soft - mapped)]
 
 
 def fill_bytes(rows, tracked, csv_sidecar=False):

@@ -140,11 +140,11 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
     say(f for f in findings if f.level != "note")
     note, progress = note or (lambda messages: None), progress or (lambda stage: None)
     track = outputs.tracked_series(sidecar is not None or options.track_all)
-    note(notices(rows, track, sidecar))
     check_memory(fill_bytes(rows, len(track)),  # Shot.run checks too, in the API's words
                  f"a run of {rows:,} rows ({len(track)} step values tracked)",
                  "fewer rows (a larger E2 or a shorter E6) or fewer outputs (--only summary; "
                  "an archived run tracks every step value)")
+    note(notices(rows, track, sidecar))  # after the refusals: a refusal stays one line
     progress("running")
     result = model_shot.run(integrator=options.integrator, host=options.host, track=track)
     diverged = unloading_diverged(result, crit, options.integrator)

@@ -272,3 +272,41 @@ def test_23_4_a_very_long_formula_is_refused_before_parsing_and_echoed_cut(tmp_p
     line = _refused(capsys, ["fill", shot, "-o", out], "E43", out)
     assert time.perf_counter() - began < 30  # bounded, not 67-85 s (a loose guard, not speed)
     assert len(line) < 400 and "characters, over Excel's 8,192" in line
+
+
+def test_23_5_the_memory_estimate_knows_ulimit_v(tmp_path):
+    """Under RLIMIT_AS the estimate counts what the process may still map: E6 = 5 s at 0.5 us
+    ('needs about 2.1 GB') under a 1.5 GB ulimit -v is refused up front in one line (it died
+    in a numpy MemoryError traceback); a MemoryError past the estimate is one line too."""
+    import resource
+    import subprocess
+    import sys
+
+    import openpyxl
+
+    shot = tmp_path / "long.xlsx"
+    wb = openpyxl.load_workbook(TEMPLATE)
+    wb["Sheet1"]["E6"] = 5.0
+    wb.save(shot)
+
+    def limited():
+        resource.setrlimit(resource.RLIMIT_AS, (1_500_000_000, 1_500_000_000))
+
+    proc = subprocess.run([sys.executable, "-m", "airgun_xl", "fill", str(shot), "-o",
+                           str(tmp_path / "o.xlsx")], capture_output=True, text=True,
+                          preexec_fn=limited, timeout=300)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1, proc.stderr
+    assert "more than the" in lines[0] and "available" in lines[0]
+    assert not (tmp_path / "o.xlsx").exists()
+
+
+def test_23_5_a_memory_error_past_the_estimate_is_one_line(tmp_path, capsys, monkeypatch):
+    import airgun_xl.shot as shot_module
+
+    def no_memory(*args, **kwargs):
+        raise MemoryError
+
+    monkeypatch.setattr(shot_module, "get_integrator", lambda name: no_memory)
+    out = tmp_path / "o.xlsx"
+    _refused(capsys, ["fill", TEMPLATE, "-o", out], "out of memory during the run", out)

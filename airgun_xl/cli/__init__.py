@@ -97,6 +97,11 @@ def main(argv=None):
     except KeyboardInterrupt:
         _say("airgun-xl: interrupted; nothing was left half-written")
         return 130
+    except MemoryError:  # past the estimate (ulimit -v, another process): one line (23.5)
+        _say("airgun-xl: error: out of memory during the run; expected a smaller run (fewer "
+             "rows, shots or samples) or more memory ($AIRGUN_XL_MEMORY sets the budget the "
+             "estimates check); nothing was left half-written")
+        return 2
     except BrokenPipeError:  # e.g. `airgun-xl history | head`
         sys.stdout = open(os.devnull, "w")
         return 0
