@@ -310,3 +310,35 @@ def test_23_5_a_memory_error_past_the_estimate_is_one_line(tmp_path, capsys, mon
     monkeypatch.setattr(shot_module, "get_integrator", lambda name: no_memory)
     out = tmp_path / "o.xlsx"
     _refused(capsys, ["fill", TEMPLATE, "-o", out], "out of memory during the run", out)
+
+
+@pytest.mark.parametrize("argv", [
+    ["compare-measured", "--sign", "-1"],
+    ["sweep", "--sobol", "16", "--sd", "E40=3%", "--sd", "E37=2%"],
+])
+def test_23_16_a_file_size_limit_is_one_line_with_no_zipfile_traceback(tmp_path, argv):
+    """ulimit -f: the one-line error used to be followed by 'Exception ignored in
+    ZipFile.__del__' and a traceback."""
+    import resource
+    import subprocess
+    import sys
+
+    import airgun_xl
+    from airgun_xl.studies.recorder import Recorder
+
+    rec = Recorder(rate=50_000.0)
+    trace = rec.record(airgun_xl.Shot(airgun_xl.load(TEMPLATE).params).run(track=()), seed=1)
+    csv = rec.csv(trace, tmp_path / "m.csv")
+    command, *options = argv
+    args = [command, str(TEMPLATE)] + ([str(csv)] if command == "compare-measured" else [])
+
+    def limited():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))
+
+    out = tmp_path / "o.xlsx"
+    proc = subprocess.run([sys.executable, "-m", "airgun_xl", *args, *options, "-o", str(out)],
+                          capture_output=True, text=True, preexec_fn=limited, timeout=300)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1, proc.stderr
+    assert "cannot be written" in lines[0] and "Traceback" not in proc.stderr
+    assert not out.exists()

@@ -5,6 +5,7 @@ written), 128 + N for signal N. SIGTERM and SIGHUP clean up like Ctrl-C (temp fi
 is half published); SIGXFSZ is ignored, so a file-size limit (``ulimit -f``) is a write error.
 """
 import contextlib
+import errno
 import os
 import signal
 import sys
@@ -59,9 +60,27 @@ def _say(text):
     print(text.encode(encoding, "backslashreplace").decode(encoding, "replace"), file=stream)
 
 
+#: Write errors a full disk or ``ulimit -f`` gives: already said in one line by the command.
+_FULL = (errno.EFBIG, errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC))
+
+
+def _unraisable(hook):
+    """An unraisable-exception hook that drops a full disk's second report: a zip file the
+    failed write left open retries its flush when it is collected (ZipFile.__del__), and would
+    print a traceback after the one-line error (issue 23.16)."""
+    def quiet(unraisable):
+        error = unraisable.exc_value
+        if isinstance(error, OSError) and error.errno in _FULL:
+            return
+        hook(unraisable)
+    return quiet
+
+
 def main(argv=None):
     """Run the CLI; return the exit code (0 ok, 1 differences, 2 bad input, 128+N signal N)."""
     _WARNED.clear()
+    if argv is None:  # the command itself, not a caller's in-process run
+        sys.unraisablehook = _unraisable(sys.unraisablehook)
     for stream in (sys.stdout, sys.stderr):  # a file name may hold undecodable bytes
         with contextlib.suppress(AttributeError, ValueError, OSError):
             stream.reconfigure(errors="backslashreplace")
