@@ -64,6 +64,16 @@ def columns_off_the_macro(legacy, new):
     return off
 
 
+def template_with(tmp_path, **cells):
+    """A copy of the template in ``tmp_path`` with some parameter cells changed (openpyxl)."""
+    shot = tmp_path / "shot.xlsx"
+    wb = openpyxl.load_workbook(TEMPLATE)
+    for address, value in cells.items():
+        wb["Sheet1"][address] = value
+    wb.save(shot)
+    return shot
+
+
 @pytest.fixture
 def shot_copy(tmp_path):
     """A copy of the template in tmp_path, so tests can fill it beside itself."""

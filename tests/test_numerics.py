@@ -1,12 +1,11 @@
 """Issue 5: stability prediction, divergence detection, extreme cases, the Newmark integrator
 and the convergence ladder."""
 import math
-import shutil
 
 import numpy as np
 import openpyxl
 import pytest
-from conftest import TEMPLATE
+from conftest import TEMPLATE, template_with
 
 import airgun_xl
 from airgun_xl import Shot, ShotParams
@@ -63,13 +62,7 @@ def test_single_mode_critical_step_matches_the_formula():
 
 
 def _stiff_shot(tmp_path, **cells):
-    shot = tmp_path / "shot.xlsx"
-    shutil.copy(TEMPLATE, shot)
-    wb = openpyxl.load_workbook(shot)
-    for address, value in cells.items():
-        wb["Sheet1"][address] = value
-    wb.save(shot)
-    return shot
+    return template_with(tmp_path, **cells)
 
 
 #: (id, cells changed, extra flags, verdict, cells that must be named in the messages)

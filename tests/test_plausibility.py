@@ -1,11 +1,10 @@
 """Issue 18.2: implausible inputs and the sheet's quiet cells are named, on the terminal and in
 the Summary, instead of giving figures with no flag."""
 import json
-import shutil
 
 import openpyxl
 import pytest
-from conftest import REFERENCE, TEMPLATE
+from conftest import REFERENCE, TEMPLATE, template_with
 
 import airgun_xl
 from airgun_xl.cells import CELLS
@@ -14,13 +13,7 @@ from airgun_xl.studies.check import plausibility
 
 
 def _shot(tmp_path, **cells):
-    shot = tmp_path / "shot.xlsx"
-    shutil.copy(TEMPLATE, shot)
-    wb = openpyxl.load_workbook(shot)
-    for address, value in cells.items():
-        wb["Sheet1"][address] = value
-    wb.save(shot)
-    return shot
+    return template_with(tmp_path, **cells)
 
 
 def _fill(tmp_path, capsys, **cells):
