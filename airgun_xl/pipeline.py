@@ -13,7 +13,7 @@ from .engine.summary import summarize
 from .errors import AirgunXlError, StabilityError
 from .limits import check_memory, fill_bytes
 from .models import apply_model
-from .studies.check import after_run, before_run, unloading_diverged
+from .studies.check import after_run, before_run, quirk_fired, unloading_diverged
 from .transaction import Publication, check_output, display
 from .workbook.sidecar import SIDECAR_SUFFIXES, render_history, sidecar_path
 from .workbook.writer import render_workbook
@@ -88,17 +88,14 @@ def sidecar_bytes(rows, tracked):
 
 
 def compare_continuous(shot, options):
-    """The shot run with a continuous unloading force, beside a run the macro's quirk hit;
-    (None, why) when that run fails too."""
+    """(the shot run with a continuous unloading force, or None when that run fails too,
+    and the error it failed with), to put beside a run the macro's quirk hit."""
     other = dataclasses.replace(shot, params=shot.params.replace(unloading="continuous"))
     try:
         run = other.run(integrator=options.integrator, host=options.host, track=())
-    except AirgunXlError as error:  # the comparison is extra: say why it is missing
-        return None, (f"the run without the quirk (--unloading continuous) fails too, so the "
-                      f"quirk is not the only cause: {error}")
-    return dataclasses.replace(run, model="continuous unloading"), (
-        f"without the quirk (--unloading continuous) the peak is {run.peak_kg:.5g} kG, "
-        f"against {{peak:.5g}} kG with it; both are in the workbook")
+    except AirgunXlError as error:  # the comparison is extra: the caller says why it is missing
+        return None, error
+    return dataclasses.replace(run, model="continuous unloading"), None
 
 
 def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
@@ -152,17 +149,19 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
         raise StabilityError(f"{diverged}; {UNLOADING_WAY_OUT}")
     say([str(diverged)] if diverged is not None else [])
     say(result.warnings[len(shot.warnings):])
-    after = after_run(result)
-    say(str(f) for f in after)
+    say(str(f) for f in after_run(result))
     compared = None
     if options.compare_models:
         other = "rigid" if options.model == "4-mass" else "4-mass"
         compared = dataclasses.replace(shot, params=apply_model(shot.params, other)).run(
             integrator=options.integrator, host=options.host, track=())
         compared = dataclasses.replace(compared, model=other)
-    elif any(f.cell == "E31" and "unloading-force quirk" in f.message for f in after):
-        compared, said = compare_continuous(model_shot, options)
-        say([said.format(peak=result.peak_kg)])
+    elif quirk_fired(result):
+        compared, error = compare_continuous(model_shot, options)
+        say([f"the run without the quirk (--unloading continuous) fails too, so the quirk is "
+             f"not the only cause: {error}" if compared is None else
+             f"without the quirk (--unloading continuous) the peak is {compared.peak_kg:.5g} "
+             f"kG, against {result.peak_kg:.5g} kG with it; both are in the workbook"])
     result = dataclasses.replace(result, model=options.model)
     needs_summary = outputs.groups & {"summary", "spectrum", "charts"}
     progress("summarizing")

@@ -117,7 +117,7 @@ def align(result, rec, nudge=0.0):
     ok = np.isfinite(result.accel_kg)
     t_run, a_run = h.time[ok], result.accel_kg[ok]
     trace = rec.trace
-    shift = threshold_shift(t_run, a_run, rec, rec.anti_alias)[0] + nudge
+    shift = threshold_shift(t_run, a_run, rec)[0] + nudge
     t = trace.time + shift
     if ((t >= t_run[0]) & (t <= t_run[-1])).sum() < 16:
         raise OptionError("the aligned traces overlap in fewer than 16 samples, expected the "
@@ -176,7 +176,7 @@ def fit_law(v, x, degree=DEGREE, v_range=None):
 SPAN_PERCENTILES = (1, 99)
 
 
-def shots_range(pairs, v):
+def shots_range(v):
     """The velocities the shots' samples cover [m/s] (:data:`SPAN_PERCENTILES`): the fitted
     law claims no more; a shot faster than its top meets the extrapolation warning of any
     run of it (:func:`airgun_xl.studies.check.impact_speed_finding`)."""
@@ -214,7 +214,7 @@ def calibrate_law(pairs, cfc=None, degree=DEGREE, integrator="legacy",
             xs.append(x)
             errors.append(rms_error(a))
         v, x = np.concatenate(vs), np.concatenate(xs)
-        new = fit_law(v, x, degree, shots_range(pairs, v))
+        new = fit_law(v, x, degree, shots_range(v))
         change = law_change(new, law, np.linspace(v.min(), v.max(), 101))
         out.iterations.append(Iteration(number, change, float(np.max(errors)), len(v)))
         out.law, out.velocity, out.factor = new, v, x
@@ -438,7 +438,6 @@ class Calibration:
     bounds: dict = field(default_factory=dict)  # (low, high) of each fitted value
     law_nodes: np.ndarray = None  # [m/s] where the law's standard errors are
     law_errors: np.ndarray = None  # [-] standard errors of the law's values there
-    law_span: tuple = None  # [m/s] the velocities the law's samples cover (1st-99th pct)
     recordings: list = field(default_factory=list)  # each shot's measured Recording
     warnings: list = field(default_factory=list)
     notes: list = field(default_factory=list)  # said with the figures; no verdict on them
@@ -568,12 +567,9 @@ def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objecti
     recs = [prepare(t, cfc, anti_alias, p.delta) for p, t in zip(params, traces, strict=True)]
     pairs = list(zip(params, recs, strict=True))
 
-    def run_all(ps):
-        counter["runs"] += len(ps)
-        return [align(_run(p, integrator), r) for p, r in zip(ps, recs, strict=True)]
-
-    before = [score(a) for a in run_all(params)]
-    law_cal, nodes, law_errors, span = None, None, None, None
+    before = [score(align(_run(p, integrator), r)) for p, r in zip(params, recs, strict=True)]
+    counter["runs"] += len(params)
+    law_cal, nodes, law_errors = None, None, None
     if law:
         law_cal = calibrate_law(pairs, cfc, degree, integrator)
         counter["runs"] += len(law_cal.iterations) * len(pairs)
@@ -582,24 +578,23 @@ def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objecti
         counter["runs"] += evaluations * len(pairs)
         params = [p.replace(crush_law=refined) for p in params]
         pairs = list(zip(params, recs, strict=True))
-        span = refined.v_range
     fitted, start, errors, bounds = {}, {}, {}, {}
     if fit:
         result = fit_parameters(pairs, fit, cfc, objective, integrator)
         counter["runs"] += result.evaluations * len(pairs)
         params, fitted, start = result.params, result.values, result.start
         errors, bounds = result.errors, result.bounds
-    aligned = run_all(params)
+    runs = [_run(p, integrator) for p in params]
+    counter["runs"] += len(runs)
+    aligned = [align(run, rec) for run, rec in zip(runs, recs, strict=True)]
     after = [score(a) for a in aligned]
     cal = Calibration(params, law_cal, fitted, start, before, after, aligned,
                       counter["runs"], time.perf_counter() - started, errors, bounds, nodes,
-                      law_errors, span, recs)
-    for rec, p in zip(recs, params, strict=True):
+                      law_errors, recs)
+    for rec, run in zip(recs, runs, strict=True):  # the same runs, cross-checked
         cal.warnings += [f"{rec.trace.name}: {w}" for w in rec.warnings]
-        run = _run(p, integrator)
         ok = np.isfinite(run.accel_kg)
-        said = alignment_shift(run.history.time[ok], run.accel_kg[ok], rec, "threshold",
-                               rec.anti_alias)[3]
+        said = alignment_shift(run.history.time[ok], run.accel_kg[ok], rec, "threshold")[3]
         cal.warnings += [f"{rec.trace.name}: {w}" for w in said]
     found, cal.notes = verdict(cal, cfc, objective, params[0])
     cal.warnings += found

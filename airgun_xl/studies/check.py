@@ -117,13 +117,12 @@ def before_run(p, integrator="legacy"):
                              f"the macro's row count gives {p.rows:,} rows, not "
                              f"{round(steps) + 2:,}"))
     s = p.samplerate
-    if s < 1:
-        pass  # the sub-row filter quirk: named by the run (engine.filtered.sub_row_warning)
-    elif 2 * s >= p.rows - 2:
+    # below one row (s < 1) is the sub-row filter quirk, named by the run (engine.filtered)
+    if 1 <= s and 2 * s >= p.rows - 2:
         found.append(Finding("warning", "E34", f"1/(E2*E34) = {s:.6g} rows: the filter needs "
                              f"2 x that within the run's {p.rows:,} rows, so there is no "
                              "filtered column"))
-    elif not float(s).is_integer():
+    elif 1 <= s and not float(s).is_integer():
         found.append(Finding("warning", "E34", f"1/(E2*E34) = {s:.6g} is not a whole number "
                              "of rows: the legacy filtered column is ill-defined (Excel "
                              "drifts a row per sample, LibreOffice writes zeros)"))
@@ -221,6 +220,13 @@ def shot_findings(p, stats):
     if speed is not None:
         found.append(speed)
     return found + stats_findings(p, stats)
+
+
+def quirk_fired(result):
+    """Whether the macro's unloading-force quirk fired in a run (the kernel's count)."""
+    stats = result.history.stats
+    return (result.params.unloading == "macro" and stats is not None
+            and stats.second_onset >= 0)
 
 
 def quirk_findings(result):

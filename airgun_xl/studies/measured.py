@@ -259,13 +259,13 @@ def check_prediction(pred_kg):
                           "mitigator: A27..A30), expected a shot whose bird hits the MEM")
 
 
-def threshold_shift(pred_time, pred_kg, rec, anti_alias=None):
+def threshold_shift(pred_time, pred_kg, rec):
     """(shift, impact, filtered prediction): the shift [s] to add to the measured time so that
     both impact instants coincide (:func:`crossing` of each filtered pulse at the recording's
     level, held), the prediction's impact instant [s], and its filtered (time, values) from
     rest."""
     check_prediction(pred_kg)
-    pred_time, pred = filtered_from_rest(pred_time, pred_kg, rec.cfc, anti_alias)
+    pred_time, pred = filtered_from_rest(pred_time, pred_kg, rec.cfc, rec.anti_alias)
     impact = crossing(pred_time, pred, rec.fraction)
     measured = crossing(rec.trace.time, rec.filtered, rec.fraction, rec.sustain)
     return impact - measured, impact, (pred_time, pred)
@@ -288,10 +288,10 @@ def xcorr_shift(f_time, f_pred, rec):
     return float(grid[0] + k * dt - rec.trace.time[0])
 
 
-def alignment_shift(pred_time, pred_kg, rec, alignment="threshold", anti_alias=None):
+def alignment_shift(pred_time, pred_kg, rec, alignment="threshold"):
     """(shift, impact, both shifts, warnings): the alignment asked for, cross-checked against
     the other; a disagreement over :data:`AGREE_SAMPLES` samples is a warning naming both."""
-    shift, impact, (f_time, f_pred) = threshold_shift(pred_time, pred_kg, rec, anti_alias)
+    shift, impact, (f_time, f_pred) = threshold_shift(pred_time, pred_kg, rec)
     other = xcorr_shift(f_time, f_pred, rec)
     shifts = {"threshold": shift, "xcorr": other}
     used = shifts[alignment]
@@ -352,7 +352,7 @@ def compare(pred_time, pred_kg, trace, cfc=None, alignment="threshold", rigid=No
                           f"{', '.join(ALIGNMENTS)}")
     rec = prepare(trace, cfc, anti_alias, float(pred_time[1] - pred_time[0]))
     hz = rec.anti_alias
-    shift, impact_pred, shifts, said = alignment_shift(pred_time, pred_kg, rec, alignment, hz)
+    shift, impact_pred, shifts, said = alignment_shift(pred_time, pred_kg, rec, alignment)
     time = trace.time + shift
     inside = (time >= min(pred_time[0], impact_pred)) & (time <= pred_time[-1])
     if inside.sum() < 16:
