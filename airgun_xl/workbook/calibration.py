@@ -15,7 +15,7 @@ from ..transaction import atomic_path, check_output
 from .charts import line_series, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
 from .law_sheet import write_law_sheet
-from .page_setup import not_printed, one_page
+from .report import not_printed, one_page
 from .sheets import write_about, write_number_columns, write_warnings
 from .writer import close_workbook, new_workbook, sheet_names, write_cells
 

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..engine.summary import KG, PEAK_MIN_HZ, SPECTRUM_MAX_HZ
-from .page_setup import one_page
+from . import report
+from .report import one_page
 
 #: Most points a chart series references; spreadsheet apps slow down well before 100,000.
 POINT_BUDGET = 20_000
@@ -30,6 +31,7 @@ class Series:
     markers: bool = False
     y2: bool = False  # on the secondary (right) axis
     dash: bool = False  # dashed, drawn over the others (a comparison or a mark)
+    style: str = "solid"  # the line's dash type, to tell apart curves of one chart
 
 
 @dataclass(frozen=True)
@@ -41,6 +43,8 @@ class ChartSpec:
     series: tuple
     x_range: tuple = None  # (min, max); None: the run's time span
     y2_title: str = None
+    y_format: str = None  # the y axis's number format (None: by its span)
+    x_format: str = None  # the x axis's ("0.0," shows Hz as kHz)
 
 
 #: Lowest frequency the spectrum chart shows: below it the pulse's own content (4.2 kG at 0 Hz
@@ -48,29 +52,29 @@ class ChartSpec:
 SPECTRUM_MIN_HZ = PEAK_MIN_HZ
 
 CHARTS = (
-    ChartSpec("accel", "Test-item acceleration (Fig. 12)", "Time (s)", "Acceleration (kG's)",
+    ChartSpec("accel", "Test-item acceleration (Fig. 12)", "Time (ms)", "Acceleration (kG's)",
               (Series("accel_kg", "Acceleration"),
                Series("filtered_kg", "Filtered samples", markers=True),
                Series("compared_kg", "Other model", dash=True))),
     ChartSpec("spectrum", "FFT of the test-item acceleration (Figs. 14-15), from the end of "
-              "the pulse's own lobe", "Frequency (Hz)", "Amplitude (kG)",
+              "the pulse's own lobe", "Frequency (kHz)", "Amplitude (kG)",
               (Series("spectrum", "Amplitude"),
                Series("dominant", "Dominant frequencies (the Summary's)", markers=True),
                Series("natural", "OBR chain natural frequencies (initial masses)",
                       dash=True)),
-              (SPECTRUM_MIN_HZ, SPECTRUM_MAX_HZ)),
-    ChartSpec("force", "Mitigator force (Fig. 16)", "Time (s)", "Force (N)",
-              (Series("force", "Mitigator force"),)),
-    ChartSpec("crush", "Mitigator deflection and plastic wave front (Fig. 17)", "Time (s)",
+              (SPECTRUM_MIN_HZ, SPECTRUM_MAX_HZ), x_format="0.0,"),
+    ChartSpec("force", "Mitigator force (Fig. 16)", "Time (ms)", "Force (kN)",
+              (Series("force", "Mitigator force"),), y_format="#,##0,"),
+    ChartSpec("crush", "Mitigator deflection and plastic wave front (Fig. 17)", "Time (ms)",
               "Deflection (m)", (Series("deflection", "Mitigator deflection"),
                                  Series("x_plastic", "Plastic wave front"))),
-    ChartSpec("velocity", "OBR velocity (Fig. 19)", "Time (s)", "Velocity (m/s)",
+    ChartSpec("velocity", "OBR velocity (Fig. 19)", "Time (ms)", "Velocity (m/s)",
               (Series("v31", "OBR front plate"), Series("v1", "MEM"))),
     ChartSpec("displacements", "Displacements; Y32, Y33 relative to Y31 (right axis)",
-              "Time (s)", "Displacement (m)",
+              "Time (ms)", "Displacement (m)",
               (Series("y1", "Y1 (MEM)"), Series("y31", "Y31 (OBR Front Plate)"),
                Series("y32_rel", "Y32 - Y31 (mm)", y2=True),
-               Series("y33_rel", "Y33 - Y31 (mm)", y2=True)),
+               Series("y33_rel", "Y33 - Y31 (mm)", y2=True, style="round_dot")),
               y2_title="Relative to Y31 (mm)"),
 )
 
@@ -91,7 +95,7 @@ def series_data(result, spectrum, compared=None, natural=()):
     ``natural`` are the OBR chain's natural frequencies [Hz], marked on the spectrum chart.
     """
     h = result.history
-    t = h.time
+    t = h.time * 1e3  # [ms], as the Summary
     f_rows = result.filtered.rows[result.filtered.rows < len(t)]
     f_vals = result.filtered.values[result.filtered.rows < len(t)]
     data = {
@@ -112,7 +116,7 @@ def series_data(result, spectrum, compared=None, natural=()):
     if marks and shown.any():
         data["natural"] = natural_marks(marks, float(np.max(spectrum.amplitude[shown])))
     if compared is not None:
-        data["compared_kg"] = (compared.history.time, compared.accel_kg)
+        data["compared_kg"] = (compared.history.time * 1e3, compared.accel_kg)
     for key in ("force", "deflection", "x_plastic", "v31", "v1"):
         values = getattr(h, key)
         if values is not None:
@@ -173,10 +177,8 @@ def line_series(chart, sheet, name, first, last, x_col, y_col, color, dash=None)
                       "marker": {"type": "none"}})
 
 
-def _axis(title, lo, hi, gridlines=True):
-    return {"name": title, "min": lo, "max": hi,
-            "major_gridlines": {"visible": gridlines, "line": {"color": "#d9d9d9"}},
-            "num_format": "0.0E+0" if max(abs(lo), abs(hi)) >= 1e5 else "General"}
+def _axis(title, lo, hi, gridlines=True, num_format=None):
+    return report.axis(title, lo, hi, gridlines=gridlines, num_format=num_format)
 
 
 def _in_range(x, y, x_range):
@@ -190,7 +192,7 @@ def _in_range(x, y, x_range):
 CHART_ROWS, CHART_COLS = 19, 10
 
 
-def add_charts(workbook, sheet, refs, data, max_time, labels=None, x_ranges=None):
+def add_charts(workbook, sheet, refs, data, max_time, labels=None, x_ranges=None, shot=None):
     """Insert the charts on ``sheet``, two a row; the sheet prints as one landscape page.
 
     Parameters
@@ -202,12 +204,14 @@ def add_charts(workbook, sheet, refs, data, max_time, labels=None, x_ranges=None
     data : dict
         Series key -> full-resolution (x, y), for the axis ranges.
     max_time : float
-        End of the time axis [s].
+        End of the time axis [ms].
     labels : dict, optional
         Series key -> legend name, overriding the chart's own.
     x_ranges : dict, optional
         Chart key -> (min, max) of its x axis, overriding the chart's own (the spectrum's
         band starts where the pulse's own lobe ends).
+    shot : str, optional
+        The input file's name, for the page header.
 
     Returns
     -------
@@ -235,7 +239,7 @@ def add_charts(workbook, sheet, refs, data, max_time, labels=None, x_ranges=None
                 options["line"] = {"none": True}
             else:
                 options["line"] = {"color": color, "width": 2.0 if s.dash else 1.25,
-                                   "dash_type": "dash" if s.dash else "solid"}
+                                   "dash_type": "dash" if s.dash else s.style}
                 options["marker"] = {"type": "none"}
             chart.add_series(options)
             if ref.points < ref.total:
@@ -246,7 +250,7 @@ def add_charts(workbook, sheet, refs, data, max_time, labels=None, x_ranges=None
         chart.set_title({"name": title, "name_font": {"size": 11}})
         x_range = (x_ranges or {}).get(spec.key, spec.x_range)
         xlo, xhi = x_range or (0.0, max_time)
-        chart.set_x_axis(_axis(spec.x_title, xlo, xhi))
+        chart.set_x_axis(_axis(spec.x_title, xlo, xhi, num_format=spec.x_format))
         for secondary in (False, True):
             on_axis = [s for s in present if s.y2 == secondary]
             if not on_axis:
@@ -256,12 +260,12 @@ def add_charts(workbook, sheet, refs, data, max_time, labels=None, x_ranges=None
             if secondary:
                 chart.set_y2_axis(_axis(spec.y2_title, ylo, yhi, gridlines=False))
             else:
-                chart.set_y_axis(_axis(spec.y_title, ylo, yhi))
+                chart.set_y_axis(_axis(spec.y_title, ylo, yhi, num_format=spec.y_format))
         chart.set_legend({"position": "bottom"} if len(present) > 1 else {"none": True})
         chart.set_size({"width": 640, "height": 360})
         row, col = 2 + (placed // 2) * CHART_ROWS, (placed % 2) * CHART_COLS
         sheet.insert_chart(row, col, chart)
         placed += 1
     last_row = 2 + -(-placed // 2) * CHART_ROWS
-    one_page(sheet, last_row, 2 * CHART_COLS - 1)
+    one_page(sheet, last_row, 2 * CHART_COLS - 1, shot=shot, title="Charts")
     return placed

@@ -6,7 +6,7 @@ from ..engine.decimate import minmax_indices
 from ..transaction import atomic_path, check_output
 from .charts import nice_range
 from .columns_sheet import ColumnsWorksheet
-from .page_setup import one_page
+from .report import one_page
 from .sheets import write_number_columns
 from .writer import close_workbook, new_workbook
 

@@ -15,7 +15,7 @@ import math
 from ..crush_law import DEGREE, LEGACY_LAW, CrushLaw
 from ..errors import CellError
 from .columns_sheet import ColumnsWorksheet
-from .page_setup import one_page
+from .report import one_page
 
 SHEET_NAME = "Crush law"
 KEY = SHEET_NAME.upper()

@@ -5,7 +5,7 @@ import numpy as np
 from ..transaction import atomic_path, check_output
 from .charts import line_series, log_axis, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
-from .page_setup import not_printed, one_page
+from .report import not_printed, one_page
 from .sheets import write_about, write_number_columns, write_warnings
 from .writer import close_workbook, new_workbook
 

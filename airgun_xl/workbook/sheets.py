@@ -12,7 +12,7 @@ from ..engine.decimate import minmax_indices
 from ..engine.summary import PULSE_FRACTION, SPECTRUM_MAX_HZ
 from ..errors import OutputError
 from .charts import COPY_POINTS, POINT_BUDGET
-from .page_setup import not_printed, one_page
+from .report import Style, general_format, not_printed, one_page, shown
 
 
 @dataclass(frozen=True)
@@ -25,13 +25,17 @@ class Ref:
     first_row: int
     last_row: int
     total: int  # points of the full-resolution series
+    x_sheet: str = None  # the x values on another sheet (None: on ``sheet``) ...
+    x_first_row: int = None  # ... from this row, as many as the y values
 
     @property
     def points(self):
         return self.last_row - self.first_row + 1
 
     def x_range(self):
-        return [self.sheet, self.first_row, self.x_col, self.last_row, self.x_col]
+        sheet = self.x_sheet or self.sheet
+        first = self.first_row if self.x_first_row is None else self.x_first_row
+        return [sheet, first, self.x_col, first + self.points - 1, self.x_col]
 
     def y_range(self):
         return [self.sheet, self.first_row, self.y_col, self.last_row, self.y_col]
@@ -101,13 +105,18 @@ def write_spectrum(wb, spectrum, sheet_class, name="Spectrum"):
     return {"spectrum": Ref(ws.get_name(), 0, 1, 1, n, n)} if n else {}
 
 
-def write_chart_data(wb, data, refs, sheet_class, name="ChartData", budget=POINT_BUDGET):
+def write_chart_data(wb, data, refs, sheet_class, name="ChartData", budget=POINT_BUDGET,
+                     time_ms=None):
     """Copies on ChartData of the series that have no usable home; decimated past the budget.
 
     ``budget`` lowers the budget (the rows a ``--every N`` run keeps on its sheets): a longer
-    series is cut to that many points, the min and max of each bucket. Returns the refs of all
-    chart series, homes and copies.
+    series is cut to that many points, the min and max of each bucket. ``time_ms`` is the kept
+    rows' time [ms]: a series charted from its home (whose time column is in s) takes its x
+    from a copy of it here, so every chart's time axis is in ms, as the Summary. Returns the
+    refs of all chart series, homes and copies.
     """
+    import dataclasses
+
     ws = wb.add_worksheet(name, worksheet_class=sheet_class)
     not_printed(ws)
     limit = max(2, min(budget, POINT_BUDGET))
@@ -116,9 +125,18 @@ def write_chart_data(wb, data, refs, sheet_class, name="ChartData", budget=POINT
                           "the min and max of each bucket of consecutive points.")
     out = {}
     col = 0
+    time_col = None
     for key, (x, y) in data.items():
         home = refs.get(key)
         if home is not None and home.points <= limit:
+            if key in TIME_SERIES and time_ms is not None:
+                if time_col is None:  # the kept rows' time in ms, once, for every home
+                    time_col = col
+                    ws.write_string(1, col, "Time (ms)")
+                    write_number_columns(ws, 2, {col: time_ms[:limit]})
+                    col += 1
+                home = dataclasses.replace(home, x_sheet=ws.get_name(), x_col=time_col,
+                                           x_first_row=home.first_row + 1)
             out[key] = home
             continue
         index = minmax_indices(y, min(COPY_POINTS, limit) if len(y) > limit else limit)
@@ -130,21 +148,9 @@ def write_chart_data(wb, data, refs, sheet_class, name="ChartData", budget=POINT
     return out
 
 
-#: How the Summary shows a quantity, by the unit code of its row: (shown unit, factor from SI,
-#: number format). Values are stored in the shown unit, so what a cell shows is what it holds.
-DISPLAY = {
-    "kG": ("kG", 1.0, "0.000"),
-    "s": ("ms", 1e3, "0.0000"),
-    "Hz": ("kHz", 1e-3, "0.00"),
-    "m": ("m", 1.0, "0.0000"),
-    "kg": ("kg", 1.0, "0.000"),
-    "m/s": ("m/s", 1.0, "0.00"),
-    "step": ("µs", 1e6, "0.000"),
-    "runtime": ("s", 1.0, "0.00"),
-    "ratio": ("", 1.0, "0.000"),
-    "count": ("", 1.0, "#,##0"),
-    "": ("", 1.0, None),
-}
+#: Chart series against time (the rest are against frequency).
+TIME_SERIES = ("accel_kg", "filtered_kg", "compared_kg", "y1", "y31", "y32_rel", "y33_rel",
+               "force", "deflection", "x_plastic", "v31", "v1")
 
 
 def variant_name(result):
@@ -155,7 +161,8 @@ def variant_name(result):
 
 
 def _summary_rows(result, summary, timings):
-    """(label, value in SI, unit code of :data:`DISPLAY`, definition) per Summary row."""
+    """(label, value in SI, quantity code of :data:`~airgun_xl.workbook.report.QUANTITIES`
+    or "" for text, definition) per Summary row."""
     p = result.params
     s = summary
     rows = [
@@ -233,41 +240,35 @@ def write_summary(wb, result, summary, timings, name="Summary"):
     """The Summary sheet: one labelled cell per figure (label A, value B in the unit of C, with
     a number format fit for it, definition D); printed as one landscape page."""
     ws = wb.add_worksheet(name)
+    style = Style(wb)
     ws.set_column(0, 0, 44)
     ws.set_column(1, 1, 16)
     ws.set_column(2, 2, 6)
     ws.set_column(3, 3, 100)
-    bold = wb.add_format({"bold": True})
-    formats = {code: wb.add_format({"num_format": fmt, "align": "right"})
-               for code, (_, _, fmt) in DISPLAY.items() if fmt}
-    text = wb.add_format({"align": "left"})
+    text = style.get(align="left")
     for col, heading in enumerate(("Quantity", "Value", "Unit", "Definition")):
-        ws.write_string(0, col, heading, bold)
+        ws.write_string(0, col, heading, style.bold)
     rows = _summary_rows(result, summary, timings)
     flags = flagged_figures(timings.get("warnings", []))
-    flagged = {code: wb.add_format({"num_format": fmt, "align": "right", "bg_color": "#FFC7CE",
-                                    "font_color": "#9C0006"})
-               for code, (_, _, fmt) in DISPLAY.items() if fmt}
     for row, (label, value, code, note) in enumerate(rows, 1):
-        unit, factor, _ = DISPLAY[code]
         ws.write_string(row, 0, label)
         if label in flags:  # a figure the warnings below put in doubt, flagged where shown
             note = f"DOUBTED: see the warnings on {', '.join(flags[label])}" + (
                 f"; {note}" if note else "")
         if isinstance(value, (float, int, np.floating, np.integer)) and not isinstance(value,
                                                                                          bool):
-            ws.write_number(row, 1, float(value) * factor,
-                            (flagged if label in flags else formats).get(code))
+            ws.write_number(row, 1, shown(float(value), code),
+                            style.of(code, label in flags, align="right"))
         elif isinstance(value, datetime.datetime):
             ws.write_string(row, 1, value.isoformat(), text)
         elif value is not None:
             ws.write_string(row, 1, str(value), text)
-        if unit:
-            ws.write_string(row, 2, unit)
+        if code and style.unit(code):
+            ws.write_string(row, 2, style.unit(code))
         if note:
             ws.write_string(row, 3, note)
     last = write_warnings(wb, ws, len(rows) + 2, timings.get("warnings", []), 3)
-    one_page(ws, last, 3)
+    one_page(ws, last, 3, shot=timings.get("shot"), title="Summary")
     ws.freeze_panes(1, 0)
     return ws
 
@@ -315,3 +316,43 @@ def write_warnings(wb, ws, row, warnings, last_col):
         lines = -(-len(text) // WARNING_LINE_CHARS)
         ws.set_row(row + i, 15 * max(1, lines))
     return row + len(warnings)
+
+
+def write_parameters(wb, params, shot, name="Parameters"):
+    """The Parameters sheet: every cell the macro reads (:data:`airgun_xl.cells.CELLS`), its
+    quantity, the value the run used (exact, shown to 7 significant digits), its unit and
+    meaning; printed as one landscape page. Sheet 1 keeps the input's layout as data."""
+    from ..cells import CELLS
+
+    ws = wb.add_worksheet(name)
+    style = Style(wb)
+    widths = (7, 30, 16, 8, 70)
+    for col, width in enumerate(widths):
+        ws.set_column(col, col, width)
+    ws.write_string(0, 0, f"Parameters of {shot or 'the shot'}, as the run read them "
+                          "(ARL-TR-3559's cells)", style.title)
+    for col, heading in enumerate(("Cell", "Quantity", "Value", "Unit", "Meaning")):
+        ws.write_string(2, col, heading, style.header)
+    row = 3
+    for cell in CELLS:
+        value = getattr(params, cell.name, None)
+        ws.write_string(row, 0, cell.address)
+        ws.write_string(row, 1, cell.label)
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            ws.write_number(row, 2, float(value),
+                            style.fmt(general_format([value], digits=7), align="right"))
+        else:
+            ws.write_string(row, 2, "blank", style.get(align="right"))
+        ws.write_string(row, 3, cell.unit.replace("^3", "³") or "-")
+        ws.write_string(row, 4, cell.meaning)
+        row += 1
+    law = params.crush_law
+    ws.write_string(row + 1, 1, "Crush-factor law")
+    ws.write_string(row + 1, 2, "Eq. (8)" if law.is_legacy else "fitted")
+    ws.write_string(row + 1, 4, "the macro's polynomial" if law.is_legacy else
+                    f"from the Crush law sheet, valid {law.v_range[0]:.4g} to "
+                    f"{law.v_range[1]:.4g} m/s")
+    ws.write_string(row + 2, 1, "Model; unloading force")
+    ws.write_string(row + 2, 2, f"{params.model}; {params.unloading}")
+    one_page(ws, row + 2, len(widths) - 1, shot=shot, title="Parameters")
+    return ws

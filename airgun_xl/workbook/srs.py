@@ -2,7 +2,7 @@
 
 from ..transaction import atomic_path, check_output
 from .charts import log_axis, titled
-from .page_setup import one_page
+from .report import one_page
 from .sheets import write_about
 from .writer import close_workbook, new_workbook
 

@@ -8,7 +8,7 @@ from ..engine.batch import FIGURES
 from ..transaction import atomic_path, check_output
 from .charts import nice_range
 from .columns_sheet import ColumnsWorksheet
-from .page_setup import not_printed, one_page
+from .report import not_printed, one_page
 from .sheets import write_number_columns
 from .writer import close_workbook, new_workbook
 

@@ -39,7 +39,7 @@ from .columns_sheet import ColumnsWorksheet, fast_deflate
 from .formula_eval import Evaluator, FormulaFailure
 from .law_sheet import SHEET_NAME as LAW_SHEET
 from .law_sheet import write_law_sheet
-from .page_setup import not_printed, one_page
+from .report import not_printed, one_page
 from .safe_text import (
     BOOLEAN_FORMAT,
     WORKBOOK_OPTIONS,
@@ -52,6 +52,7 @@ from .sheets import (
     variant_name,
     write_chart_data,
     write_number_columns,
+    write_parameters,
     write_spectrum,
     write_summary,
     write_tracked,
@@ -96,7 +97,7 @@ def new_workbook(path):
 
 
 #: The sheets a fill adds after sheet 1, by their fixed names.
-OUTPUT_SHEETS = ("Summary", "Charts", "Tracked", "Spectrum", "ChartData", SHEET_NAME, LAW_SHEET)
+OUTPUT_SHEETS = ("Parameters", "Summary", "Charts", "Tracked", "Spectrum", "ChartData", SHEET_NAME, LAW_SHEET)
 
 
 def sheet_names(source_title):
@@ -242,10 +243,7 @@ def _write_sheet1(wb, result, outputs, keep, stride, title):
     if "filtered" in outputs:
         for row, value in _filtered_cells(result, stride):
             ws.write_number(row, 27, value)
-    if block:
-        one_page(ws, max(r for r, _ in block) - 1, PARAMETER_COLUMNS - 1, landscape=False)
-    else:
-        not_printed(ws)  # no parameter block: only data
+    not_printed(ws)  # the input's layout and the macro's columns: data (Parameters prints)
     refs = {}
     if rows == result.rows:
         title = ws.get_name()
@@ -253,6 +251,21 @@ def _write_sheet1(wb, result, outputs, keep, stride, title):
             if col in columns and np.isfinite(columns[col]).any():
                 refs[key] = Ref(title, 7, col, 1, rows, rows)
     return refs, warnings
+
+
+def print_outputs_block(ws, block, shot):
+    """The Outputs block on one page, its columns wide enough for their text (a label used
+    to run past the print area and be cut off)."""
+    widths, cells_in_row = {}, {}
+    for (row, _), (cached, _) in block.items():
+        cells_in_row[row] = cells_in_row.get(row, 0) + (cached is not None)
+    for (row, col), (cached, _) in block.items():
+        if cached is not None and cells_in_row[row] > 1:  # a row's lone note overflows
+            widths[col] = max(widths.get(col, 0), len(str(cached)))
+    for col, chars in widths.items():
+        ws.set_column(col - 1, col - 1, min(max(chars + 2, 6), 120))
+    one_page(ws, max(r for r, _ in block) - 1, max(c for _, c in block) - 1, shot=shot,
+             title="Outputs")
 
 
 def close_workbook(wb, path):
@@ -331,7 +344,10 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
     wb = new_workbook(tmp)
     names = sheet_names(source.sheet_title if source is not None else None)
     refs, warnings = _write_sheet1(wb, result, outputs, keep, stride, names["first"])
+    shot = source.path.name if source is not None else None
+    info["shot"] = shot
     if "summary" in outputs:
+        write_parameters(wb, result.params, shot, names["Parameters"])
         write_summary(wb, result, summary, info, names["Summary"])
     charts_ws = wb.add_worksheet(names["Charts"]) if "charts" in outputs else None
     if "tracked" in outputs:
@@ -342,21 +358,21 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
         compared = info.get("compared")
         data = series_data(result, summary.spectrum, compared, summary.natural_initial)
         placed = write_chart_data(wb, data, refs, ColumnsWorksheet, names["ChartData"],
-                                  budget=len(keep))  # --every N thins the copies too
+                                  budget=len(keep),  # --every N thins the copies too
+                                  time_ms=result.history.time[keep] * 1e3)
         labels = None
         if compared is not None:
             labels = {"compared_kg": f"Acceleration, {variant_name(compared)}",
                       "accel_kg": "Acceleration, the macro's unloading (quirk)"
                       if compared.params.unloading == "continuous" else
                       f"Acceleration, {variant_name(result)}"}
-        add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]), labels,
+        add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]) * 1e3, labels,
                    {"spectrum": (np.floor(summary.spectrum.band_start / 100) * 100,
-                                 SPECTRUM_MAX_HZ)})
+                                 SPECTRUM_MAX_HZ)}, shot)
     if source is not None and source.outputs_block:
         outputs_ws = wb.add_worksheet(names[SHEET_NAME], worksheet_class=ColumnsWorksheet)
         warnings += write_cells(outputs_ws, source.outputs_block)
-        one_page(outputs_ws, max(r for r, _ in source.outputs_block) - 1,
-                 max(c for _, c in source.outputs_block) - 1)
+        print_outputs_block(outputs_ws, source.outputs_block, shot)
     if not result.params.crush_law.is_legacy:  # a fitted law goes with the shot
         write_law_sheet(wb, result.params.crush_law, names[LAW_SHEET])
     close_workbook(wb, shown if shown is not None else tmp)

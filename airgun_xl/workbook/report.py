@@ -1,0 +1,191 @@
+"""The report layer: how every report sheet of every workbook shows its numbers and prints.
+
+Every writer (fill, diff, sweep, Monte Carlo, Sobol, convergence, srs, compare-measured,
+calibrate) goes through this module:
+
+- :data:`QUANTITIES` is the one table of shown units: a value's quantity code names its unit,
+  the factor from the unit the writer holds it in, and its number format (kG or g, ms, kHz,
+  MPa, %). :class:`Style` makes the formats once per workbook and writes numbers with them.
+- :func:`one_page` prints a report sheet on one landscape A4 page with a header naming the
+  shot, the input file, the version and the print date; :func:`not_printed` leaves a data
+  sheet out of the print. A fill's workbook holds up to a million rows of data; printed
+  (LibreOffice's PDF export prints every sheet) it used to run to 1,303 pages. A data sheet's
+  print area is one cell that is always blank: LibreOffice leaves out empty pages and Excel
+  prints nothing for it. To print a data sheet, clear its print area (Excel: Page Layout >
+  Print Area > Clear; LibreOffice: Format > Print Ranges > Clear).
+- :func:`axis` gives a chart axis its explicit limits and the number format of its quantity;
+  :func:`chart_size` sizes a chart to the printed columns.
+
+The header carries the print date as a field (``&D``), so a workbook's bytes depend on the
+run alone (the same run gives the same file).
+"""
+from dataclasses import dataclass
+
+from .. import __version__
+
+#: A4 in xlsxwriter's paper codes; Letter printers scale it.
+A4 = 9
+
+#: The blank cell a data sheet's print area holds: the sheet's last column, row 1 (XFD1).
+BLANK_CELL = (0, 16_383)
+
+
+@dataclass(frozen=True)
+class Quantity:
+    """How a quantity is shown: ``unit``, the ``factor`` from the unit its value is held in,
+    and an Excel number ``fmt`` (which never shows more than 7 significant digits)."""
+
+    unit: str
+    factor: float
+    fmt: str
+
+
+#: Quantity code -> how it is shown. The code names the unit the value is held in.
+QUANTITIES = {
+    "kG": Quantity("kG", 1.0, "0.000"),  # the macro's kG (9,800 m/s^2)
+    "g": Quantity("g", 1.0, "#,##0.0"),  # standard g (9.80665 m/s^2), as shock labs work
+    "s": Quantity("ms", 1e3, "0.0000"),
+    "ms": Quantity("ms", 1.0, "0.0000"),
+    "Hz": Quantity("kHz", 1e-3, "0.00"),
+    "Hz-plain": Quantity("Hz", 1.0, "#,##0"),
+    "Pa": Quantity("MPa", 1e-6, "0.000"),
+    "N": Quantity("kN", 1e-3, "#,##0.0"),
+    "m": Quantity("m", 1.0, "0.0000"),
+    "mm": Quantity("mm", 1.0, "0.000"),
+    "kg": Quantity("kg", 1.0, "0.000"),
+    "m/s": Quantity("m/s", 1.0, "0.00"),
+    "step": Quantity("µs", 1e6, "0.000"),
+    "runtime": Quantity("s", 1.0, "0.00"),
+    "ratio": Quantity("", 1.0, "0.000"),
+    "fraction": Quantity("", 1.0, "0.0000"),  # a rating, a correlation, an index, 0..1
+    "%": Quantity("%", 1.0, "0.00%"),  # held as a fraction, shown as a percentage
+    "count": Quantity("", 1.0, "#,##0"),
+    "sci": Quantity("", 1.0, "0.000E+00"),  # any other number: 4 significant digits
+}
+
+
+def number_format(code):
+    """The number format of quantity ``code`` (:data:`QUANTITIES`)."""
+    return QUANTITIES[code].fmt
+
+
+def shown(value, code):
+    """``value`` in the shown unit of ``code``."""
+    return value * QUANTITIES[code].factor
+
+
+def general_format(values, digits=4):
+    """A number format for values of no fixed quantity: fixed decimals to ``digits``
+    significant digits of the largest, or scientific past 1e6 or below 1e-3."""
+    import math
+
+    finite = [abs(float(v)) for v in values if v is not None and math.isfinite(float(v))]
+    top = max(finite, default=0.0)
+    if top == 0.0:
+        return "0"
+    if top >= 1e6 or top < 1e-3:
+        return "0." + "0" * (digits - 1) + "E+00"
+    decimals = max(0, digits - 1 - math.floor(math.log10(top)))
+    return "#,##0" + ("." + "0" * decimals if decimals else "")
+
+
+class Style:
+    """The formats of one workbook's report sheets, made once (xlsxwriter formats belong to
+    their workbook)."""
+
+    def __init__(self, wb):
+        self.wb = wb
+        self._cache = {}
+        self.bold = self.get(bold=True)
+        self.title = self.get(bold=True, font_size=13)
+        self.wrap = self.get(text_wrap=True, valign="top")
+        self.header = self.get(bold=True, text_wrap=True, valign="bottom", bottom=1)
+
+    def get(self, **props):
+        """The format with ``props`` (cached)."""
+        key = tuple(sorted(props.items()))
+        if key not in self._cache:
+            self._cache[key] = self.wb.add_format(props)
+        return self._cache[key]
+
+    def of(self, code, flagged=False, **props):
+        """The format of quantity ``code``; ``flagged``: red, for a doubted figure."""
+        if flagged:
+            props.update(bg_color="#FFC7CE", font_color="#9C0006")
+        return self.get(num_format=number_format(code), **props)
+
+    def fmt(self, num_format, **props):
+        return self.get(num_format=num_format, **props)
+
+    def number(self, ws, row, col, value, code, flagged=False):
+        """Write ``value`` (held in the unit ``code`` names) in its shown unit and format;
+        None or a non-finite value leaves the cell empty."""
+        import math
+
+        if value is None or not math.isfinite(float(value)):
+            return
+        ws.write_number(row, col, float(value) * QUANTITIES[code].factor,
+                        self.of(code, flagged))
+
+    def unit(self, code):
+        return QUANTITIES[code].unit
+
+
+#: Characters of the shot's name the header keeps (Excel allows 255 for the whole header).
+HEADER_NAME_CHARS = 60
+
+
+def _header_text(text):
+    text = str(text)
+    if len(text) > HEADER_NAME_CHARS:
+        text = text[:HEADER_NAME_CHARS - 1] + "…"
+    return text.replace("&", "&&")
+
+
+def one_page(ws, last_row, last_col, first_row=0, first_col=0, landscape=True, shot=None,
+             title=None):
+    """Print ``ws``'s range (0-based, inclusive) on one A4 page: a header with ``shot`` (the
+    input file's name), ``title`` (the sheet's name by default), the version and the print
+    date; the file and sheet names in the footer."""
+    ws.print_area(first_row, first_col, last_row, last_col)
+    if landscape:
+        ws.set_landscape()
+    else:
+        ws.set_portrait()
+    ws.set_paper(A4)
+    ws.fit_to_pages(1, 1)
+    ws.set_margins(left=0.5, right=0.5, top=0.75, bottom=0.6)
+    left = _header_text(shot) if shot else "&F"
+    centre = _header_text(title) if title else "&A"
+    ws.set_header(f"&L{left}&C&B{centre}&Rairgun-xl {__version__}, printed &D")
+    ws.set_footer("&L&F&R&A")
+
+
+def not_printed(ws):
+    """Leave ``ws`` out of the default print: a print area of one blank cell."""
+    ws.print_area(*BLANK_CELL, *BLANK_CELL)
+
+
+#: Pixels of a default column (8.43 characters) and of a default row (15 points).
+COLUMN_PX, ROW_PX = 64, 20
+
+
+def chart_size(columns, rows):
+    """(width, height) [px] of a chart that covers ``columns`` default columns and ``rows``
+    default rows: charts sized to the printed range."""
+    return {"width": columns * COLUMN_PX, "height": rows * ROW_PX}
+
+
+def axis(title, lo, hi, code=None, log=False, gridlines=True, num_format=None):
+    """An xlsxwriter axis dict: explicit limits, gridlines, and the number format of quantity
+    ``code`` (the values are plotted in the unit the code names, its factor applied already);
+    ``num_format`` overrides it."""
+    out = {"name": title, "min": lo, "max": hi,
+           "major_gridlines": {"visible": gridlines, "line": {"color": "#d9d9d9"}}}
+    fmt = num_format or (number_format(code) if code else general_format([lo, hi], digits=2))
+    out["num_format"] = fmt
+    if log:
+        out["log_base"] = 10
+        out["num_format"] = num_format or "#,##0.###"
+        out["minor_gridlines"] = {"visible": gridlines, "line": {"color": "#eeeeee"}}
+    return out
