@@ -108,13 +108,20 @@ def run(args):
     seconds = time.perf_counter() - started
     stats = spread(result.figures[:, 0])
     write_sweep(result, output, args.force, stats if args.mc is not None else None,
-                sensitivity)
+                sensitivity, shot=Path(args.shot).name)
     steps = total * (shot.params.rows - 2)
     print(f"wrote {output}: {total:,} shots in {seconds:.2f} s ({steps / seconds:.3g} "
           f"shot-steps/s); {int(result.diverged.sum())} diverged, "
           f"{int(result.invalid.sum())} invalid")
-    print(f"  peak {stats['mean']:.4f} kG mean, sd {stats['sd']:.4f}, 5-95% "
-          f"{stats['p5']:.4f}-{stats['p95']:.4f} kG")
+    if result.kind == "grid":  # every combination, not a distribution: its extremes
+        import numpy as np
+
+        peaks = result.figures[:, 0][np.isfinite(result.figures[:, 0])]
+        if len(peaks):
+            print(f"  peak from {peaks.min():.4f} to {peaks.max():.4f} kG over the grid")
+    else:
+        print(f"  peak {stats['mean']:.4f} kG mean, sd {stats['sd']:.4f}, 5-95% "
+              f"{stats['p5']:.4f}-{stats['p95']:.4f} kG")
     flagged, cells = result.flagged()
     if flagged:
         from . import warn

@@ -102,7 +102,7 @@ def sobol(p, sds, n, seed=None, integrator="legacy", model="4-mass", progress=No
                                 print_to_console=False)
         indices[name] = {k: np.asarray(found[k], dtype=float)
                          for k in ("S1", "S1_conf", "ST", "ST_conf")}
-    shots = SweepResult(problem["names"], samples, figures, diverged, invalid, flags)
+    shots = SweepResult(problem["names"], samples, figures, diverged, invalid, flags, "sobol")
     return Sensitivity(problem["names"], indices, shots)
 
 

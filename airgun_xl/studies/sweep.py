@@ -79,6 +79,7 @@ class SweepResult:
     diverged: np.ndarray
     invalid: np.ndarray  # shots whose sampled values were not a valid shot
     flags: list = None  # each shot's warnings (str), as a fill of it would say them
+    kind: str = "grid"  # "grid" (every combination), "montecarlo" or "sobol" (samples)
 
     def flagged(self):
         """How many shots have a warning, and how often each cell is named: (n, {cell: n})."""
@@ -140,7 +141,8 @@ def monte_carlo(p, sds, n, seed=None, integrator="legacy", model="4-mass", progr
     varied = [(cell, fields) for cell, fields, _, _ in sds]
     figures, diverged, invalid, flags = _evaluate(p, varied, samples, integrator, model,
                                                   progress, runner)
-    return SweepResult([c for c, _ in varied], samples, figures, diverged, invalid, flags)
+    return SweepResult([c for c, _ in varied], samples, figures, diverged, invalid, flags,
+                       "montecarlo")
 
 
 def spread(values):

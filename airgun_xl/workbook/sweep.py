@@ -8,7 +8,7 @@ from ..engine.batch import FIGURES
 from ..transaction import atomic_path, check_output
 from .charts import nice_range
 from .columns_sheet import ColumnsWorksheet
-from .report import not_printed, one_page
+from .report import Style, axis, chart_size, general_format, not_printed, one_page
 from .sheets import write_number_columns
 from .writer import close_workbook, new_workbook
 
@@ -16,25 +16,44 @@ FIGURE_HEADERS = {"peak_kg": "Peak (kG)", "time_of_peak": "Time of peak (s)",
                   "filtered_peak_kg": "Filtered peak (kG)",
                   "pulse_duration": "Pulse duration (s)", "max_crush": "Max crush (m)"}
 
+#: How a chart axis shows a cell of each unit: the shown unit and the number format (the
+#: trailing commas show Pa as MPa, without a copy of the values).
+AXIS_UNITS = {"Pa": ("MPa", "#,##0.0,,"), "m/s": ("m/s", "0.0"), "N/m": ("N/m", "0.00E+00"),
+              "s": ("s", "0.00E+00")}
 
-def _label(cell):
+#: Most levels a family of curves has (one series per level); more: a scatter.
+MAX_FAMILY = 12
+
+
+def _label(cell, unit=None):
     c = BY_ADDRESS.get(cell)
-    return f"{cell} {c.label} ({c.unit})" if c and c.unit else cell
+    if c is None:
+        return cell
+    unit = unit if unit is not None else c.unit
+    return f"{cell} {c.label}" + (f" ({unit})" if unit else "")
 
 
-def write_sweep(result, path, force, stats=None, sensitivity=None):
-    """The sweep's workbook at ``path``: the Sweep table and Charts; with ``stats`` (a Monte
+def _cell_axis(cell, values):
+    """(title, number format) of a chart axis over ``cell``'s ``values``."""
+    c = BY_ADDRESS.get(cell)
+    unit, fmt = AXIS_UNITS.get(c.unit if c else "", (None, None))
+    return _label(cell, unit), fmt or general_format(values, digits=3)
+
+
+def write_sweep(result, path, force, stats=None, sensitivity=None, shot=None):
+    """The sweep's workbook at ``path``: the Sweep table and Charts (a grid over two or more
+    inputs: a family of curves, one series per level of the second); with ``stats`` (a Monte
     Carlo) the Spread sheet and the band's convergence; with ``sensitivity`` (Sobol) the
-    Sensitivity sheet and its bar charts."""
+    Sensitivity sheet and its bar charts. ``shot`` names the input in the page headers."""
     check_output(path, force)
     with atomic_path(path, force) as tmp:
         wb = new_workbook(tmp)
+        style = Style(wb)
         ws = wb.add_worksheet("Sweep", worksheet_class=ColumnsWorksheet)
-        bold = wb.add_format({"bold": True})
         headers = ([_label(c) for c in result.cells]
                    + [FIGURE_HEADERS[f] for f in FIGURES]
                    + ["Diverged", "Invalid", "Warnings (count)", "Warnings"])
-        ws.write_row(0, 0, headers, bold)
+        ws.write_row(0, 0, headers, style.bold)
         ws.set_column(0, len(headers) - 2, 16)
         ws.set_column(len(headers) - 1, len(headers) - 1, 120)
         k = len(result.cells)
@@ -49,40 +68,117 @@ def write_sweep(result, path, force, stats=None, sensitivity=None):
             if found:
                 ws.write_string(r, len(headers) - 1, " | ".join(found))
         not_printed(ws)
-        _write_warnings(wb, result, bold)
-        n = len(result.values)
-        charts = wb.add_worksheet("Charts")
-        for i, cell in enumerate(result.cells):
+        _write_warnings(wb, result, style, shot)
+        _write_charts(wb, result, shot)
+        if stats is not None:
+            _write_spread(wb, result, stats, style, shot)
+            _write_band(wb, result, style, shot)
+        if sensitivity is not None:
+            _write_sensitivity(wb, sensitivity, style, shot)
+        close_workbook(wb, path)
+
+
+def families(result, i):
+    """The curves of the peak against cell ``i`` of a grid: [(label, x, peak)], one per level
+    of the other cell with the fewest levels (the rest held at their middle level); None
+    for samples (a Monte Carlo, Sobol), a single input, or more than :data:`MAX_FAMILY`
+    levels."""
+    k = len(result.cells)
+    if result.kind != "grid" or k < 2:
+        return None
+    levels = [np.unique(result.values[:, j]) for j in range(k)]
+    j = min((m for m in range(k) if m != i), key=lambda m: len(levels[m]))
+    if len(levels[j]) > MAX_FAMILY:
+        return None
+    held = np.ones(len(result.values), dtype=bool)
+    fixed = []
+    for m in range(k):
+        if m not in (i, j):
+            middle = levels[m][len(levels[m]) // 2]
+            held &= result.values[:, m] == middle
+            fixed.append(f"{result.cells[m]} = {middle:.4g}")
+    c = BY_ADDRESS.get(result.cells[j])
+    unit, fmt = AXIS_UNITS.get(c.unit if c else "", (c.unit if c else "", None))
+    scale = 1e-6 if unit == "MPa" else 1.0
+    out = []
+    for level in levels[j]:
+        rows = held & (result.values[:, j] == level)
+        order = np.argsort(result.values[rows, i], kind="stable")
+        name = f"{result.cells[j]} = {level * scale:.4g} {unit}".rstrip()
+        if fixed:
+            name += " (" + ", ".join(fixed) + ")"
+        out.append((name, result.values[rows, i][order], result.figures[rows, 0][order]))
+    return out
+
+
+#: Charts on the sweep's Charts sheet: two a row, each this many default columns and rows.
+CHART_COLS, CHART_ROWS = 10, 22
+
+
+def _write_charts(wb, result, shot):
+    """The Charts sheet: the peak against each input, two charts a row, on one page. A grid
+    over two or more inputs draws a family of curves (their data on the not printed Chart
+    data sheet); samples draw a scatter."""
+    charts = wb.add_worksheet("Charts")
+    data = None
+    n, k = len(result.values), len(result.cells)
+    peaks = result.figures[:, 0][np.isfinite(result.figures[:, 0])]
+    plo, phi = nice_range(peaks, include_zero=True) if len(peaks) else (0.0, 1.0)
+    col = 0
+    for i, cell in enumerate(result.cells):
+        family = families(result, i)
+        finite = result.values[:, i][np.isfinite(result.values[:, i])]
+        title, fmt = _cell_axis(cell, finite)
+        if family is None:
             chart = wb.add_chart({"type": "scatter"})
             chart.add_series({"name": "Peak", "categories": ["Sweep", 1, i, n, i],
                               "values": ["Sweep", 1, k, n, k],
                               "marker": {"type": "circle", "size": 4}})
-            finite = result.values[:, i][np.isfinite(result.values[:, i])]
-            peaks = result.figures[:, 0][np.isfinite(result.figures[:, 0])]
-            chart.set_title({"name": f"Peak acceleration against {cell}"})
-            chart.set_x_axis({"name": _label(cell),
-                              "min": float(finite.min()) if len(finite) else 0.0,
-                              "max": float(finite.max()) if len(finite) else 1.0})
-            chart.set_y_axis({"name": "Peak (kG)", "min": 0.0,
-                              "max": float(np.ceil(peaks.max())) if len(peaks) else 1.0})
             chart.set_legend({"none": True})
-            charts.insert_chart(1 + 20 * i, 1, chart)
-        one_page(charts, 20 * len(result.cells) + 1, 9, landscape=False)
-        if stats is not None:
-            _write_spread(wb, result, stats, bold)
-            _write_band(wb, result, bold)
-        if sensitivity is not None:
-            _write_sensitivity(wb, sensitivity, bold)
-        close_workbook(wb, path)
+        else:
+            if data is None:
+                data = wb.add_worksheet("Chart data", worksheet_class=ColumnsWorksheet)
+                not_printed(data)
+            chart = wb.add_chart({"type": "scatter", "subtype": "straight_with_markers"})
+            for m, (name, x, y) in enumerate(family):
+                data.write_string(0, col, f"{cell} ({name})")
+                data.write_string(0, col + 1, "Peak (kG)")
+                write_number_columns(data, 1, {col: x, col + 1: y})
+                color = FAMILY_COLORS[m % len(FAMILY_COLORS)]
+                chart.add_series({"name": name, "categories": ["Chart data", 1, col, len(x), col],
+                                  "values": ["Chart data", 1, col + 1, len(x), col + 1],
+                                  "line": {"color": color, "width": 1.25},
+                                  "marker": {"type": "circle", "size": 3,
+                                             "border": {"color": color},
+                                             "fill": {"color": color}}})
+                col += 2
+            chart.set_legend({"position": "bottom"})
+        lo = float(finite.min()) if len(finite) else 0.0
+        hi = float(finite.max()) if len(finite) else 1.0
+        chart.set_title({"name": f"Peak acceleration against {cell}",
+                         "name_font": {"size": 11}})
+        chart.set_x_axis(axis(title, lo, hi if hi > lo else lo + 1.0, num_format=fmt))
+        chart.set_y_axis(axis("Peak (kG)", plo, phi, num_format="0.0"))
+        chart.set_size(chart_size(CHART_COLS, CHART_ROWS))
+        charts.insert_chart(1 + (i // 2) * CHART_ROWS, (i % 2) * CHART_COLS, chart)
+    charts.write_string(0, 0, "Peak acceleration of the test item (raw) against each input"
+                        + (" (one curve per level of another input)" if data else ""))
+    one_page(charts, 1 + -(-k // 2) * CHART_ROWS, 2 * CHART_COLS - 1, shot=shot,
+             title="Charts")
 
 
-def _write_warnings(wb, result, bold):
+FAMILY_COLORS = ("#1f4e79", "#c00000", "#548235", "#7f6000", "#7030a0", "#00b0f0",
+                 "#ff7f00", "#595959", "#a50021", "#2e75b6", "#92d050", "#bf9000")
+
+
+def _write_warnings(wb, result, style, shot):
     """The Warnings sheet: how many shots have a warning, how often each cell is named, and
     every distinct warning with its count; printed on one page."""
     ws = wb.add_worksheet("Warnings")
     ws.set_column(0, 0, 14)
     ws.set_column(1, 1, 120)
     flagged, cells = result.flagged()
+    bold = style.bold
     ws.write_string(0, 0, "Shots", bold)
     ws.write_string(0, 1, f"{flagged:,} of {len(result.values):,} shots have warnings (the "
                           "Sweep sheet's Warnings column names them, shot by shot)")
@@ -99,47 +195,49 @@ def _write_warnings(wb, result, bold):
             counts[key] = counts.get(key, 0) + 1
     ws.write_row(row + 1, 0, ["Shots", "Warning (as the first shot with it says it)"], bold)
     row += 2
-    wrap = wb.add_format({"text_wrap": True, "valign": "top"})
     for text, n in sorted(counts.items(), key=lambda item: -item[1])[:40]:
-        ws.write_number(row, 0, n, wb.add_format({"num_format": "#,##0"}))
-        ws.write_string(row, 1, text, wrap)
+        ws.write_number(row, 0, n, style.of("count"))
+        ws.write_string(row, 1, text, style.wrap)
         row += 1
-    one_page(ws, row, 1)
+    one_page(ws, row, 1, shot=shot, title="Warnings")
 
 
-def _write_spread(wb, result, stats, bold):
+def _write_spread(wb, result, stats, style, shot):
     ws = wb.add_worksheet("Spread")
     ws.set_column(0, 0, 30)
-    rows = [("Shots counted", stats["n"], ""), ("Mean peak", stats["mean"], "kG"),
+    ws.set_column(1, 1, 12)
+    rows = [("Shots counted", stats["n"], "count"), ("Mean peak", stats["mean"], "kG"),
             ("Standard deviation", stats["sd"], "kG"), ("5th percentile", stats["p5"], "kG"),
             ("95th percentile", stats["p95"], "kG")]
-    ws.write_row(0, 0, ["Peak acceleration (raw)", "Value", "Unit"], bold)
-    for r, (label, value, unit) in enumerate(rows, start=1):
+    ws.write_row(0, 0, ["Peak acceleration (raw)", "Value", "Unit"], style.bold)
+    for r, (label, value, code) in enumerate(rows, start=1):
         ws.write_string(r, 0, label)
-        ws.write_number(r, 1, value)
-        ws.write_string(r, 2, unit)
+        style.number(ws, r, 1, value, code)
+        ws.write_string(r, 2, style.unit(code))
     peaks = result.figures[:, 0][np.isfinite(result.figures[:, 0])]
     counts, edges = np.histogram(peaks, bins=min(30, max(5, len(peaks) // 20)))
-    ws.write_row(7, 0, ["Bin centre (kG)", "Shots"], bold)
+    ws.write_row(7, 0, ["Bin centre (kG)", "Shots"], style.bold)
     for i, (c, lo, hi) in enumerate(zip(counts, edges, edges[1:]), start=8):
-        ws.write_number(i, 0, float(0.5 * (lo + hi)))
-        ws.write_number(i, 1, int(c))
+        style.number(ws, i, 0, float(0.5 * (lo + hi)), "kG")
+        style.number(ws, i, 1, int(c), "count")
     chart = wb.add_chart({"type": "column"})
     chart.add_series({"name": "Shots", "categories": ["Spread", 8, 0, 7 + len(counts), 0],
                       "values": ["Spread", 8, 1, 7 + len(counts), 1], "gap": 10})
     chart.set_title({"name": "Spread of the peak acceleration (Monte Carlo)"})
-    chart.set_x_axis({"name": "Peak (kG)", "num_format": "0.00"})
-    chart.set_y_axis({"name": "Shots", "min": 0, "max": int(counts.max()) + 1})
+    chart.set_x_axis({"name": "Peak (kG), bin centre", "num_format": "0.000"})
+    chart.set_y_axis({"name": "Shots", "min": 0, "max": int(counts.max()) + 1,
+                      "num_format": "#,##0"})
     chart.set_legend({"none": True})
+    chart.set_size(chart_size(12, 24))
     ws.insert_chart(1, 4, chart)
-    one_page(ws, max(8 + len(counts), 18), 12)
+    one_page(ws, max(8 + len(counts), 25), 15, shot=shot, title="Spread")
 
 
 SENSITIVITY_TITLES = {"peak_kg": "Peak acceleration", "pulse_duration": "Pulse duration",
                       "max_crush": "Maximum crush"}
 
 
-def _write_sensitivity(wb, sensitivity, bold):
+def _write_sensitivity(wb, sensitivity, style, shot):
     """One block of rows a figure (input, S1, S1 +/-, ST, ST +/-) and a bar chart of S1 and ST
     with their 95 % confidence half-widths as error bars."""
     ws = wb.add_worksheet("Sensitivity")
@@ -150,11 +248,12 @@ def _write_sensitivity(wb, sensitivity, bold):
                           "+/- is the 95 % confidence half-width.")
     row, k = 2, len(sensitivity.cells)
     for n, (name, found) in enumerate(sensitivity.indices.items()):
-        ws.write_row(row, 0, [SENSITIVITY_TITLES[name], "S1", "S1 +/-", "ST", "ST +/-"], bold)
+        ws.write_row(row, 0, [SENSITIVITY_TITLES[name], "S1", "S1 +/-", "ST", "ST +/-"],
+                     style.bold)
         for i, cell in enumerate(sensitivity.cells):
             ws.write_string(row + 1 + i, 0, _label(cell))
             for j, key in enumerate(("S1", "S1_conf", "ST", "ST_conf")):
-                ws.write_number(row + 1 + i, 1 + j, float(found[key][i]))
+                style.number(ws, row + 1 + i, 1 + j, float(found[key][i]), "ratio")
         chart = wb.add_chart({"type": "column"})
         for col, key, color in ((1, "S1", "#1f4e79"), (3, "ST", "#c00000")):
             half_widths = "='Sensitivity'!" + xl_range_abs(row + 1, col + 1, row + k, col + 1)
@@ -168,14 +267,15 @@ def _write_sensitivity(wb, sensitivity, bold):
                                  "minus_values": half_widths}})
         chart.set_title({"name": f"Sobol indices: {SENSITIVITY_TITLES[name]}"})
         chart.set_x_axis({"name": "Uncertain input"})
-        chart.set_y_axis({"name": "Index", "min": 0.0, "max": 1.2})
+        chart.set_y_axis({"name": "Index", "min": 0.0, "max": 1.2, "num_format": "0.0"})
         chart.set_legend({"position": "bottom"})
         ws.insert_chart(2 + 18 * n, 6, chart)
         row += k + 3
-    one_page(ws, max(row, 2 + 18 * len(sensitivity.indices)), 14)
+    one_page(ws, max(row, 2 + 18 * len(sensitivity.indices)), 14, shot=shot,
+             title="Sensitivity")
 
 
-def _write_band(wb, result, bold):
+def _write_band(wb, result, style, shot):
     """The Monte Carlo's mean and 5-95 % band of the peak over its first n shots."""
     from ..studies.sensitivity import band_convergence
 
@@ -185,8 +285,10 @@ def _write_band(wb, result, bold):
     ws = wb.add_worksheet("Band convergence", worksheet_class=ColumnsWorksheet)
     ws.set_column(0, 3, 21)
     ws.write_row(0, 0, ["Shots", "Mean peak (kG)", "5th percentile (kG)",
-                        "95th percentile (kG)"], bold)
-    write_number_columns(ws, 1, {j: rows[:, j] for j in range(4)})
+                        "95th percentile (kG)"], style.bold)
+    for r, values in enumerate(rows.tolist(), start=1):
+        for j, value in enumerate(values):
+            style.number(ws, r, j, value, "count" if j == 0 else "kG")
     n = len(rows)
     chart = wb.add_chart({"type": "scatter", "subtype": "straight_with_markers"})
     for col, name in ((1, "Mean"), (2, "5th percentile"), (3, "95th percentile")):
@@ -194,8 +296,10 @@ def _write_band(wb, result, bold):
                           "values": ["Band convergence", 1, col, n, col]})
     lo, hi = nice_range(rows[:, 1:4])
     chart.set_title({"name": "Monte Carlo: the peak's 5-95 % band against the number of shots"})
-    chart.set_x_axis({"name": "Shots", "log_base": 10, "min": 10, "max": float(rows[-1, 0])})
-    chart.set_y_axis({"name": "Peak (kG)", "min": lo, "max": hi, "num_format": "0.00"})
+    chart.set_x_axis({"name": "Shots", "log_base": 10, "min": 10, "max": float(rows[-1, 0]),
+                      "num_format": "#,##0"})
+    chart.set_y_axis(axis("Peak (kG)", lo, hi, num_format="0.00"))
     chart.set_legend({"position": "bottom"})
+    chart.set_size(chart_size(12, 24))
     ws.insert_chart(1, 5, chart)
-    one_page(ws, max(n, 16), 13)
+    one_page(ws, max(n, 25), 16, shot=shot, title="Band convergence")
