@@ -233,7 +233,8 @@ def test_convergence_command(tmp_path, capsys):
     assert "legacy integrator:" in printed and "newmark integrator:" in printed
     assert "coarsest dt with peak within 0.1%" in printed
     ws = openpyxl.load_workbook(out)["Convergence"]
-    assert ws["A1"].value == "Integrator" and ws["B2"].value == 2e-6
+    assert ws["A1"].value == "Integrator" and ws["B1"].value == "Time step (µs)"
+    assert ws["B2"].value == pytest.approx(2.0, rel=1e-12)  # µs, as shown
     assert (tmp_path / "c.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 

@@ -4,6 +4,7 @@ import math
 from ..errors import OutputError
 from ..studies.convergence import QUANTITIES
 from ..transaction import Publication, display
+from .report import Style, chart_size, one_page
 from .writer import close_workbook, new_workbook
 
 COLORS = ("#1f4e79", "#c00000", "#548235")
@@ -36,46 +37,71 @@ def write_convergence(ladders, path, force, shot, png=None):
     return figure is not None
 
 
+#: Quantity codes (:data:`airgun_xl.workbook.report.QUANTITIES`) of the figures' units.
+_CODES = {"kG": "kG", "s": "s", "m": "m", "kg": "kg"}
+
+
 def _render(ladders, tmp, path, shot):
-    """The workbook, into the temp file ``tmp`` (``path`` names it in messages)."""
+    """The workbook, into the temp file ``tmp`` (``path`` names it in messages): a table of
+    each level's figures and relative errors, then the observed orders, then the chart; one
+    landscape page."""
     wb = new_workbook(tmp)
+    style = Style(wb)
     ws = wb.add_worksheet("Convergence")
-    bold = wb.add_format({"bold": True})
-    sci = wb.add_format({"num_format": "0.00E+00"})
-    headers = ["Integrator", "Time step (s)", "Rows", "Kernel time (s)", "Total time (s)"]
-    for _, label, unit in QUANTITIES:
-        headers += [f"{label} ({unit})", f"{label}: relative error", f"{label}: order"]
-    ws.write_row(0, 0, headers, bold)
-    ws.set_column(0, len(headers), 14)
+    headers = ["Integrator", "Time step (µs)", "Rows", "Kernel time (s)", "Total time (s)"]
+    codes = [_CODES[unit] for _, _, unit in QUANTITIES]
+    for (_, label, _), code in zip(QUANTITIES, codes, strict=True):
+        headers += [f"{label} ({style.unit(code)})", f"{label}: relative error"]
+    ws.write_row(0, 0, headers, style.header)
+    ws.set_row(0, 62)
+    ws.set_column(0, 0, 12)
+    ws.set_column(1, len(headers) - 1, 11)
     row = 1
     spans = []
     for lad in ladders:
         first = row
         for lv in lad.levels:
-            values = [lv.integrator, lv.delta, lv.rows, lv.kernel_seconds,
-                      lv.total_seconds]
-            for q, _, _ in QUANTITIES:
-                values += [lv.figures[q], lv.errors[q], lv.order.get(q)]
-            for col, value in enumerate(values):
-                if isinstance(value, str):
-                    ws.write_string(row, col, value)
-                elif value is not None and math.isfinite(value):
-                    ws.write_number(row, col, value, sci if col in (1, 3, 4) else None)
+            ws.write_string(row, 0, lv.integrator)
+            style.number(ws, row, 1, lv.delta, "step")
+            style.number(ws, row, 2, lv.rows, "count")
+            style.number(ws, row, 3, lv.kernel_seconds, "runtime-fine")
+            style.number(ws, row, 4, lv.total_seconds, "runtime-fine")
+            for i, ((q, _, _), code) in enumerate(zip(QUANTITIES, codes, strict=True)):
+                style.number(ws, row, 5 + 2 * i, lv.figures[q], code)
+                if math.isfinite(lv.errors[q]):
+                    ws.write_number(row, 6 + 2 * i, lv.errors[q], style.fmt("0.00E+00"))
             row += 1
         spans.append((lad, first, row - 2))  # the finest level is the reference
-        ws.write_string(row, 0, f"{lad.integrator}: Richardson extrapolation", bold)
-        for i, (q, _, _) in enumerate(QUANTITIES):
-            if math.isfinite(lad.richardson[q]):
-                ws.write_number(row, 5 + 3 * i, lad.richardson[q])
+        ws.write_string(row, 0, f"{lad.integrator}: Richardson extrapolation", style.bold)
+        for i, ((q, _, _), code) in enumerate(zip(QUANTITIES, codes, strict=True)):
+            style.number(ws, row, 5 + 2 * i, lad.richardson[q], code)
         row += 1
         ws.write_string(row, 0, f"{lad.integrator}: coarsest time step with the raw peak "
-                                f"within {lad.rtol:.2%} of the finest level (s)", bold)
+                                f"within {lad.rtol:.2%} of the finest level", style.bold)
         if lad.recommended == lad.recommended:
-            ws.write_number(row, 5, lad.recommended)
+            style.number(ws, row, 7, lad.recommended, "step")
+            ws.write_string(row, 8, "µs")
         else:
-            ws.write_string(row, 5, "none")
+            ws.write_string(row, 7, "none")
         row += 2
-    ws.write_string(row, 0, f"Shot: {shot.source.path if shot.source else 'API'}; errors "
+    ws.write_string(row, 0, "Observed order of each figure's error", style.bold)
+    row += 1
+    ws.write_row(row, 0, ["Integrator", "Time step (µs)"]
+                 + [label for _, label, _ in QUANTITIES], style.header)
+    ws.set_row(row, 30)
+    for lad in ladders:
+        for lv in lad.levels:
+            if not any(lv.order.get(q) is not None for q, _, _ in QUANTITIES):
+                continue
+            row += 1
+            ws.write_string(row, 0, lv.integrator)
+            style.number(ws, row, 1, lv.delta, "step")
+            for i, (q, _, _) in enumerate(QUANTITIES):
+                value = lv.order.get(q)
+                if value is not None:
+                    style.number(ws, row, 2 + i, value, "ratio")
+    row += 2
+    ws.write_string(row, 0, f"Shot: {shot.source.path.name if shot.source else 'API'}; errors "
                             "are relative to the finest level of the same integrator.")
     chart = wb.add_chart({"type": "scatter", "subtype": "straight_with_markers"})
     times, errors = [], []
@@ -93,12 +119,17 @@ def _render(ladders, tmp, path, shot):
         errors += [lv.errors["peak_kg"] for lv in lad.levels[:-1] if lv.errors["peak_kg"]]
     lo_t, hi_t = _decades(times)
     lo_e, hi_e = _decades(errors)
-    chart.set_title({"name": "Error against run time (work-precision)"})
-    chart.set_x_axis({"name": "Run time (s)", "log_base": 10, "min": lo_t, "max": hi_t})
+    chart.set_title({"name": "Error against run time (work-precision)",
+                     "name_font": {"size": 11}})
+    chart.set_x_axis({"name": "Run time (s)", "log_base": 10, "min": lo_t, "max": hi_t,
+                      "num_format": "0.000", "major_gridlines": {"visible": True}})
     chart.set_y_axis({"name": "Relative error of the peak", "log_base": 10, "min": lo_e,
-                      "max": hi_e, "num_format": "0E+0"})
-    chart.set_size({"width": 720, "height": 420})
+                      "max": hi_e, "num_format": "0E+0", "major_gridlines": {"visible": True}})
+    chart.set_legend({"position": "bottom"})
+    chart.set_size(chart_size(19, 20))
     ws.insert_chart(row + 2, 0, chart)
+    one_page(ws, row + 22, len(headers) - 1, shot=shot.source.path.name if shot.source
+             else None, title="Convergence")
     close_workbook(wb, path)
 
 

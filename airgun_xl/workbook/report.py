@@ -56,6 +56,7 @@ QUANTITIES = {
     "m/s": Quantity("m/s", 1.0, "0.00"),
     "step": Quantity("µs", 1e6, "0.000"),
     "runtime": Quantity("s", 1.0, "0.00"),
+    "runtime-fine": Quantity("s", 1.0, "0.0000"),  # a kernel's milliseconds
     "ratio": Quantity("", 1.0, "0.000"),
     "fraction": Quantity("", 1.0, "0.0000"),  # a rating, a correlation, an index, 0..1
     "%": Quantity("%", 1.0, "0.00%"),  # held as a fraction, shown as a percentage
