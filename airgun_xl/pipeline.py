@@ -32,6 +32,7 @@ class Options:
     command: tuple = ()  # the command line, for provenance
     archive: object = None  # an ArchiveRequest: also store the run as an archive entry
     force_word: str = "--force"  # how messages name `force`
+    srs_requirement: tuple = None  # (frequencies [Hz], levels [kG], Q): SRS sheets, drawn over
 
 
 @dataclasses.dataclass
@@ -169,7 +170,8 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
     info = {"version": __version__, "command": " ".join(options.command), "warnings": record,
             "dt_crit": crit.dt_crit, "dt_compacted": crit.dt_compacted,
             "dt_unloading": crit.dt_unloading,
-            "dt_ratio": crit.ratio, "compared": compared}
+            "dt_ratio": crit.ratio, "compared": compared,
+            "srs_requirement": options.srs_requirement}
     if shot.source is not None:
         info.update(input=str(shot.source.path), sha256=shot.source.sha256)
     if not options.reproducible:

@@ -92,10 +92,10 @@ def test_srs_command_writes_the_spectrum_of_the_predicted_pulse(tmp_path, capsys
 
     out = tmp_path / "srs.xlsx"
     assert main(["srs", str(TEMPLATE), "-o", str(out), "--cfc", "1000"]) == 0
-    ws = openpyxl.load_workbook(out)["SRS"]
-    cells = list(ws.iter_rows(values_only=True))
-    start = [r[0] for r in cells].index("Frequency (Hz)") + 1
-    rows = [r for r in cells[start:] if r[0] is not None]
+    ws = openpyxl.load_workbook(out)["SRS table"]
+    cells = list(ws.iter_rows(min_row=2, values_only=True))
+    # three column groups of (frequency, g, kG), 27 rows each
+    rows = [(r[c], r[c + 2]) for c in (0, 4, 8) for r in cells if r[c] is not None]
     freqs = np.array([r[0] for r in rows], dtype=float)
     result = airgun_xl.load(TEMPLATE).run(track=())
     pulse = cfc_filter(result.accel_kg[np.isfinite(result.accel_kg)], 5e-7, 1000)

@@ -124,10 +124,10 @@ def run_srs(args):
           f"least margin of {design.margin:+.2%}, at {design.governing_hz:,.0f} Hz")
     print(f"  peak {design.peak_kg:.5f} kG, pulse {design.duration * 1e3:.4f} ms; "
           f"{design.evaluations} simulations in {time.perf_counter() - started:.2f} s")
-    return _write_design(args, shot, design)
+    return _write_design(args, shot, design, (frequencies, required, args.q))
 
 
-def _write_design(args, shot, design):
+def _write_design(args, shot, design, requirement=None):
     from ..pipeline import Options, fill_workbook
     from . import note, warn
     from .progress import Progress
@@ -139,7 +139,7 @@ def _write_design(args, shot, design):
     designed = with_cells(shot, design)
     outputs = from_sheet(shot.source.outputs_block)
     options = Options(args.integrator, "excel", args.model, False, args.force,
-                      command=tuple(args.argv))
+                      command=tuple(args.argv), srs_requirement=requirement)
     progress = Progress.for_rows(designed.params.rows)
     try:
         filled = fill_workbook(designed, output, outputs, options, warn, None, note, progress)

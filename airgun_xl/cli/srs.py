@@ -65,7 +65,7 @@ def run(args):
     about = [("Shot", str(args.shot)), ("Quality factor Q", f"{args.q:g}"),
              ("Filter", f"CFC {args.cfc}" if args.cfc else "none"),
              ("Model, integrator", f"{args.model}, {args.integrator}")]
-    write_srs(output, freqs, spectrum, about, args.force)
+    write_srs(output, freqs, spectrum, about, args.force, shot=shot_path.name)
     k = int(np.argmax(spectrum))
     print(f"wrote {output}: SRS at {len(freqs)} frequencies, {args.lo:g}-{args.hi:g} Hz, "
           f"Q = {args.q:g}; largest {spectrum[k]:.4f} kG at {freqs[k]:,.0f} Hz")

@@ -97,7 +97,8 @@ def new_workbook(path):
 
 
 #: The sheets a fill adds after sheet 1, by their fixed names.
-OUTPUT_SHEETS = ("Parameters", "Summary", "Charts", "Tracked", "Spectrum", "ChartData", SHEET_NAME, LAW_SHEET)
+OUTPUT_SHEETS = ("Parameters", "Summary", "Charts", "Tracked", "Spectrum", "ChartData", "SRS",
+                 "SRS table", SHEET_NAME, LAW_SHEET)
 
 
 def sheet_names(source_title):
@@ -253,6 +254,24 @@ def _write_sheet1(wb, result, outputs, keep, stride, title):
     return refs, warnings
 
 
+def _write_srs_sheets(wb, result, requirement, shot, name):
+    """The SRS and SRS table sheets of a design to a required spectrum: the designed shot's
+    SRS over the requirement's band (and at least 100 Hz-10 kHz), the requirement drawn
+    over it."""
+    from ..studies.shock import default_frequencies, srs
+    from .srs import add_srs_sheets
+
+    frequencies, required, q = requirement
+    pulse = result.accel_kg[np.isfinite(result.accel_kg)]
+    freqs = default_frequencies(min(100.0, float(frequencies[0])),
+                                max(10_000.0, float(frequencies[-1])))
+    about = [("Shot", shot or ""), ("Quality factor Q", f"{q:g}"),
+             ("Required", f"{len(frequencies)} levels, {frequencies[0]:,.0f} to "
+                          f"{frequencies[-1]:,.0f} Hz (design --target-srs)")]
+    add_srs_sheets(wb, freqs, srs(pulse, result.params.delta, freqs, q), about, shot,
+                   (frequencies, required), name)
+
+
 def print_outputs_block(ws, block, shot):
     """The Outputs block on one page, its columns wide enough for their text (a label used
     to run past the print area and be cut off)."""
@@ -369,6 +388,8 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
         add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]) * 1e3, labels,
                    {"spectrum": (np.floor(summary.spectrum.band_start / 100) * 100,
                                  SPECTRUM_MAX_HZ)}, shot)
+    if info.get("srs_requirement") is not None:
+        _write_srs_sheets(wb, result, info["srs_requirement"], shot, names["SRS"])
     if source is not None and source.outputs_block:
         outputs_ws = wb.add_worksheet(names[SHEET_NAME], worksheet_class=ColumnsWorksheet)
         warnings += write_cells(outputs_ws, source.outputs_block)
