@@ -73,7 +73,8 @@ def run(args):
              ("Anti-alias model", "none" if c.anti_alias is None else
               f"{ANTI_ALIAS_ORDER}-pole Butterworth at {c.anti_alias:,.0f} Hz on the prediction"),
              ("Warnings", f"{len(c.warnings)} (below the scores)" if c.warnings else "none")]
-    write_comparison(output, c, about, args.force, models=(args.model, other))
+    write_comparison(output, c, about, args.force, models=(args.model, other),
+                     shot=Path(args.shot).name)
     print(f"wrote {output}: {trace.name} against {args.shot} ({len(c.time):,} samples, "
           f"aligned by {args.align}, shift {c.shift * 1e3:.4f} ms)")
     print(f"  peak {c.predicted.peak_kg:.4f} kG predicted, {c.measured.peak_kg:.4f} measured "

@@ -5,7 +5,8 @@ import numpy as np
 from ..transaction import atomic_path, check_output
 from .charts import line_series, log_axis, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
-from .report import not_printed, one_page
+from .report import axis, chart_size, not_printed, one_page
+from .srs import G_PER_KG
 from .sheets import write_about, write_number_columns, write_warnings
 from .writer import close_workbook, new_workbook
 
@@ -21,6 +22,9 @@ ISO_ROWS = (("Corridor (weight 0.4)", "corridor"), ("Phase (0.2)", "phase"),
 PREDICTED, MEASURED, RIGID = "#1f4e79", "#c00000", "#7f7f7f"
 SPECTRUM_FROM_HZ = 1_000.0  # below: the pulse's own shape, as the fill's chart
 SPECTRUM_TO_HZ = 15_000.0
+
+#: Default columns a chart of the Charts sheet spans (two a row).
+CHART_COLS = 10
 
 
 def _series(chart, sheet, name, n, x_col, y_col, color, dash=None):
@@ -38,8 +42,9 @@ def _write_scores(wb, ws, c, head, bold, models):
         ws.write_number(row, 1, getattr(c.predicted, key) * factor, form)
         ws.write_number(row, 2, getattr(c.measured, key) * factor, form)
         ws.write_string(row, 3, unit)
-        if key == "time_of_peak":
-            ws.write_number(row, 4, c.errors[key] * factor, form)
+        if key == "time_of_peak":  # an absolute error: its unit in its format
+            ws.write_number(row, 4, c.errors[key] * factor, wb.add_format(
+                {"num_format": f'{fmt}" ms"'}))
         else:
             ws.write_number(row, 4, c.errors[key], pct)
         row += 1
@@ -58,9 +63,10 @@ def _write_scores(wb, ws, c, head, bold, models):
             ws.write_number(row, 4, c.errors["dominant_frequency"], pct)
         row += 1
     ws.write_string(row, 0, "SRS peak (maximax, Q = 10)")
-    ws.write_number(row, 1, float(c.predicted_srs.max()), score)
-    ws.write_number(row, 2, float(c.measured_srs.max()), score)
-    ws.write_string(row, 3, "kG")
+    g = wb.add_format({"num_format": "#,##0.0"})
+    ws.write_number(row, 1, float(c.predicted_srs.max()) * G_PER_KG, g)
+    ws.write_number(row, 2, float(c.measured_srs.max()) * G_PER_KG, g)
+    ws.write_string(row, 3, "g")
     ws.write_number(row, 4, c.errors["srs_peak"], pct)
     row += 1
     ws.write_string(row, 0, "SRS of the record")
@@ -122,11 +128,13 @@ def _traces_chart(wb, c, n, models):
     if c.rigid_kg is not None:
         _series(chart, "Traces", f"Predicted, {models[1]} model", n, 0, 3, RIGID, "dash")
         values += list(c.rigid_kg)
-    lo, hi = nice_range(c.time)
+    lo, hi = nice_range(c.time * 1e3)
     ylo, yhi = nice_range(values, include_zero=True)
-    return titled(chart, "Test against prediction (Fig. 13)",
-                  {"name": "Time after impact (s)", "min": lo, "max": hi},
-                  {"name": "Acceleration (kG)", "min": ylo, "max": yhi}, 420)
+    chart = titled(chart, "Test against prediction (Fig. 13)",
+                   axis("Time after impact (ms)", lo, hi),
+                   axis("Acceleration (kG)", ylo, yhi))
+    chart.set_size(chart_size(2 * CHART_COLS, 21))
+    return chart
 
 
 def _spectrum_chart(wb, c, n):
@@ -136,40 +144,50 @@ def _spectrum_chart(wb, c, n):
     keep = c.predicted_spectrum.frequency >= SPECTRUM_FROM_HZ
     _, yhi = nice_range(list(c.predicted_spectrum.amplitude[keep])
                         + list(c.measured_spectrum.amplitude[keep]), include_zero=True)
-    return titled(chart, "Spectra of test and prediction (Figs. 14-15)",
-                  {"name": "Frequency (Hz)", "min": SPECTRUM_FROM_HZ, "max": SPECTRUM_TO_HZ},
-                  {"name": "Amplitude (kG)", "min": 0, "max": yhi}, 380)
+    chart = titled(chart, "Spectra of test and prediction (Figs. 14-15)",
+                   axis("Frequency (kHz)", SPECTRUM_FROM_HZ, SPECTRUM_TO_HZ, num_format="0,"),
+                   axis("Amplitude (kG)", 0, yhi))
+    chart.set_size(chart_size(CHART_COLS, 20))
+    return chart
 
 
 def _srs_chart(wb, c, n):
     chart = wb.add_chart({"type": "scatter", "subtype": "straight"})
     _series(chart, "SRS", "Measured", n, 0, 2, MEASURED)
     _series(chart, "SRS", "Predicted", n, 0, 1, PREDICTED)
-    both = np.concatenate([c.predicted_srs, c.measured_srs])
-    return titled(chart, "Shock response spectra (maximax, Q = 10)",
-                  log_axis("Natural frequency (Hz)", c.srs_frequencies),
-                  log_axis("Peak response (kG)", both), 380)
+    both = np.concatenate([c.predicted_srs, c.measured_srs]) * G_PER_KG
+    x_axis = log_axis("Natural frequency (Hz)", c.srs_frequencies, gridlines=True)
+    y_axis = log_axis("Peak response (g)", both, gridlines=True)
+    for a in (x_axis, y_axis):
+        a["num_format"] = "#,##0"
+    chart = titled(chart, "Shock response spectra (maximax, Q = 10)", x_axis, y_axis)
+    chart.set_size(chart_size(CHART_COLS, 20))
+    return chart
 
 
-def write_comparison(path, comparison, about, force=False, models=("4-mass", "rigid")):
+def write_comparison(path, comparison, about, force=False, models=("4-mass", "rigid"),
+                     shot=None):
     """Write the Compared sheet (figures, errors, the ISO/TS 18571 rating, spectra and SRS
-    figures, and the charts of Figs. 13-15) and its data sheets (Traces, Spectra, SRS) at
-    ``path``; ``models`` names the prediction's model and the compared one."""
+    figures, one page), the Charts sheet (Figs. 13-15 and the SRS, one page) and the data
+    sheets (Traces, Spectra, SRS) at ``path``; ``models`` names the prediction's model and the
+    compared one, ``shot`` the input in the page headers."""
     c = comparison
     check_output(path, force)
     with atomic_path(path, force) as tmp:
         wb = new_workbook(tmp)
         ws = wb.add_worksheet("Compared")
         bold = wb.add_format({"bold": True})
-        ws.set_column(0, 0, 38)
-        ws.set_column(1, 4, 14)
+        ws.set_column(0, 0, 50)
+        ws.set_column(1, 4, 18)
         head = write_about(ws, about, bold) + 1
         row = _write_scores(wb, ws, c, head, bold, models)
-        row = write_warnings(wb, ws, row + 1, c.warnings, 4) + 1
+        row = write_warnings(wb, ws, row + 1, c.warnings, 4)
+        one_page(ws, row, 4, shot=shot, title="Compared")
+        charts = wb.add_worksheet("Charts")
 
         data = wb.add_worksheet("Traces", worksheet_class=ColumnsWorksheet)
-        names = ["Time after impact (s)", "Predicted (kG)", "Measured (kG)"]
-        columns = {0: c.time, 1: c.predicted_kg, 2: c.measured_kg}
+        names = ["Time after impact (ms)", "Predicted (kG)", "Measured (kG)"]
+        columns = {0: c.time * 1e3, 1: c.predicted_kg, 2: c.measured_kg}
         if c.rigid_kg is not None:
             names.append(f"Predicted, {models[1]} model (kG)")
             columns[3] = c.rigid_kg
@@ -187,14 +205,15 @@ def write_comparison(path, comparison, about, force=False, models=("4-mass", "ri
         not_printed(spectra)
 
         srs = wb.add_worksheet("SRS", worksheet_class=ColumnsWorksheet)
-        srs.write_row(0, 0, ["Natural frequency (Hz)", "Predicted (kG)", "Measured (kG)"],
+        srs.write_row(0, 0, ["Natural frequency (Hz)", "Predicted (g)", "Measured (g)"],
                       bold)
-        write_number_columns(srs, 1, {0: c.srs_frequencies, 1: c.predicted_srs,
-                                      2: c.measured_srs})
+        write_number_columns(srs, 1, {0: c.srs_frequencies, 1: c.predicted_srs * G_PER_KG,
+                                      2: c.measured_srs * G_PER_KG})
         not_printed(srs)
 
-        ws.insert_chart(row + 1, 0, _traces_chart(wb, c, len(c.time), models))
-        ws.insert_chart(row + 23, 0, _spectrum_chart(wb, c, n_spec))
-        ws.insert_chart(row + 43, 0, _srs_chart(wb, c, len(c.srs_frequencies)))
-        one_page(ws, row + 63, 8)  # the tables and the three charts
+        charts.write_string(0, 0, f"Measured record: {c.srs_record}")
+        charts.insert_chart(1, 0, _traces_chart(wb, c, len(c.time), models))
+        charts.insert_chart(22, 0, _spectrum_chart(wb, c, n_spec))
+        charts.insert_chart(22, CHART_COLS, _srs_chart(wb, c, len(c.srs_frequencies)))
+        one_page(charts, 42, 2 * CHART_COLS - 1, shot=shot, title="Charts")
         close_workbook(wb, path)
