@@ -113,7 +113,7 @@ def test_cli_writes_a_workbook_fill_runs(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "crush law: converged" in text and "shot 2: RMS error" in text
     wb = openpyxl.load_workbook(out)
-    assert wb.sheetnames[:3] == ["Sheet1", "Outputs", "Crush law"]
+    assert wb.sheetnames[:4] == ["Sheet1", "Parameters", "Outputs", "Crush law"]
     assert "Calibration" in wb.sheetnames
     # fill runs the fitted law: the same peak as the API with the law read back
     calibrated = airgun_xl.load(out)

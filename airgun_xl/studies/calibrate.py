@@ -513,7 +513,7 @@ def verdict(cal, cfc, objective, p0):
         fastest = max(p.v31 - p.v1 for p in cal.params)
         if fastest > hi:
             notes.append(f"crush law: measured from {lo:.1f} to {hi:.1f} m/s (its samples' "
-                         f"{SPAN_PERCENTILES[0]}th to {SPAN_PERCENTILES[1]}th percentile), "
+                         f"{SPAN_PERCENTILES[0]}st to {SPAN_PERCENTILES[1]}th percentile), "
                          f"below the shots' impact speed of {fastest:.1f} m/s: a run of them "
                          "extrapolates it at first (fill warns); the law itself is not "
                          "claimed there")

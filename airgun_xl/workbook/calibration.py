@@ -15,12 +15,24 @@ from ..transaction import atomic_path, check_output
 from .charts import line_series, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
 from .law_sheet import write_law_sheet
-from .report import not_printed, one_page
-from .sheets import write_about, write_number_columns, write_warnings
-from .writer import close_workbook, new_workbook, sheet_names, write_cells
+from .report import Style, axis, chart_size, not_printed, one_page, shown
+from .sheets import write_about, write_number_columns, write_parameters, write_warnings
+from .writer import (
+    close_workbook,
+    new_workbook,
+    print_outputs_block,
+    sheet_names,
+    write_cells,
+)
 
 #: Fitted name -> (parameter cell (row, col), ShotParams field).
 CELLS = {"E40": ((40, 5), "sigmay"), "E43": ((43, 5), "zeta")}
+
+#: How the Fitted table shows each fitted value: a quantity code of the report layer.
+FITTED_CODES = {"E40": "Pa", "E43": "fraction", "scale": "ratio"}
+
+#: Default columns and rows of each chart, right of the tables.
+CHART_COLS, CHART_ROWS = 10, 22
 
 
 def _parameter_sheet(wb, shot, params, names, fitted):
@@ -31,16 +43,18 @@ def _parameter_sheet(wb, shot, params, names, fitted):
             block[cell] = (getattr(params, field), None)  # the fitted value, a plain number
     ws = wb.add_worksheet(names["first"], worksheet_class=ColumnsWorksheet)
     warnings = write_cells(ws, block, {k: v[0] for k, v in block.items()})
-    one_page(ws, max(r for r, _ in block) - 1, 6, landscape=False)
+    not_printed(ws)  # the input's layout, for fill: data (Parameters prints)
+    write_parameters(wb, params, source.path.name, names["Parameters"])
     if source.outputs_block:
         out = wb.add_worksheet(names["Outputs"], worksheet_class=ColumnsWorksheet)
         warnings += write_cells(out, source.outputs_block)
-        one_page(out, max(r for r, _ in source.outputs_block) - 1,
-                 max(c for _, c in source.outputs_block) - 1)
+        print_outputs_block(out, source.outputs_block, source.path.name)
     return warnings
 
 
 def _law_chart(wb, n_grid, n_samples, v_range, values):
+    """The fitted law, the macro's and the last iteration's samples, against the relative
+    velocity (only when the law was fitted)."""
     chart = wb.add_chart({"type": "scatter"})
     if n_samples:
         chart.add_series({"name": "Measured samples (last iteration)",
@@ -52,9 +66,11 @@ def _law_chart(wb, n_grid, n_samples, v_range, values):
     line_series(chart, "Law", "The macro's law, Eq. (8)", 1, n_grid, 0, 1, "#1f4e79", "dash")
     lo, hi = nice_range(v_range)
     ylo, yhi = nice_range(values, include_zero=True)
-    return titled(chart, "Crush factor against relative velocity (Figs. 7-8)",
-                  {"name": "Relative velocity (m/s)", "min": lo, "max": hi},
-                  {"name": "Crush factor (-)", "min": ylo, "max": yhi})
+    chart = titled(chart, "Crush factor against relative velocity (Figs. 7-8)",
+                   axis("Relative velocity (m/s)", lo, hi),
+                   axis("Crush factor (-)", ylo, yhi))
+    chart.set_size(chart_size(CHART_COLS, CHART_ROWS))
+    return chart
 
 
 def _pulse_chart(wb, a):
@@ -62,11 +78,12 @@ def _pulse_chart(wb, a):
     chart = wb.add_chart({"type": "scatter", "subtype": "straight"})
     for col, name, color in ((2, "Measured", "#c00000"), (1, "Calibrated model", "#1f4e79")):
         line_series(chart, "Pulses", name, 1, n, 0, col, color)
-    lo, hi = nice_range(a.time)
+    lo, hi = nice_range(a.time * 1e3)
     ylo, yhi = nice_range(list(a.simulated_kg) + list(a.measured_kg), include_zero=True)
-    return titled(chart, "Shot 1: measured and calibrated pulses",
-                  {"name": "Time (s)", "min": lo, "max": hi},
-                  {"name": "Acceleration (kG)", "min": ylo, "max": yhi})
+    chart = titled(chart, "Shot 1: measured and calibrated pulses",
+                   axis("Time (ms)", lo, hi), axis("Acceleration (kG)", ylo, yhi))
+    chart.set_size(chart_size(CHART_COLS, CHART_ROWS))
+    return chart
 
 
 def write_calibration(path, shot, cal, files, options, force=False):
@@ -79,13 +96,14 @@ def write_calibration(path, shot, cal, files, options, force=False):
         names = sheet_names(shot.source.sheet_title)
         warnings = _parameter_sheet(wb, shot, params, names, cal.fitted)
         if not law.is_legacy:
-            write_law_sheet(wb, law, names["Crush law"])
+            write_law_sheet(wb, law, names["Crush law"], shot=shot.source.path.name)
         ws = wb.add_worksheet("Calibration")
-        bold = wb.add_format({"bold": True})
-        pct = wb.add_format({"num_format": "0.00%"})
-        num = wb.add_format({"num_format": "0.000"})
-        ws.set_column(0, 0, 34)
-        ws.set_column(1, 5, 15)
+        style = Style(wb)
+        bold = style.bold
+        pct = style.of("%")
+        num = style.of("ratio")
+        ws.set_column(0, 0, 40)
+        ws.set_column(1, 5, 13)
         about = [(f"Shot {i}", f"{s} against {m}") for i, (s, m) in enumerate(files, start=1)]
         about += [("Filter", f"CFC {options.cfc}" if options.cfc else "none"),
                   ("Objective", options.objective + (" (derivative-free from the L2 fit; the "
@@ -101,10 +119,10 @@ def write_calibration(path, shot, cal, files, options, force=False):
                    f"NOT TRUSTED: {len(cal.warnings)} warning"
                    f"{'s' * (len(cal.warnings) > 1)} below")]
         row = write_about(ws, about, bold) + 1
-        row = write_warnings(wb, ws, row, cal.warnings, 5) + 2
-        for text in cal.notes:
-            ws.write_string(row - 1, 0, f"Note: {text}")
-            row += 1
+        row = write_warnings(wb, ws, row, cal.warnings, 5, line_chars=95) + 2
+        if cal.notes:
+            row = write_warnings(wb, ws, row - 1, cal.notes, 5, line_chars=95,
+                                 heading="Notes") + 2
         for i, rec in enumerate(cal.recordings, start=1):
             ws.write_string(row, 0, f"Shot {i}: baseline removed, pre-trigger noise")
             ws.write_number(row, 1, rec.base.offset, num)
@@ -118,13 +136,13 @@ def write_calibration(path, shot, cal, files, options, force=False):
             ws.write_string(row, 0, "Crush-law iteration (report, section 3.2)", bold)
             row += 1
             ws.write_row(row, 0, ["Iteration", "Law change", "Worst RMS error", "Samples"],
-                         bold)
+                         style.header)
             for it in lc.iterations:
                 row += 1
-                ws.write_number(row, 0, it.number)
+                style.number(ws, row, 0, it.number, "count")
                 ws.write_number(row, 1, it.change, pct)
                 ws.write_number(row, 2, it.rms_error, pct)
-                ws.write_number(row, 3, it.samples)
+                style.number(ws, row, 3, it.samples, "count")
             row += 1
             ws.write_string(row, 0, "Converged (< 1 %)" if lc.converged else
                             "NOT converged: the last law was kept")
@@ -136,30 +154,32 @@ def write_calibration(path, shot, cal, files, options, force=False):
             ws.write_number(row, 2, law.v_range[1], num)
             row += 2
         if cal.fitted:
-            ws.write_row(row, 0, ["Fitted", "Start", "Fitted", "Change", "Standard error",
-                                  "At a bound"], bold)
-            sci = wb.add_format({"num_format": "0.0000E+00"})
+            ws.write_row(row, 0, ["Fitted (unit)", "Start", "Fitted", "Change",
+                                  "Standard error", "At a bound"], style.header)
             for name, value in cal.fitted.items():
                 row += 1
                 lo, hi = cal.bounds[name]
-                ws.write_string(row, 0, name)
-                ws.write_number(row, 1, cal.start[name], sci)
-                ws.write_number(row, 2, value, sci)
+                code = FITTED_CODES.get(name, "sci")
+                unit = style.unit(code)
+                ws.write_string(row, 0, name + (f" ({unit})" if unit else ""))
+                style.number(ws, row, 1, cal.start[name], code)
+                style.number(ws, row, 2, value, code)
                 ws.write_number(row, 3, value / cal.start[name] - 1 if cal.start[name]
                                 else 0.0, pct)
                 error = cal.errors.get(name, float("inf"))
                 if error == error and error != float("inf"):
-                    ws.write_number(row, 4, error, sci)
+                    ws.write_number(row, 4, shown(error, code), style.fmt("0.00E+00"))
                 else:
                     ws.write_string(row, 4, "not identified")
                 ws.write_string(row, 5, "YES" if min(value - lo, hi - value)
                                 <= AT_BOUND * (hi - lo) else "no")
             row += 2
-        ws.write_row(row, 0, ["Shot", "RMS error before", "after", "ISO/TS 18571 before",
-                              "after"], bold)
+        ws.write_row(row, 0, ["Shot", "RMS error before", "RMS error after",
+                              "ISO/TS 18571 before", "ISO/TS 18571 after"], style.header)
+        ws.set_row(row, 30)
         for i, (b, a) in enumerate(zip(cal.before, cal.after), start=1):
             row += 1
-            ws.write_number(row, 0, i)
+            style.number(ws, row, 0, i, "count")
             ws.write_number(row, 1, b.rms, pct)
             ws.write_number(row, 2, a.rms, pct)
             for col, iso in ((3, b.iso), (4, a.iso)):
@@ -183,13 +203,19 @@ def write_calibration(path, shot, cal, files, options, force=False):
         not_printed(data)
         a = cal.aligned[0]
         pulses = wb.add_worksheet("Pulses", worksheet_class=ColumnsWorksheet)
-        pulses.write_row(0, 0, ["Time (s)", "Calibrated model (kG)", "Measured (kG)"], bold)
-        write_number_columns(pulses, 1, {0: a.time, 1: a.simulated_kg, 2: a.measured_kg})
+        pulses.write_row(0, 0, ["Time (ms)", "Calibrated model (kG)", "Measured (kG)"], bold)
+        write_number_columns(pulses, 1, {0: a.time * 1e3, 1: a.simulated_kg,
+                                         2: a.measured_kg})
         not_printed(pulses)
         values = list(columns[1]) + list(columns[2]) + list(np.percentile(x, [1, 99])
                                                             if len(x) else [])
-        ws.insert_chart(row, 0, _law_chart(wb, len(grid), len(v), law.v_range, values))
-        ws.insert_chart(row + 21, 0, _pulse_chart(wb, a))
-        one_page(ws, row + 42, 6)
+        # the charts right of the tables: the law's only when a law was fitted
+        charts = [_pulse_chart(wb, a)]
+        if lc is not None:
+            charts.insert(0, _law_chart(wb, len(grid), len(v), law.v_range, values))
+        for k, chart in enumerate(charts):
+            ws.insert_chart(1 + k * CHART_ROWS, 7, chart)
+        one_page(ws, max(row, 1 + len(charts) * CHART_ROWS), 7 + CHART_COLS,
+                 shot=shot.source.path.name, title="Calibration")
         close_workbook(wb, path)
     return warnings

@@ -62,9 +62,11 @@ class ColumnsWorksheet(SafeWorksheet):
     def __init__(self):
         super().__init__()
         self._bulk = []  # (col, first_row, list of rendered <c> elements)
+        self._bulk_formats = {}  # (col, first_row) of a run -> its cells' Format
 
-    def write_number_column(self, first_row, col, values):
-        """Write finite numbers down column ``col`` from ``first_row`` (0-based).
+    def write_number_column(self, first_row, col, values, cell_format=None):
+        """Write finite numbers down column ``col`` from ``first_row`` (0-based), exactly
+        (17 significant digits), with ``cell_format`` if given.
 
         Several calls may fill one column, in runs that do not overlap.
 
@@ -89,11 +91,13 @@ class ColumnsWorksheet(SafeWorksheet):
             raise ValueError("write_number_column takes finite numbers only")
         if not FAST:  # xlsxwriter's public path, to the same values
             for row, value in enumerate(values.tolist(), start=first_row):
-                self.write_number(row, col, Exact(value))
+                self.write_number(row, col, Exact(value), cell_format)
             return 0
         self._check_dimensions(first_row, col)
         self._check_dimensions(last, col)
         self._bulk.append((col, first_row, np.ascontiguousarray(values)))
+        if cell_format is not None:
+            self._bulk_formats[(col, first_row)] = cell_format
         return 0
 
     def _get_range_data(self, row_start, col_start, row_end, col_end):
@@ -116,6 +120,11 @@ class ColumnsWorksheet(SafeWorksheet):
         with ThreadPoolExecutor(2) as pool:  # render_cells formats without the GIL
             texts = list(pool.map(lambda p: render_cells(xl_col_to_name(p[0]), p[1] + 1, p[2]),
                                   pieces))
+        for k, (col, first, _) in enumerate(runs):  # a run's format: its cells' style index
+            fmt = self._bulk_formats.get((col, first))
+            if fmt is not None:
+                style = f'" s="{fmt._get_xf_index()}"><v>'
+                texts[k] = [t.replace('"><v>', style, 1) for t in texts[k]]
         spans = [(col, first, first + len(values), t)
                  for (col, first, values), t in zip(pieces, texts)]
         edges = sorted({s[1] for s in spans} | {s[2] for s in spans})

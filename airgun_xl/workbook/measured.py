@@ -181,7 +181,7 @@ def write_comparison(path, comparison, about, force=False, models=("4-mass", "ri
         ws.set_column(1, 4, 18)
         head = write_about(ws, about, bold) + 1
         row = _write_scores(wb, ws, c, head, bold, models)
-        row = write_warnings(wb, ws, row + 1, c.warnings, 4)
+        row = write_warnings(wb, ws, row + 1, c.warnings, 4, line_chars=115)
         one_page(ws, row, 4, shot=shot, title="Compared")
         charts = wb.add_worksheet("Charts")
 

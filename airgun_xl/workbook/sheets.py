@@ -302,18 +302,20 @@ def flagged_figures(warnings):
 WARNING_LINE_CHARS = 150
 
 
-def write_warnings(wb, ws, row, warnings, last_col):
+def write_warnings(wb, ws, row, warnings, last_col, line_chars=WARNING_LINE_CHARS,
+                   heading="Warnings"):
     """The run's warnings from ``row`` down, each across columns 0..``last_col`` with its text
-    wrapped, under a bold heading that counts them; returns the last row written. Every
-    warning the terminal showed is on the printed page."""
+    wrapped (``line_chars`` to a line, for the row's height), under a bold heading that counts
+    them; returns the last row written. Every warning the terminal showed is on the printed
+    page."""
     bold = wb.add_format({"bold": True, "font_color": "#9C0006" if warnings else "#000000"})
     wrap = wb.add_format({"text_wrap": True, "valign": "top"})
-    ws.write_string(row, 0, f"Warnings ({len(warnings)})" if warnings else
-                    "Warnings: none", bold)
+    ws.write_string(row, 0, f"{heading} ({len(warnings)})" if warnings else
+                    f"{heading}: none", bold)
     for i, text in enumerate(warnings, 1):
         ws.merge_range(row + i, 0, row + i, last_col, "", wrap)
         ws.write_string(row + i, 0, text, wrap)
-        lines = -(-len(text) // WARNING_LINE_CHARS)
+        lines = -(-len(text) // line_chars)
         ws.set_row(row + i, 15 * max(1, lines))
     return row + len(warnings)
 

@@ -395,6 +395,6 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
         warnings += write_cells(outputs_ws, source.outputs_block)
         print_outputs_block(outputs_ws, source.outputs_block, shot)
     if not result.params.crush_law.is_legacy:  # a fitted law goes with the shot
-        write_law_sheet(wb, result.params.crush_law, names[LAW_SHEET])
+        write_law_sheet(wb, result.params.crush_law, names[LAW_SHEET], shot=shot)
     close_workbook(wb, shown if shown is not None else tmp)
     return warnings
