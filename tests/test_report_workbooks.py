@@ -1,0 +1,128 @@
+"""Issue 20: every workbook the commands write reads and prints like the fill's Summary.
+
+One workbook of each kind (tests/report_workbooks.py) is scanned and printed through
+LibreOffice: one page per report sheet and none for data sheets, no float shown as a General
+number of more than 7 significant digits, a header naming the shot and the version, and a
+grid sweep's charts with one series per level."""
+import re
+import shutil
+import subprocess
+import zipfile
+
+import openpyxl
+import pytest
+from openpyxl.utils.cell import range_boundaries
+from report_workbooks import make_all
+
+needs_lo = pytest.mark.skipif(not (shutil.which("soffice") and shutil.which("pdftotext")),
+                              reason="needs LibreOffice and poppler-utils")
+
+#: The most significant digits a General number may show: Excel's General shows up to 11
+#: characters, LibreOffice's up to 10 digits; a figure past 7 looks exact and is not read.
+MAX_DIGITS = 7
+
+
+@pytest.fixture(scope="module")
+def workbooks(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("reports")
+    paths, codes = make_all(folder)
+    # diff exits 0 (the legacy input filled equals its legacy output); the rest succeed
+    assert codes == dict.fromkeys(codes, 0), codes
+    return paths
+
+
+def report_sheets(path):
+    """[(sheet, (min_col, min_row, max_col, max_row))] of the sheets that print: a data
+    sheet's print area is the blank XFD1 (airgun_xl/workbook/report.py)."""
+    wb = openpyxl.load_workbook(path)
+    out = []
+    for ws in wb.worksheets:
+        area = ws.print_area
+        assert area, f"{path.name}: {ws.title} has no print area"
+        bounds = range_boundaries(str(area[0] if isinstance(area, list) else area)
+                                  .split("!")[-1].replace("$", ""))
+        if bounds != (16384, 1, 16384, 1):
+            out.append((ws, bounds))
+    return out
+
+
+def significant_digits(x):
+    """Significant digits of the shortest repr of ``x``: 0.1 -> 1, 680.388555 -> 9."""
+    mantissa = repr(abs(float(x))).lower().split("e")[0].replace(".", "")
+    return len(mantissa.strip("0"))
+
+
+def test_significant_digits():
+    assert [significant_digits(x) for x in (0.1, 680.388555, 2.7e7, 1.25e-9, 100.0)] == [
+        1, 9, 2, 3, 1]
+
+
+KINDS = ("fill", "diff", "grid", "montecarlo", "sobol", "convergence", "srs", "design_srs",
+         "compare", "calibrate_law", "calibrate_fit")
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_no_report_sheet_shows_a_long_general_number(workbooks, kind):
+    """Every number on a printed sheet has a format: none is a General float of more than 7
+    significant digits (the workbooks showed '105.925372517729 Hz', '24152274.0490178')."""
+    long, numbers = [], 0
+    for ws, (c0, r0, c1, r1) in report_sheets(workbooks[kind]):
+        for row in ws.iter_rows(min_row=r0, max_row=r1, min_col=c0, max_col=c1):
+            for cell in row:
+                if isinstance(cell.value, (int, float)) and not isinstance(cell.value, bool):
+                    numbers += 1
+                    if (cell.number_format == "General"
+                            and significant_digits(cell.value) > MAX_DIGITS):
+                        long.append(f"{ws.title}!{cell.coordinate}={cell.value!r}")
+    assert numbers > 0 and not long, long[:10]
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_every_report_sheet_has_the_header(workbooks, kind):
+    """The page header names the shot (or the compared files), the sheet and the version."""
+    for ws, _ in report_sheets(workbooks[kind]):
+        header = ws.oddHeader
+        assert "airgun-xl" in header.right.text and "&D" in header.right.text, ws.title
+        assert header.left.text and header.center.text, ws.title
+        assert ws.page_setup.orientation == "landscape", ws.title
+
+
+@needs_lo
+def test_each_workbook_prints_one_page_per_report_sheet(workbooks, tmp_path):
+    """LibreOffice's PDF export prints every sheet: each report sheet on one page (its title
+    in the header), each data sheet on none. Before: convergence 7 pages for its one sheet."""
+    paths = [workbooks[k] for k in KINDS]
+    done = subprocess.run(["soffice", f"-env:UserInstallation=file://{tmp_path}/lo",
+                           "--headless", "--convert-to", "pdf", "--outdir", str(tmp_path),
+                           *map(str, paths)], capture_output=True, text=True, timeout=600,
+                          check=False)
+    assert done.returncode == 0, done.stderr
+    for kind, path in zip(KINDS, paths, strict=True):
+        text = subprocess.run(["pdftotext", "-layout", str(tmp_path / (path.stem + ".pdf")),
+                               "-"], capture_output=True, text=True, check=True).stdout
+        pages = text.split("\f")[:-1]
+        sheets = [ws.title for ws, _ in report_sheets(path)]
+        assert len(pages) == len(sheets), (kind, len(pages), sheets)
+        for page, title in zip(pages, sheets, strict=True):
+            assert "airgun-xl" in page.splitlines()[0], (kind, title)
+
+
+def test_the_grid_sweeps_charts_have_one_series_per_level(workbooks):
+    """--vary A28=150:250:5 --vary E40=2.5e7:3e7:3: the peak against A28 is three curves
+    (one per E40 level), against E40 five (one per A28); the axes name their units (MPa)."""
+    with zipfile.ZipFile(workbooks["grid"]) as z:
+        charts = sorted(n for n in z.namelist() if re.fullmatch(r"xl/charts/chart\d+\.xml", n))
+        xml = [z.read(n).decode() for n in charts]
+    assert [x.count("<c:ser>") for x in xml] == [3, 5]
+    assert "E40 = 25 MPa" in xml[0] and "A28 = 150 m/s" in xml[1]
+    assert "E40 Yield Stress (MPa)" in xml[1] and 'formatCode="#,##0.0,,"' in xml[1]
+
+
+def test_the_fills_charts_are_in_the_summarys_units(workbooks):
+    """Time in ms, force in kN (the axis shows N / 1000), frequency in kHz."""
+    with zipfile.ZipFile(workbooks["fill"]) as z:
+        text = "".join(z.read(n).decode() for n in z.namelist()
+                       if re.fullmatch(r"xl/charts/chart\d+\.xml", n))
+    assert "Time (ms)" in text and "Time (s)" not in text
+    assert "Force (kN)" in text and 'formatCode="#,##0,"' in text
+    assert "Frequency (kHz)" in text
