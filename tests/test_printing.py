@@ -140,8 +140,8 @@ def test_spectrum_chart_from_the_lobe_end_with_its_dominant_and_natural_marks(tm
 
 @needs_lo
 def test_compare_and_calibration_workbooks_print_their_reports(tmp_path):
-    """compare-measured: one page, the scores, the rating and the three charts (the data
-    sheets unprinted). calibrate: the shot's parameters, its Outputs block, the Crush law and
+    """compare-measured: two pages, the scores and the rating, then the three charts (the
+    data sheets unprinted). calibrate: the shot's parameters, its Outputs block, the Crush law and
     the Calibration report, a page each. LibreOffice opens both (the PDF is its reading)."""
     from airgun_xl.studies.calibrate import synthetic_measurement
 
@@ -154,9 +154,9 @@ def test_compare_and_calibration_workbooks_print_their_reports(tmp_path):
     assert main(["compare-measured", str(TEMPLATE), str(m), "--cfc", "1000", "-o",
                  str(compared)]) == 0
     pages = _pdf_pages(compared, tmp_path)
-    assert len(pages) == 1
+    assert len(pages) == 2
     assert re.search(r"Overall rating R\s+0\.9\d\d", pages[0])
-    assert "Test against prediction (Fig. 13)" in pages[0]
+    assert "Test against prediction (Fig. 13)" in pages[1]
     calibrated = tmp_path / "calibrated.xlsx"
     assert main(["calibrate", str(TEMPLATE), str(m), "--cfc", "1000", "-o",
                  str(calibrated)]) == 0
