@@ -66,10 +66,12 @@ def _law_chart(wb, n_grid, n_samples, v_range, values):
     line_series(chart, "Law", "The macro's law, Eq. (8)", 1, n_grid, 0, 1, "#1f4e79", "dash")
     lo, hi = nice_range(v_range)
     ylo, yhi = nice_range(values, include_zero=True)
-    chart = titled(chart, "Crush factor against relative velocity (Figs. 7-8)",
+    title = "Crush factor against relative velocity (Figs. 7-8)"
+    chart = titled(chart, title,
                    axis("Relative velocity (m/s)", lo, hi),
                    axis("Crush factor (-)", ylo, yhi))
     chart.set_size(chart_size(CHART_COLS, CHART_ROWS))
+    chart.set_title({"name": title, "name_font": {"size": 11}})
     return chart
 
 
@@ -80,9 +82,11 @@ def _pulse_chart(wb, a):
         line_series(chart, "Pulses", name, 1, n, 0, col, color)
     lo, hi = nice_range(a.time * 1e3)
     ylo, yhi = nice_range(list(a.simulated_kg) + list(a.measured_kg), include_zero=True)
-    chart = titled(chart, "Shot 1: measured and calibrated pulses",
+    title = "Shot 1: measured and calibrated pulses"
+    chart = titled(chart, title,
                    axis("Time (ms)", lo, hi), axis("Acceleration (kG)", ylo, yhi))
     chart.set_size(chart_size(CHART_COLS, CHART_ROWS))
+    chart.set_title({"name": title, "name_font": {"size": 11}})
     return chart
 
 
