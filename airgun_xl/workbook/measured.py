@@ -6,8 +6,8 @@ from ..transaction import atomic_path, check_output
 from .charts import line_series, log_axis, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
 from .report import axis, chart_size, not_printed, one_page
-from .srs import G_PER_KG
 from .sheets import write_about, write_number_columns, write_warnings
+from .srs import G_PER_KG
 from .writer import close_workbook, new_workbook
 
 ROWS = (("Peak acceleration", "peak_kg", "kG", 1.0, "0.000"),
