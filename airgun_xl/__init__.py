@@ -17,6 +17,7 @@ __version__ = "0.1.0"
 from .errors import (
     AirgunXlError,
     ArchiveError,
+    CampaignError,
     CellError,
     DesignError,
     DivergenceError,
@@ -57,6 +58,7 @@ def load(path: str | os.PathLike[str]) -> Shot:
 __all__ = [
     "AirgunXlError",
     "ArchiveError",
+    "CampaignError",
     "CellError",
     "DesignError",
     "DivergenceError",

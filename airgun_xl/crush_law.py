@@ -6,7 +6,7 @@ calibration and the rigid model.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -37,11 +37,16 @@ class CrushLaw:
         Relative velocities [m/s] the law was fitted over (where it can be trusted).
     name : str
         ``"legacy"`` (the macro's) or ``"fitted"``.
+    source : str
+        Where a fitted law came from, for the record: ``"the Crush law sheet"``, or an
+        archive's law library entry such as ``"LOT-2026-07@1"`` (not compared: the same
+        coefficients are the same law).
     """
 
     coefficients: tuple = LEGACY_COEFFICIENTS
     v_range: tuple = CRUSH_FIT_RANGE
     name: str = "legacy"
+    source: str = field(default="", compare=False)
 
     def __post_init__(self):
         c = tuple(float(x) for x in self.coefficients)

@@ -84,3 +84,8 @@ class DesignError(AirgunXlError):
 
 class ArchiveError(AirgunXlError):
     """The archive cannot be used or does not hold what was asked for."""
+
+
+class CampaignError(AirgunXlError):
+    """Some shots of a campaign (``fill`` of many workbooks) failed; the others were filled.
+    Each failure was said on its own line; this message counts them."""

@@ -103,7 +103,7 @@ def _make_file(tmp_path, kind):
         return path, "no such file"
     if kind == "folder":
         path.mkdir()
-        return path, "is a folder"
+        return path, "holds no .xlsx shot"  # a folder is a campaign of its shots
     if kind == "empty":
         path.write_bytes(b"")
         return path, "is not a workbook"

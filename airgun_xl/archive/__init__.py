@@ -2,7 +2,8 @@
 
 - :mod:`.store`: the folder, its SQLite index, entries and how they are committed (light: the
   standard library only, so ``history`` and ``show`` start fast);
-- :mod:`.entry`: what a fill puts in an entry (imported by the fill when it archives).
+- :mod:`.entry`: what a fill puts in an entry (imported by the fill when it archives);
+- :mod:`.laws`: the library of fitted crush laws, kept by name (calibrate stores, fill runs).
 """
 from .store import (
     ENV,

@@ -1,11 +1,9 @@
 """``airgun-xl fill SHOT.xlsx [-o OUT.xlsx] [--force] [...]``: run a shot into a new workbook."""
-import dataclasses
-import time
 from pathlib import Path
 
 from ..archive import ENV, archive_dir
 from ..choices import HOSTS, INTEGRATORS, MODELS, SIDECAR_MODES, UNLOADINGS
-from ..outputs import GROUPS, from_sheet
+from ..outputs import GROUPS
 from ..transaction import display
 
 
@@ -16,10 +14,18 @@ def add_parser(sub):
                                    "a new workbook. SHOT itself is never modified. The "
                                    "workbook's Outputs sheet, if any, picks the outputs; the "
                                    "flags below override it.")
-    p.add_argument("shot", metavar="SHOT.xlsx", help="workbook in the report's layout")
+    p.add_argument("shots", nargs="+", metavar="SHOT.xlsx",
+                   help="workbook in the report's layout; several, or a folder (its .xlsx "
+                        "shots), fill a campaign")
     p.add_argument("-o", "--output", metavar="OUT.xlsx",
-                   help="output workbook (default: SHOT.out.xlsx beside SHOT)")
+                   help="output workbook (default: SHOT.out.xlsx beside SHOT; one shot only)")
     p.add_argument("--force", action="store_true", help="overwrite OUT.xlsx if it exists")
+    p.add_argument("--jobs", metavar="N",
+                   help="worker processes for a campaign (default: the cores this process "
+                        "may use)")
+    p.add_argument("--summary", metavar="DAY.xlsx",
+                   help="also write the campaign's table: one row a shot, the peak against "
+                        "v0, every warning")
     p.add_argument("--host", choices=HOSTS, default="excel",
                    help="whose Offset rounding the filtered column reproduces when 1/(E2*E34) "
                         "is fractional (default: excel)")
@@ -40,10 +46,12 @@ def add_parser(sub):
                         "run still stops)")
     p.add_argument("--model", choices=MODELS, default="4-mass",
                    help="4-mass: ArtSim (default); rigid: the previous rigid-body model")
-    p.add_argument("--crush-law", choices=("workbook", "legacy"), default="workbook",
+    p.add_argument("--crush-law", metavar="LAW", default="workbook",
                    help="workbook: the law the workbook's Crush law sheet names (a calibrated "
                         "workbook's fitted law), else the macro's (default); legacy: the "
-                        "macro's polynomial, Eq. (8), whatever the workbook says")
+                        "macro's polynomial, Eq. (8), whatever the workbook says; NAME or "
+                        "NAME@N: a law of the --archive's library (calibrate --archive "
+                        "--name)")
     p.add_argument("--unloading", choices=UNLOADINGS, default="macro",
                    help="macro: the macro's unloading force, quirk included (default); "
                         "continuous: each unloading starts from the force before it (no jump "
@@ -59,11 +67,6 @@ def add_parser(sub):
     p.add_argument("--reproducible", action="store_true",
                    help="leave run times out of the Summary, so equal inputs give equal bytes")
     p.set_defaults(run=run)
-
-
-def default_output(shot_path):
-    shot_path = Path(shot_path)
-    return shot_path.with_name(shot_path.stem + ".out.xlsx")
 
 
 def _ms(seconds):
@@ -102,33 +105,35 @@ def print_summary(output, filled):
     print("\n".join(lines))
 
 
+def settings_of(args):
+    """The :class:`~airgun_xl.campaign.FillSettings` the command line asks for."""
+    from ..campaign import FillSettings
+
+    return FillSettings(
+        args.output, args.force, args.host, args.only, args.no_charts, args.every,
+        args.max_sheet_rows, args.sidecar, args.integrator, args.allow_unstable, args.model,
+        args.crush_law, args.unloading, args.compare_models,
+        str(archive_dir(args.archive, required=False) or "") or None, args.name,
+        args.reproducible, tuple(args.argv))
+
+
 def run(args):
-    from ..archive.entry import now, shot_name
-    from ..pipeline import ArchiveRequest, Options, fill_workbook
-    from ..shot import Shot
+    settings = settings_of(args)
+    if len(args.shots) == 1 and not Path(args.shots[0]).is_dir() and not args.summary:
+        return run_one(args.shots[0], settings)
+    from .campaign import run_batch
+
+    return run_batch(args, settings)
+
+
+def run_one(path, settings):
+    """One shot, as fill always did: its warnings and notes on the terminal, a progress bar,
+    its figures printed."""
+    from ..campaign import fill_one
     from . import note, warn
     from .progress import Progress
 
-    started = time.perf_counter()
-    output = Path(args.output) if args.output else default_output(args.shot)
-    # --crush-law legacy runs the macro's law whatever the sheet says: the sheet is not read
-    shot = Shot.from_workbook(args.shot, read_law=args.crush_law != "legacy")
-    if args.unloading != "macro":
-        shot = shot.with_params(unloading=args.unloading)
-    outputs = from_sheet(shot.source.outputs_block).with_flags(
-        args.only, args.no_charts, args.every, args.max_sheet_rows, args.sidecar)
-    options = Options(args.integrator, args.host, args.model, args.compare_models, args.force,
-                      args.allow_unstable, args.reproducible, command=tuple(args.argv))
-    root = archive_dir(args.archive, required=False)
-    if root is not None:
-        outputs = dataclasses.replace(outputs, sidecar="never")  # the entry holds the history
-        options.track_all = True
-        options.archive = ArchiveRequest(root, shot_name(shot, args.name), now())
-    progress = Progress.for_rows(shot.params.rows)
-    try:
-        filled = fill_workbook(shot, output, outputs, options, warn, started, note, progress)
-    finally:
-        progress.close()
+    output, filled, root = fill_one(path, settings, warn, note, Progress.for_rows)
     print_summary(output, filled)
     if filled.entry is not None:
         print(f"  archived as {filled.entry.ref} in {display(root)}")

@@ -97,3 +97,39 @@ def _is_terminal(stream):
         return stream.isatty()
     except (AttributeError, ValueError):
         return False
+
+
+class CountBar:
+    """A campaign's one bar: shots done of all, and how many failed; on a terminal only.
+    ``update(failed)`` counts one more shot done."""
+
+    def __init__(self, total, stream=None, enabled=None):
+        self.stream = stream if stream is not None else sys.stderr
+        self.enabled = _is_terminal(self.stream) if enabled is None else enabled
+        self.total, self.done, self.failed = total, 0, 0
+        self.started = time.perf_counter()
+        if self.enabled:
+            ACTIVE[:] = [self]
+            self._draw()
+
+    def update(self, failed=False):
+        self.done += 1
+        self.failed += bool(failed)
+        self._draw()
+
+    def _draw(self):
+        if not self.enabled:
+            return
+        filled = int(round(self.done / max(self.total, 1) * WIDTH))
+        failed = f", {self.failed} failed" if self.failed else ""
+        self.stream.write(f"\r[{'#' * filled}{'.' * (WIDTH - filled)}] {self.done}/"
+                          f"{self.total} shots{failed} "
+                          f"({time.perf_counter() - self.started:.1f} s)\x1b[K")
+        self.stream.flush()
+
+    def close(self):
+        if not self.enabled:
+            return
+        ACTIVE.clear()
+        self.stream.write("\r\x1b[K")
+        self.stream.flush()

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..crush_law import LEGACY_LAW
 from ..studies.calibrate import AT_BOUND
-from ..transaction import atomic_path, check_output
+from ..transaction import atomic_path, check_output, display
 from .charts import line_series, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
 from .law_sheet import write_law_sheet
@@ -44,11 +44,11 @@ def _parameter_sheet(wb, shot, params, names, fitted):
     ws = wb.add_worksheet(names["first"], worksheet_class=ColumnsWorksheet)
     warnings = write_cells(ws, block, {k: v[0] for k, v in block.items()})
     not_printed(ws)  # the input's layout, for fill: data (Parameters prints)
-    write_parameters(wb, params, source.path.name, names["Parameters"])
+    write_parameters(wb, params, display(source.path.name), names["Parameters"])
     if source.outputs_block:
         out = wb.add_worksheet(names["Outputs"], worksheet_class=ColumnsWorksheet)
         warnings += write_cells(out, source.outputs_block)
-        print_outputs_block(out, source.outputs_block, source.path.name)
+        print_outputs_block(out, source.outputs_block, display(source.path.name))
     return warnings
 
 
@@ -100,7 +100,7 @@ def write_calibration(path, shot, cal, files, options, force=False):
         names = sheet_names(shot.source.sheet_title)
         warnings = _parameter_sheet(wb, shot, params, names, cal.fitted)
         if not law.is_legacy:
-            write_law_sheet(wb, law, names["Crush law"], shot=shot.source.path.name)
+            write_law_sheet(wb, law, names["Crush law"], shot=display(shot.source.path.name))
         ws = wb.add_worksheet("Calibration")
         style = Style(wb)
         bold = style.bold
@@ -220,6 +220,6 @@ def write_calibration(path, shot, cal, files, options, force=False):
         for k, chart in enumerate(charts):
             ws.insert_chart(1 + k * CHART_ROWS, 7, chart)
         one_page(ws, max(row, 1 + len(charts) * CHART_ROWS), 7 + CHART_COLS,
-                 shot=shot.source.path.name, title="Calibration")
+                 shot=display(shot.source.path.name), title="Calibration")
         close_workbook(wb, path)
     return warnings

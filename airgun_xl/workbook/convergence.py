@@ -101,7 +101,7 @@ def _render(ladders, tmp, path, shot):
                 if value is not None:
                     style.number(ws, row, 2 + i, value, "ratio")
     row += 2
-    ws.write_string(row, 0, f"Shot: {shot.source.path.name if shot.source else 'API'}; errors "
+    ws.write_string(row, 0, f"Shot: {display(shot.source.path.name) if shot.source else 'API'}; errors "
                             "are relative to the finest level of the same integrator.")
     chart = wb.add_chart({"type": "scatter", "subtype": "straight_with_markers"})
     times, errors = [], []

@@ -137,7 +137,7 @@ HEADER_NAME_CHARS = 60
 
 
 def _header_text(text):
-    text = str(text)
+    text = str(text).encode("utf-8", "backslashreplace").decode("utf-8")  # an undecodable name
     if len(text) > HEADER_NAME_CHARS:
         text = text[:HEADER_NAME_CHARS - 1] + "…"
     return text.replace("&", "&&")

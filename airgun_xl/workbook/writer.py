@@ -363,7 +363,7 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
     wb = new_workbook(tmp)
     names = sheet_names(source.sheet_title if source is not None else None)
     refs, warnings = _write_sheet1(wb, result, outputs, keep, stride, names["first"])
-    shot = source.path.name if source is not None else None
+    shot = display(source.path.name) if source is not None else None
     info["shot"] = shot
     if "summary" in outputs:
         write_parameters(wb, result.params, shot, names["Parameters"])

@@ -88,7 +88,7 @@ def test_not_regular_files_are_refused(tmp_path, capsys):
     refused(capsys, ["fill", fifo], tmp_path, naming=["a FIFO"])
     refused(capsys, ["fill", "/dev/zero"], tmp_path, naming=["/dev/zero", "character device"])
     refused(capsys, ["diff", "/dev/zero", fifo], tmp_path, naming=["character device"])
-    refused(capsys, ["fill", tmp_path], tmp_path, naming=["is a folder"])
+    refused(capsys, ["fill", tmp_path], tmp_path, naming=["holds no .xlsx shot"])  # a campaign
 
 
 def test_a_file_past_the_size_cap_is_refused_unread(tmp_path, capsys):
@@ -154,10 +154,10 @@ def test_a_formula_that_calls_out_is_written_as_its_value(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("title,expected", [
-    ("Summary", ["Summary", "Summary (2)"]),
-    ("charts", ["charts", "Summary", "Charts (2)"]),
-    ("a/b[c]'", ["a_b_c_", "Summary"]),
-    ("'quoted'", ["quoted", "Summary"]),
+    ("Summary", ["Summary", "Parameters", "Summary (2)"]),
+    ("charts", ["charts", "Parameters", "Summary", "Charts (2)"]),
+    ("a/b[c]'", ["a_b_c_", "Parameters", "Summary"]),
+    ("'quoted'", ["quoted", "Parameters", "Summary"]),
 ])
 def test_odd_first_sheet_names_rename_the_output_sheets(tmp_path, title, expected):
     shot = tmp_path / "shot.xlsx"

@@ -1,0 +1,139 @@
+"""The archive's library of crush laws: fitted laws kept by name, with their velocity range,
+the shots they were fitted on and their scores, so that ``fill --crush-law NAME`` runs one.
+
+Each law is a JSON file ``.laws/<name>/vNNNN.json`` of the archive folder (a hidden folder:
+entry scans skip it). A name keeps every version: storing it again adds the next one, and
+``NAME`` runs the latest, ``NAME@N`` version N. A version is written to a temp file and then
+linked to its name, which fails if another writer took that version first (it then takes the
+next), so two calibrations can store at once and none is ever half-written.
+"""
+import datetime
+import json
+import os
+import re
+import uuid
+from pathlib import Path
+
+from ..crush_law import DEGREE, CrushLaw
+from ..errors import ArchiveError, OptionError
+from ..transaction import display
+from .store import Archive, safe_name
+
+LAWS = ".laws"
+_VERSION = re.compile(r"^v(\d{4,})\.json$")
+_REF = re.compile(r"^(?P<name>[^@]+?)(?:@(?P<version>\d+))?$")
+
+
+def _folder(root, name):
+    return Path(root) / LAWS / safe_name(name)
+
+
+def _versions(folder):
+    if not folder.is_dir():
+        return []
+    found = [(int(m.group(1)), p) for p in folder.iterdir()
+             if (m := _VERSION.match(p.name)) and p.is_file()]
+    return sorted(found)
+
+
+def store_law(root, name, law, shots, scores, command=()):
+    """Keep ``law`` in the archive at ``root`` under ``name``; return its reference
+    ``NAME@N``.
+
+    Parameters
+    ----------
+    law : CrushLaw
+    shots : list of dict
+        Each shot the law was fitted on (its workbook, recording, impact speed).
+    scores : list of dict
+        Each shot's residuals before and after.
+    """
+    if not name or safe_name(name) != name:
+        raise OptionError(f"--name: found {name!r}, expected a law name of letters, digits, "
+                          "'-', '_' and '.' (such as LOT-2026-07)")
+    Archive(root, create=True)
+    folder = _folder(root, name)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ArchiveError(f"{display(folder)}: cannot be created ({exc.strerror})") from None
+    record = {"name": name, "coefficients": list(law.coefficients),
+              "v_range": list(law.v_range), "shots": shots, "scores": scores,
+              "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+              "command": list(command)}
+    tmp = folder / f".{uuid.uuid4().hex}.tmp"
+    try:
+        with open(tmp, "x", encoding="utf-8") as fh:
+            json.dump(record, fh, indent=1)
+            fh.flush()
+            os.fsync(fh.fileno())
+        for _ in range(1000):  # a version another writer took first: the next one
+            version = (_versions(folder)[-1][0] if _versions(folder) else 0) + 1
+            try:
+                os.link(tmp, folder / f"v{version:04d}.json")
+                break
+            except FileExistsError:
+                continue
+        else:
+            raise ArchiveError(f"{display(folder)}: no free version, expected fewer writers")
+    except OSError as exc:
+        raise ArchiveError(f"{display(folder)}: the law cannot be written "
+                           f"({exc.strerror or exc})") from None
+    finally:
+        tmp.unlink(missing_ok=True)
+    return f"{name}@{version}"
+
+
+def _law(record, ref, path):
+    try:
+        coefficients = [float(c) for c in record["coefficients"]]
+        lo, hi = (float(v) for v in record["v_range"])
+        if len(coefficients) != DEGREE + 1 or not lo < hi:
+            raise ValueError
+        return CrushLaw(tuple(coefficients), (lo, hi), "fitted", source=ref)
+    except (KeyError, TypeError, ValueError):
+        raise ArchiveError(f"{display(path)}: is not a crush law record, expected 7 "
+                           "coefficients and a velocity range (see airgun-xl archive "
+                           "verify)") from None
+
+
+def load_law(root, ref):
+    """The law ``NAME`` (its latest version) or ``NAME@N`` of the archive at ``root``, as a
+    :class:`CrushLaw` whose ``source`` is its reference; and its record."""
+    m = _REF.match(str(ref).strip())
+    folder = _folder(root, m.group("name")) if m else None
+    versions = _versions(folder) if folder is not None else []
+    if m and m.group("version"):
+        versions = [v for v in versions if v[0] == int(m.group("version"))]
+    if not versions:
+        known = ", ".join(r["ref"] for r in list_laws(root)) or "none yet"
+        raise OptionError(f"--crush-law: found {ref!r}, expected workbook, legacy or a law in "
+                          f"{display(root)} (stored by calibrate --archive --name; there: "
+                          f"{known})")
+    version, path = versions[-1]
+    try:
+        record = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise ArchiveError(f"{display(path)}: cannot be read ({exc})") from None
+    name = m.group("name")
+    return _law(record, f"{name}@{version}", path), record
+
+
+def list_laws(root):
+    """Every stored law version: ``[{"ref", "v_range", "shots", "created"}]``, by name."""
+    base = Path(root) / LAWS
+    out = []
+    if not base.is_dir():
+        return out
+    for folder in sorted(p for p in base.iterdir() if p.is_dir() and not p.is_symlink()):
+        for version, path in _versions(folder):
+            try:
+                record = json.loads(path.read_text(encoding="utf-8"))
+                lo, hi = record["v_range"]
+                out.append({"ref": f"{folder.name}@{version}", "v_range": [lo, hi],
+                            "shots": len(record.get("shots", [])),
+                            "created": record.get("created", "")})
+            except (OSError, ValueError, KeyError, TypeError):
+                out.append({"ref": f"{folder.name}@{version}", "v_range": None, "shots": 0,
+                            "created": "unreadable"})
+    return out

@@ -1,0 +1,302 @@
+"""A campaign: many shots filled by one command, and the table across them.
+
+``airgun-xl fill a.xlsx b.xlsx day/`` fills each workbook (a folder means the ``.xlsx``
+files in it) as its own transaction: its workbook, sidecar and archive entry are published
+together or not at all. :func:`run_campaign` runs the shots in worker processes (``--jobs``);
+a worker fills many shots, so its start-up is paid once. A bad shot gets its one line and the
+others go on. Ctrl-C stops the batch: finished shots stay, the running ones clean up their
+temp files, the rest are not started.
+
+:class:`FillSettings` is what the command line asks of every shot (one declaration, pickled
+to the workers); :func:`fill_one` fills one shot with it; :data:`TABLE` names the columns of
+the campaign table (``fill --summary`` and ``history -o``).
+"""
+from __future__ import annotations
+
+import dataclasses
+import os
+import time
+from pathlib import Path
+
+from .errors import AirgunXlError, OptionError
+from .transaction import Interrupted, display
+
+#: Outputs of the commands, left out when a folder is expanded (they are not shots to fill;
+#: a calibrated workbook is, and is named on the command line when wanted).
+DERIVED_SUFFIXES = (".out.xlsx", ".sweep.xlsx", ".srs.xlsx", ".design.xlsx", ".measured.xlsx",
+                    ".calibrated.xlsx", ".convergence.xlsx")
+
+#: The title (document properties) of a campaign table: left out of a folder too, whatever
+#: its name.
+TABLE_TITLE = "airgun-xl campaign table"
+
+
+def is_campaign_table(path):
+    """Whether ``path`` is a campaign table airgun-xl wrote (its core properties' title); a
+    file that is not a readable workbook is not (it fails as a shot, on its own line)."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(path) as z:
+            info = z.getinfo("docProps/core.xml")
+            if info.file_size > 65_536:
+                return False
+            return TABLE_TITLE in z.read(info).decode("utf-8", "replace")
+    except (OSError, KeyError, zipfile.BadZipFile, RuntimeError, ValueError):
+        return False
+
+
+@dataclasses.dataclass(frozen=True)
+class FillSettings:
+    """What ``fill``'s options ask of each shot."""
+
+    output: str | None = None  # one shot only; else SHOT.out.xlsx beside each
+    force: bool = False
+    host: str = "excel"
+    only: str | None = None
+    no_charts: bool = False
+    every: str | None = None
+    max_sheet_rows: str | None = None
+    sidecar: str | None = None
+    integrator: str = "legacy"
+    allow_unstable: bool = False
+    model: str = "4-mass"
+    crush_law: str = "workbook"  # workbook, legacy, or a law of the archive's library
+    unloading: str = "macro"
+    compare_models: bool = False
+    archive: str | None = None
+    name: str | None = None
+    reproducible: bool = False
+    argv: tuple = ()
+
+
+def default_output(shot_path):
+    shot_path = Path(shot_path)
+    return shot_path.with_name(shot_path.stem + ".out.xlsx")
+
+
+def shot_files(paths, exclude=()):
+    """The workbooks ``paths`` name, in order: a file as given, a folder as its ``.xlsx``
+    files (sorted; outputs of the commands, lock files and hidden files left out).
+
+    Raises
+    ------
+    OptionError
+        A path that does not exist, or a folder without a shot in it.
+    """
+    exclude = {Path(p).resolve() for p in exclude}
+    out = []
+    for given in paths:
+        path = Path(given)
+        if path.is_dir():
+            found = sorted(p for p in path.iterdir()
+                           if p.suffix.lower() == ".xlsx" and p.is_file()
+                           and not p.name.startswith((".", "~$"))
+                           and not p.name.lower().endswith(DERIVED_SUFFIXES)
+                           and p.resolve() not in exclude and not is_campaign_table(p))
+            if not found:
+                raise OptionError(f"SHOT: {display(path)} holds no .xlsx shot, expected a "
+                                  "folder of shot workbooks (outputs such as *.out.xlsx are "
+                                  "left out)")
+            out += found
+        elif path.exists() or path.is_symlink():
+            out.append(path)
+        else:
+            raise OptionError(f"SHOT: {display(path)} does not exist, expected a workbook or "
+                              "a folder of them")
+    return out
+
+
+def fill_one(path, settings, warn, note=None, progress_for=None, started=None):
+    """Fill the shot at ``path`` as ``settings`` ask; return (output path, Filled, archive
+    root or None). ``progress_for(rows)`` makes the run's progress callback (told each stage;
+    closed at the end if it has ``close``)."""
+    from .archive import archive_dir
+    from .archive.entry import now, shot_name
+    from .outputs import from_sheet
+    from .pipeline import ArchiveRequest, Options, fill_workbook
+    from .shot import Shot
+
+    started = time.perf_counter() if started is None else started
+    output = Path(settings.output) if settings.output else default_output(path)
+    root = archive_dir(settings.archive, required=False)
+    library = settings.crush_law not in ("workbook", "legacy")
+    if library and root is None:
+        raise OptionError(f"--crush-law: found {settings.crush_law!r} without --archive, "
+                          "expected workbook, legacy, or a law name with the archive that "
+                          "holds it")
+    # --crush-law legacy (or a library law) runs that law whatever the sheet says: not read
+    shot = Shot.from_workbook(path, read_law=settings.crush_law == "workbook")
+    if library:
+        from .archive.laws import load_law
+
+        shot = shot.with_params(crush_law=load_law(root, settings.crush_law)[0])
+    if settings.unloading != "macro":
+        shot = shot.with_params(unloading=settings.unloading)
+    outputs = from_sheet(shot.source.outputs_block).with_flags(
+        settings.only, settings.no_charts, settings.every, settings.max_sheet_rows,
+        settings.sidecar)
+    options = Options(settings.integrator, settings.host, settings.model,
+                      settings.compare_models, settings.force, settings.allow_unstable,
+                      settings.reproducible, command=tuple(settings.argv))
+    if root is not None:
+        outputs = dataclasses.replace(outputs, sidecar="never")  # the entry holds the history
+        options.track_all = True
+        options.archive = ArchiveRequest(root, shot_name(shot, settings.name), now())
+    progress = progress_for(shot.params.rows) if progress_for is not None else None
+    try:
+        filled = fill_workbook(shot, output, outputs, options, warn, started, note, progress)
+    finally:
+        if hasattr(progress, "close"):
+            progress.close()
+    return output, filled, root
+
+
+#: The campaign table, one row a shot: (heading, key, quantity code of
+#: :data:`airgun_xl.workbook.report.QUANTITIES` or None for text).
+TABLE = (
+    ("Shot", "file", None), ("v0 (m/s)", "v0", "m/s"), ("Peak (kG)", "peak_kg", "kG"),
+    ("Filtered peak (kG)", "filtered_peak_kg", "kG"), ("Time of peak (ms)", "time_of_peak", "s"),
+    ("Pulse (ms)", "pulse_duration", "s"), ("Max crush (m)", "max_crush", "m"),
+    ("Final length (m)", "final_length", "m"), ("Warnings", "warning_count", "count"),
+    ("Status", "status", None), ("Output", "output", None),
+)
+
+
+def row_of(path, output, filled, entry=None):
+    """A filled shot's row of the campaign table."""
+    result, s = filled.result, filled.summary
+    row = {"file": display(path), "output": display(output), "status": "filled",
+           "v0": result.params.v31, "peak_kg": result.peak_kg,
+           "time_of_peak": result.time_of_peak, "warnings": list(filled.warnings),
+           "warning_count": len(filled.warnings), "entry": entry,
+           "crush_law": law_name(result.params.crush_law)}
+    if s is not None:
+        row.update(filtered_peak_kg=s.filtered_peak_kg, pulse_duration=s.pulse_duration,
+                   max_crush=s.max_crush, final_length=s.final_length)
+    return row
+
+
+def law_name(law):
+    """How a record names the law a run used."""
+    if law.is_legacy:
+        return "legacy (Eq. 8)"
+    return f"fitted ({law.source})" if law.source else "fitted"
+
+
+def _failed(path, output, status, message):
+    """A row for a shot not filled: only a skipped one names its (existing) output."""
+    return {"file": display(path), "output": display(output) if status == "skipped" else "",
+            "status": status, "message": message, "warnings": [], "warning_count": 0}
+
+
+# -- the worker side ---------------------------------------------------------------------
+
+_STOP = None  # the batch's stop event, in a worker
+
+
+def _worker_init(stop):
+    """A worker ignores Ctrl-C (the whole process group gets it) and stops at the next stage
+    when the parent sets ``stop``: its fill's publication then cleans up."""
+    import signal
+
+    global _STOP
+    _STOP = stop
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
+        if hasattr(signal, name):
+            signal.signal(getattr(signal, name), signal.SIG_IGN)
+
+
+def _check_stop(stage):
+    if _STOP is not None and _STOP.is_set():
+        raise Interrupted(2)
+
+
+def fill_task(path, settings):
+    """Fill one shot of a batch; return its table row (never raises for the shot's own
+    faults: they are its row's status)."""
+    path = Path(path)
+    output = Path(settings.output) if settings.output else default_output(path)
+    warnings = []
+    try:
+        output, filled, _ = fill_one(path, settings, warnings.extend, None,
+                                     lambda rows: _check_stop)
+    except Interrupted:
+        return _failed(path, output, "interrupted", "stopped before it was published")
+    except AirgunXlError as exc:
+        status = "skipped" if _exists_refusal(exc, output, settings) else "failed"
+        return _failed(path, output, status, str(exc))
+    except MemoryError:
+        return _failed(path, output, "failed", "out of memory during the run")
+    except Exception as exc:  # noqa: BLE001 - a fault of ours in one shot: the batch goes on
+        return _failed(path, output, "failed", f"internal error ({type(exc).__name__}: "
+                                               f"{exc}); please report it")
+    entry = filled.entry.ref if filled.entry is not None else None
+    return row_of(path, output, filled, entry)
+
+
+def _exists_refusal(exc, output, settings):
+    """Whether ``exc`` is the refusal of an output that exists (a shot filled before)."""
+    return (not settings.force and output.exists()
+            and "already exists" in str(exc) and display(output) in str(exc))
+
+
+# -- the parent side ---------------------------------------------------------------------
+
+def default_jobs():
+    """The cores this process may use."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # macOS, Windows
+        return os.cpu_count() or 1
+
+
+def run_campaign(files, settings, jobs, on_row=None):
+    """Fill ``files`` with ``jobs`` worker processes (1: in this process); return their rows
+    in the order of ``files``. ``on_row(row)`` is told each as it finishes.
+
+    Raises
+    ------
+    Interrupted
+        After Ctrl-C (or SIGTERM): the finished shots stay, the running ones stopped at their
+        next stage and cleaned up; its ``rows`` attribute holds the rows so far.
+    """
+    on_row = on_row or (lambda row: None)
+    rows = [None] * len(files)
+    if jobs <= 1 or len(files) == 1:
+        try:
+            for k, path in enumerate(files):
+                rows[k] = fill_task(path, settings)
+                on_row(rows[k])
+        except Interrupted as exc:
+            exc.rows = [r for r in rows if r is not None]
+            raise
+        return rows
+    import multiprocessing
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+    context = multiprocessing.get_context("spawn")  # as on Windows and macOS
+    stop = context.Event()
+    pool = ProcessPoolExecutor(min(jobs, len(files)), context, _worker_init, (stop,))
+    futures = {}
+    try:
+        futures = {pool.submit(fill_task, str(path), settings): k
+                   for k, path in enumerate(files)}
+        pending = set(futures)
+        while pending:
+            done, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for future in done:
+                rows[futures[future]] = future.result()
+                on_row(rows[futures[future]])
+    except Interrupted as exc:
+        stop.set()  # the running shots stop at their next stage and clean up
+        for future in futures:
+            future.cancel()
+        pool.shutdown(wait=True, cancel_futures=True)
+        for future, k in futures.items():
+            if rows[k] is None and future.done() and not future.cancelled():
+                rows[k] = future.result()
+        exc.rows = [r for r in rows if r is not None]
+        raise
+    pool.shutdown(wait=True)
+    return rows

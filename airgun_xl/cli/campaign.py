@@ -1,0 +1,100 @@
+"""``airgun-xl fill a.xlsx b.xlsx day/ --jobs N --summary DAY.xlsx``: a campaign of shots.
+
+Each shot is its own fill (workbook, sidecar, archive entry: all or nothing); a bad one gets
+its line and the others go on; exit 0 when all were filled, else 2 with the count. The
+machinery is :mod:`airgun_xl.campaign`; this module checks the options, shows one bar and
+says what happened.
+"""
+import time
+from pathlib import Path
+
+from ..errors import CampaignError, OptionError
+from ..transaction import Interrupted, check_output, display
+
+#: Most worker processes --jobs takes.
+MAX_JOBS = 256
+
+
+def parse_jobs(text):
+    from ..campaign import default_jobs
+
+    if text is None:
+        return default_jobs()
+    try:
+        jobs = int(str(text).strip())
+    except ValueError:
+        jobs = 0
+    if not 1 <= jobs <= MAX_JOBS:
+        raise OptionError(f"--jobs: found {text!r}, expected a whole number of worker "
+                          f"processes, 1 to {MAX_JOBS}")
+    return jobs
+
+
+def run_batch(args, settings):
+    from ..campaign import run_campaign, shot_files
+    from . import _say, note, warn
+    from .progress import CountBar
+
+    jobs = parse_jobs(args.jobs)
+    summary = Path(args.summary) if args.summary else None
+    files = shot_files(args.shots, exclude=[summary] if summary else ())
+    if settings.output and len(files) > 1:
+        raise OptionError(f"-o: found with {len(files)} shots, expected one shot (a campaign "
+                          "writes SHOT.out.xlsx beside each)")
+    if summary is not None:
+        check_output(summary, args.force, inputs=files)  # before any shot runs
+    if settings.crush_law not in ("workbook", "legacy"):  # a law name: refused before any run
+        from ..archive.laws import load_law
+
+        if settings.archive is None:
+            raise OptionError(f"--crush-law: found {settings.crush_law!r} without --archive, "
+                              "expected workbook, legacy, or a law name with the archive that "
+                              "holds it")
+        load_law(settings.archive, settings.crush_law)
+    started = time.perf_counter()
+    bar = CountBar(len(files))
+
+    def said(row):  # each shot's outcome as it comes
+        name = row["file"]
+        if row["status"] == "failed":
+            _say(f"airgun-xl: error: {name}: {row['message']}")
+        elif row["status"] == "skipped":
+            note([f"{name}: skipped, {row['output']} exists (--force overwrites it)"])
+        else:
+            warn([f"{name}: {w}" for w in row["warnings"]])
+        bar.update(row["status"] == "failed")
+
+    try:
+        rows = run_campaign(files, settings, min(jobs, len(files)), said)
+    except Interrupted as exc:
+        bar.close()
+        done = [r for r in getattr(exc, "rows", []) if r["status"] == "filled"]
+        _say(f"airgun-xl: stopped by signal {exc.signum}: {len(done)} of {len(files)} shots "
+             "were filled and stay; the running ones left nothing, the rest were not started"
+             + (f"; no {display(summary)}" if summary else ""))
+        return 128 + exc.signum
+    finally:
+        bar.close()
+    seconds = time.perf_counter() - started
+    counts = {s: sum(r["status"] == s for r in rows) for s in ("filled", "failed", "skipped")}
+    for row in rows:
+        if row["status"] == "filled":
+            print(f"{row['file']} -> {row['output']}: peak {row['peak_kg']:.5f} kG at "
+                  f"{row['time_of_peak'] * 1e3:.4f} ms"
+                  + (f", {row['warning_count']} warnings" if row["warning_count"] else "")
+                  + (f", archived as {row['entry']}" if row.get("entry") else ""))
+    print(f"{len(files)} shots: {counts['filled']} filled, {counts['failed']} failed, "
+          f"{counts['skipped']} skipped, in {seconds:.2f} s with {min(jobs, len(files))} "
+          f"job{'s' * (min(jobs, len(files)) > 1)} ({seconds / len(files):.2f} s a shot)")
+    if summary is not None:
+        from ..workbook.campaign import write_campaign
+
+        write_campaign(summary, rows, f"Campaign: {len(files)} shots filled by airgun-xl "
+                                      f"({counts['filled']} filled, {counts['failed']} "
+                                      f"failed, {counts['skipped']} skipped)", args.force,
+                       label=summary.name)
+        print(f"wrote {summary}: one row a shot, the peak against v0")
+    if counts["failed"]:
+        raise CampaignError(f"{counts['failed']} of {len(files)} shots failed (each said "
+                            "above); the others were filled")
+    return 0
