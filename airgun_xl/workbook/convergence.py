@@ -101,8 +101,9 @@ def _render(ladders, tmp, path, shot):
                 if value is not None:
                     style.number(ws, row, 2 + i, value, "ratio")
     row += 2
-    ws.write_string(row, 0, f"Shot: {display(shot.source.path.name) if shot.source else 'API'}; errors "
-                            "are relative to the finest level of the same integrator.")
+    name = display(shot.source.path.name) if shot.source else "API"
+    ws.write_string(row, 0, f"Shot: {name}; errors are relative to the finest level of the "
+                            "same integrator.")
     chart = wb.add_chart({"type": "scatter", "subtype": "straight_with_markers"})
     times, errors = [], []
     for i, (lad, first, last) in enumerate(spans):
