@@ -163,6 +163,17 @@ TABLE = (
 )
 
 
+#: ``history -o``: the campaign table of an archive's runs.
+HISTORY_TABLE = (
+    ("Entry", "file", None), ("Created (UTC)", "created", None), ("v0 (m/s)", "v0", "m/s"),
+    ("Peak (kG)", "peak_kg", "kG"), ("Filtered peak (kG)", "filtered_peak_kg", "kG"),
+    ("Time of peak (ms)", "time_of_peak", "s"), ("Pulse (ms)", "pulse_duration", "s"),
+    ("Max crush (m)", "max_crush", "m"), ("Final length (m)", "final_length", "m"),
+    ("Warnings", "warning_count", "count"), ("Integrator", "integrator", None),
+    ("Crush law", "crush_law", None),
+)
+
+
 def row_of(path, output, filled, entry=None):
     """A filled shot's row of the campaign table."""
     result, s = filled.result, filled.summary

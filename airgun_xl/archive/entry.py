@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..campaign import law_name
 from ..cells import CELLS
 from ..transaction import display
 from ..workbook.sidecar import have_parquet, render_history
@@ -82,6 +83,9 @@ def prepare_entry(archive, request, shot, workbook, filled, options, seconds):
                   "command": [display(a) for a in options.command],
                   "integrator": options.integrator, "model": options.model,
                   "unloading": p.unloading,
+                  "crush_law": {"name": law_name(p.crush_law),
+                                "coefficients": list(p.crush_law.coefficients),
+                                "v_range": list(p.crush_law.v_range)},
                   "host": options.host, "stride": filled.stride}
     files = {"output.xlsx": workbook}
     if shot.source is not None:

@@ -1,5 +1,6 @@
 """``history``, ``show``, ``compare`` and ``archive verify``: find archived shots again."""
 import json
+import sys
 
 from ..archive import ENV, Archive, archive_dir
 from ..transaction import display
@@ -7,12 +8,21 @@ from ..transaction import display
 
 def add_parser(sub):
     where = f"DIR defaults to ${ENV}."
-    h = sub.add_parser("history", help="list the runs stored in an archive",
-                       description=f"List archived runs with their key inputs and peak. {where}")
+    h = sub.add_parser("history", help="list the runs stored in an archive, and its crush laws",
+                       description=f"List archived runs with their key figures (peak, "
+                                   f"filtered peak, pulse, crush, warnings, integrator, crush "
+                                   f"law) and the archive's crush laws. {where}")
     h.add_argument("dir", nargs="?", metavar="DIR", help="the archive folder")
     h.add_argument("--shot", metavar="NAME", help="only this shot's runs")
     h.add_argument("--since", metavar="DATE", help="only runs from this ISO date on, e.g. "
                                                    "2026-11-01")
+    h.add_argument("--where", action="append", default=[], metavar="CELL=VALUE",
+                   help="only runs whose input cell holds VALUE (to 1e-9 of it) or lies in "
+                        "LO:HI, e.g. E40=2.703e7 or E40=2.6e7:2.8e7 (a honeycomb lot); may "
+                        "be repeated")
+    h.add_argument("-o", "--output", metavar="SHOTS.xlsx",
+                   help="also write the table across the runs, with the peak against v0")
+    h.add_argument("--force", action="store_true", help="overwrite SHOTS.xlsx if it exists")
     h.add_argument("--json", action="store_true", help="print the list as JSON")
     h.set_defaults(run=run_history)
     s = sub.add_parser("show", help="print one archived run: inputs, figures, provenance",
@@ -49,8 +59,70 @@ def _archive(given):
     return Archive(root)
 
 
-def run_history(args):
+def parse_where(text):
+    """``E40=2.703e7`` -> ("E40", 2.703e7, 2.703e7); ``E40=2.6e7:2.8e7`` -> a range."""
+    import math
 
+    from ..cells import BY_ADDRESS
+    from ..errors import OptionError
+
+    cell, _, value = str(text).partition("=")
+    cell = cell.strip().upper()
+    try:
+        lo, _, hi = value.partition(":")
+        lo, hi = float(lo), float(hi) if hi.strip() else float(lo)
+        ok = math.isfinite(lo) and math.isfinite(hi) and lo <= hi
+    except ValueError:
+        ok = False
+    if cell not in BY_ADDRESS or not ok:
+        raise OptionError(f"--where: found {text!r}, expected CELL=VALUE or CELL=LO:HI with "
+                          "a parameter cell, e.g. E40=2.703e7 or A28=200:250")
+    return cell, lo, hi
+
+
+def _matches(params, where):
+    values = {p["cell"]: p["value"] for p in params}
+    for cell, lo, hi in where:
+        v = values.get(cell)
+        if not isinstance(v, (int, float)):
+            return False
+        if lo == hi:
+            if abs(v - lo) > 1e-9 * max(abs(lo), 1e-300):
+                return False
+        elif not lo <= v <= hi:
+            return False
+    return True
+
+
+def history_rows(entries, where=()):
+    """The campaign-table row of each entry (its summary.json figures and provenance) that
+    ``where`` selects."""
+    rows = []
+    for e in entries:
+        if where and not _matches(e.load("params.json"), where):
+            continue
+        s = e.load("summary.json")
+        prov = e.load("provenance.json")
+        law = prov.get("crush_law")
+        warnings = s.get("warnings")
+        rows.append({
+            **dict(e.row), "ref": e.ref, "file": e.ref, "created": e.created, "v0": e.row["v0"],
+            "peak_kg": s.get("peak_kg"), "filtered_peak_kg": s.get("filtered_peak_kg"),
+            "time_of_peak": s.get("time_of_peak"), "pulse_duration": s.get("pulse_duration"),
+            "max_crush": s.get("max_crush"), "final_length": s.get("final_length"),
+            "warnings": [f"{w}" for w in warnings or []],
+            "warning_count": len(warnings) if warnings is not None else None,
+            "integrator": f"{prov.get('integrator')}/{prov.get('model')}",
+            "crush_law": law["name"] if isinstance(law, dict) else "not recorded"})
+    return rows
+
+
+def _cell(value, fmt, width):
+    return f"{'n/a':>{width}}" if value is None else f"{value:>{width}{fmt}}"
+
+
+def run_history(args):
+    from ..transaction import check_output
 
     if args.since:
         import datetime
@@ -62,17 +134,48 @@ def run_history(args):
 
             raise OptionError(f"--since: found {args.since!r}, expected a date such as "
                               "2026-11-01") from None
-    entries = _archive(args.dir).entries(args.shot, args.since)
-    if args.json:
-        print(json.dumps([dict(e.row, ref=e.ref) for e in entries], indent=1))
-        return 0
-    print(f"{'entry':<24} {'created':<26} {'v0 m/s':>8} {'dt s':>9} {'E40 Pa':>10} "
-          f"{'peak kG':>9}  integrator")
-    for e in entries:
-        r = e.row
-        print(f"{e.ref:<24} {e.created:<26} {r['v0']:>8.4g} {r['delta']:>9.3g} "
-              f"{r['sigmay']:>10.4g} {r['peak_kg']:>9.5f}  {r['integrator']}/{r['model']}")
-    print(f"{len(entries)} entr{'y' if len(entries) == 1 else 'ies'}")
+    where = [parse_where(w) for w in args.where]
+    if args.output:
+        check_output(args.output, args.force)  # before reading the entries
+    archive = _archive(args.dir)
+    rows = history_rows(archive.entries(args.shot, args.since), where)
+    from ..archive.laws import list_laws
+
+    laws = list_laws(archive.root)
+    if args.json:  # the index row of each entry, with its figures and its law
+        print(json.dumps(rows, indent=1))
+    else:
+        print(f"{'entry':<24} {'created (UTC)':<26} {'v0 m/s':>8} {'peak kG':>9} "
+              f"{'filt. kG':>9} {'pulse ms':>9} {'crush m':>8} {'warn':>4}  integrator, "
+              "crush law")
+        for r in rows:
+            ms = {k: None if r[k] is None else r[k] * 1e3
+                  for k in ("pulse_duration", "time_of_peak")}
+            print(f"{r['file']:<24} {r['created']:<26} {_cell(r['v0'], '.2f', 8)} "
+                  f"{_cell(r['peak_kg'], '.4f', 9)} {_cell(r['filtered_peak_kg'], '.4f', 9)} "
+                  f"{_cell(ms['pulse_duration'], '.4f', 9)} {_cell(r['max_crush'], '.4f', 8)} "
+                  f"{_cell(r['warning_count'], 'd', 4)}  {r['integrator']}, {r['crush_law']}")
+        print(f"{len(rows)} entr{'y' if len(rows) == 1 else 'ies'}"
+              + (f" of {len(archive.entries(args.shot, args.since))} (--where)" if where
+                 else ""))
+        if laws:
+            print("crush laws:")
+            for law in laws:
+                span = ("unreadable" if law["v_range"] is None else
+                        f"{law['v_range'][0]:.4g} to {law['v_range'][1]:.4g} m/s")
+                print(f"  {law['ref']:<30} {span}, fitted on {law['shots']} shot"
+                      f"{'s' * (law['shots'] != 1)}, {law['created']}")
+    if args.output:
+        from ..campaign import HISTORY_TABLE
+        from ..workbook.campaign import write_campaign
+
+        title = f"History of {display(archive.root)}: {len(rows)} runs"
+        if where:
+            title += " where " + ", ".join(w for w in args.where)
+        write_campaign(args.output, rows, title, args.force, HISTORY_TABLE,
+                       label=display(archive.root.name))
+        print(f"wrote {args.output}: one row a run, the peak against v0", file=sys.stderr
+              if args.json else sys.stdout)
     return 0
 
 

@@ -36,6 +36,12 @@ def add_parser(sub):
     add_recording_options(p, "TDMS only: the channel of every measured file (default: the "
                              "first waveform channel)")
     p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
+    p.add_argument("--archive", metavar="DIR",
+                   help="with --name: keep the fitted law in this archive's library of crush "
+                        "laws (default: $AIRGUN_XL_ARCHIVE when set), for fill --crush-law NAME")
+    p.add_argument("--name", metavar="NAME",
+                   help="the law's name in the archive, e.g. LOT-2026-07 (a honeycomb lot); "
+                        "storing it again adds its next version")
     p.set_defaults(run=run)
 
 
@@ -69,6 +75,7 @@ def run(args):
     if args.fit is not None:
         names = check_fit(names, args.objective)
     law = args.law or not names
+    root = _law_library(args, law or "scale" in names)
     first = Path(files[0][0])
     output = Path(args.output) if args.output else first.with_name(
         first.stem + ".calibrated.xlsx")
@@ -108,4 +115,43 @@ def run(args):
         return UNTRUSTED
     print("  verdict: every fitted value identified, within its bounds, and every shot's "
           "residual improved")
+    if root is not None:
+        from ..archive.laws import store_law
+        from ..transaction import display
+
+        shots_record = [{"workbook": display(w), "recording": display(m), "v0": p.v31}
+                        for (w, m), p in zip(files, cal.params, strict=True)]
+        scores = [{"rms_before": b.rms, "rms_after": a.rms, "iso_before": _plain(b.iso),
+                   "iso_after": _plain(a.iso)}
+                  for b, a in zip(cal.before, cal.after, strict=True)]
+        ref = store_law(root, args.name, cal.params[0].crush_law, shots_record, scores,
+                        [display(a) for a in args.argv])
+        print(f"  stored the law as {ref} in {display(root)} (fill --crush-law {args.name} "
+              f"--archive {display(root)})")
     return 0
+
+
+def _plain(value):
+    return value if value == value else None  # NaN (too short a pulse): null
+
+
+def _law_library(args, fits_a_law):
+    """The archive the law goes to (``--name``), checked before any run; None without it."""
+    from ..archive import Archive, archive_dir, safe_name
+
+    if args.name is None:
+        if args.archive is not None:
+            raise OptionError("--archive: found without --name, expected --name NAME for the "
+                              "law's name in the archive's library")
+        return None
+    if not fits_a_law:
+        raise OptionError("--name: found with --fit of no law, expected a law to keep (the "
+                          "default, --law, or --fit scale)")
+    if not args.name or safe_name(args.name) != args.name or args.name.lower() in (
+            "workbook", "legacy"):
+        raise OptionError(f"--name: found {args.name!r}, expected a law name of letters, "
+                          "digits, '-', '_' and '.' (such as LOT-2026-07), not workbook or "
+                          "legacy")
+    root = archive_dir(args.archive)
+    Archive(root, create=True, dry_run=True)  # a foreign folder is refused now
+    return root

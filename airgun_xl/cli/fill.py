@@ -84,6 +84,8 @@ def print_summary(output, filled):
              + (" (rigid)" if result.model == "rigid" else "")
              + f", {result.integrator} integrator"
              + ("" if result.params.crush_law.is_legacy else
+                f", the archive's crush law {result.params.crush_law.source}"
+                if result.params.crush_law.source else
                 ", the workbook's fitted crush law (Crush law sheet)")]
     if s is not None:
         filtered = ("no filtered samples" if s.filtered_peak_kg != s.filtered_peak_kg else

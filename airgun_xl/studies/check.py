@@ -93,8 +93,9 @@ def impact_speed_finding(p):
 
 
 def _law_words(p):
-    return ("the crush-factor polynomial (Eq. 8)" if p.crush_law.is_legacy else
-            "the fitted crush law (Crush law sheet)")
+    if p.crush_law.is_legacy:
+        return "the crush-factor polynomial (Eq. 8)"
+    return f"the fitted crush law ({p.crush_law.source or 'Crush law sheet'})"
 
 
 def before_run(p, integrator="legacy"):

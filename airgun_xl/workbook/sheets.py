@@ -209,7 +209,9 @@ def _summary_rows(result, summary, timings):
         ("Integrator", result.integrator, "", ""),
         ("Crush-factor law", "the macro's polynomial, Eq. (8)" if p.crush_law.is_legacy else
          f"fitted, {p.crush_law.v_range[0]:.4g} to {p.crush_law.v_range[1]:.4g} m/s",
-         "", "" if p.crush_law.is_legacy else "the Crush law sheet (airgun-xl calibrate)"),
+         "", "" if p.crush_law.is_legacy else
+         f"the archive's law {p.crush_law.source} (calibrate --archive --name)"
+         if p.crush_law.source else "the Crush law sheet (airgun-xl calibrate)"),
         ("Time step", p.delta, "step", "E2"),
         ("Critical time step", timings.get("dt_crit")
          if timings.get("dt_crit") != float("inf") else "none: implicit in the OBR chain",
