@@ -45,7 +45,7 @@ def write_campaign(path, rows, title, force=False, columns=TABLE, label=None):
             flagged = bool(row.get("warnings"))
             for col, (_, key, code) in enumerate(columns):
                 value = row.get(key)
-                if value is None:
+                if value is None or value == "":
                     continue
                 if code is None:
                     ws.write_string(r, col, str(value))
