@@ -191,15 +191,21 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
             for stale in (output.with_name(output.stem + s) for s in SIDECAR_SUFFIXES):
                 if stale != sidecar:
                     pub.remove(stale)
-        pending = None
-        if options.archive is not None:
-            progress("archiving")
-            archive = Archive(options.archive.root, create=True)  # created once the run is done
-            pending = prepare_entry(archive, options.archive, shot, workbook, filled, options,
-                                    time.perf_counter() - started)
-            pub.join(pending)
-        progress("publishing")
-        pub.commit()
+        pending, archive = None, None
+        try:
+            if options.archive is not None:
+                progress("archiving")
+                archive = Archive(options.archive.root, create=True)  # once the run is done
+                pending = prepare_entry(archive, options.archive, shot, workbook, filled,
+                                        options, time.perf_counter() - started)
+                pub.join(pending)
+            progress("publishing")
+            pub.commit()
+        except BaseException:
+            pub.abort()  # the entry's scratch first, then the archive this fill created
+            if archive is not None:
+                archive.remove_if_unused()
+            raise
     filled.entry = pending.entry if pending is not None else None
     warn(record)
     return filled

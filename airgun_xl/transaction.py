@@ -283,6 +283,13 @@ class Publication:
         """
         if not self.files:
             raise ValueError("nothing staged")
+        try:
+            self._commit()
+        except OSError as exc:  # a full disk while the journal is written (23.15): one line
+            raise OutputError(f"{display(self.files[0][1])}: cannot be published "
+                              f"({exc.strerror or exc}); nothing was changed") from None
+
+    def _commit(self):
         folder = self.files[0][1].parent
         for temp, _ in self.files:
             _fsync(temp)

@@ -342,3 +342,114 @@ def test_23_16_a_file_size_limit_is_one_line_with_no_zipfile_traceback(tmp_path,
     assert proc.returncode == 2 and len(lines) == 1, proc.stderr
     assert "cannot be written" in lines[0] and "Traceback" not in proc.stderr
     assert not out.exists()
+
+
+def _law_sheet_with(tmp_path, formula, cached):
+    """The template with a Crush law sheet holding the macro's law, its B5 (c1) the formula
+    ``formula`` with the cached value ``cached`` (written into the sheet's XML, as a
+    spreadsheet app saves it: openpyxl writes no cached values)."""
+    import re
+    import zipfile
+
+    import openpyxl
+
+    from airgun_xl.crush_law import LEGACY_COEFFICIENTS
+
+    plain = tmp_path / "plain.xlsx"
+    wb = openpyxl.load_workbook(TEMPLATE)
+    law = wb.create_sheet("Crush law")
+    law["A1"], law["B1"], law["B2"], law["B3"] = "Law", "fitted", -20.0, 250.0
+    for k, c in enumerate(LEGACY_COEFFICIENTS):
+        law.cell(4 + k, 2, c)
+    law["B5"] = formula
+    wb.save(plain)
+    shot = tmp_path / "shot.xlsx"
+    with zipfile.ZipFile(plain) as src, zipfile.ZipFile(shot, "w") as dst:
+        for item in src.infolist():
+            data = src.read(item)
+            if item.filename == f"xl/worksheets/sheet{len(wb.sheetnames)}.xml":
+                text = data.decode()
+                text, n = re.subn(r'(<c r="B5"[^>]*>)(<f>.*?</f>)(<v>.*?</v>|<v\s*/>)?',
+                                  lambda m: f"{m.group(1)}{m.group(2)}<v>{cached!r}</v>",
+                                  text)
+                assert n == 1
+                data = text.encode()
+            dst.writestr(item, data)
+    return shot
+
+
+@pytest.mark.parametrize("formula, cached, said", [
+    ("=B5", 0.008340218, "circular reference; using the cached value 0.008340218"),
+    ('=HYPERLINK("http://example.com",1)', 0.008340218, "; using the cached value"),
+    ("=100", 0.008340218, "the cached value 0.008340218 disagrees with =100 = 100.0"),
+])
+def test_23_20_the_crush_law_sheets_formulas_are_evaluated_as_the_parameter_sheets(
+        tmp_path, capsys, formula, cached, said):
+    """One cell reader for both sheets: a circular reference or a function the engine does not
+    know runs on the cached number with a warning naming 'Crush law'!B5; a formula whose
+    cached value disagrees runs on its evaluated value, with a warning (it used to run the
+    cached value silently, equal to the legacy run)."""
+    import airgun_xl
+
+    shot = _law_sheet_with(tmp_path, formula, cached)
+    loaded = airgun_xl.load(shot)
+    assert any(w.startswith("'Crush law'!B5 (crush law): ") and said in w
+               for w in loaded.warnings), loaded.warnings
+    c1 = loaded.params.crush_law.coefficients[1]
+    assert c1 == (100.0 if formula == "=100" else cached)
+    assert main(["fill", str(shot), "-o", str(tmp_path / "o.xlsx"), "--only", "summary"]) == 0
+    assert "'Crush law'!B5" in capsys.readouterr().err
+
+
+def _failing_journal(monkeypatch, error):
+    """The publication's journal write fails with ``error`` (a full disk, a signal)."""
+    import json
+    import types
+
+    import airgun_xl.transaction as transaction
+
+    def dump(obj, fh, *args, **kwargs):
+        raise error
+
+    monkeypatch.setattr(transaction, "json", types.SimpleNamespace(
+        dump=dump, dumps=json.dumps, load=json.load, loads=json.loads))
+
+
+def test_23_15_a_full_disk_while_the_journal_is_written_is_one_line(tmp_path, capsys,
+                                                                     monkeypatch):
+    """convergence -o on a full filesystem: the journal's write fails (ENOSPC); one line, exit
+    2, and neither the workbook nor the PNG nor a temp file is left."""
+    import errno
+
+    _failing_journal(monkeypatch, OSError(errno.ENOSPC, "No space left on device"))
+    out = tmp_path / "c.xlsx"
+    line = _refused(capsys, ["convergence", TEMPLATE, "--levels", "5us,2us", "-o", out],
+                    "cannot be published (No space left on device)", out)
+    assert "nothing was changed" in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("error, code", [
+    (OSError(28, "No space left on device"), 2),
+    ("interrupt", 130),
+])
+def test_23_22_a_failed_fill_leaves_no_new_archive_folder(tmp_path, capsys, monkeypatch,
+                                                          error, code):
+    """fill --archive NEW that fails at publishing (a full disk) or gets SIGINT there leaves
+    neither NEW/ (its marker and scratch folder) nor the workbook; an existing archive stays."""
+    from airgun_xl.transaction import Interrupted
+
+    _failing_journal(monkeypatch, Interrupted(2) if error == "interrupt" else error)
+    archive = tmp_path / "new_archive"
+    out = tmp_path / "o.xlsx"
+    assert main(["fill", str(TEMPLATE), "-o", str(out), "--only", "summary", "--archive",
+                 str(archive)]) == code
+    assert "Traceback" not in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+    monkeypatch.undo()
+    assert main(["fill", str(TEMPLATE), "-o", str(out), "--only", "summary", "--archive",
+                 str(archive)]) == 0
+    _failing_journal(monkeypatch, Interrupted(2))
+    assert main(["fill", str(TEMPLATE), "-o", str(tmp_path / "p.xlsx"), "--only", "summary",
+                 "--archive", str(archive)]) == 130
+    assert archive.is_dir() and len(list(archive.glob("*/v0001"))) == 1  # the archive stays

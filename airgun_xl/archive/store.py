@@ -194,6 +194,7 @@ class Archive:
 
     def __init__(self, root, create=False, dry_run=False):
         self.root = Path(root)
+        self.created_here = False  # this object made the folder (undone if nothing commits)
         shown = display(self.root)
         if dry_run and not self.root.exists():  # what create would do, without doing it
             if not self.root.parent.is_dir():
@@ -206,6 +207,7 @@ class Archive:
                                    "airgun-xl fill --archive")
             try:
                 os.mkdir(self.root)
+                self.created_here = True
             except FileExistsError:
                 pass  # another fill created it a moment ago: it is checked below as any other
             except FileNotFoundError:
@@ -234,6 +236,36 @@ class Archive:
                 pass
             except OSError as exc:
                 raise ArchiveError(f"{shown}: cannot be written ({exc.strerror})") from None
+
+    def remove_if_unused(self):
+        """Undo the creation of a new archive whose first entry was never committed (a failed
+        or interrupted fill): remove its empty index, marker and empty scratch folder, then
+        the folder, and stop at anything else in it (another writer's work). Only for a
+        folder this object created."""
+        if not self.created_here:
+            return
+        index_files = {INDEX, f"{INDEX}-wal", f"{INDEX}-shm", f"{INDEX}-journal"}
+        with contextlib.suppress(OSError, sqlite3.Error):
+            if set(os.listdir(self.root)) - {MARKER, SCRATCH} - index_files:
+                return
+            if (self.root / INDEX).exists():
+                conn = sqlite3.connect(self.root / INDEX, timeout=5, isolation_level=None)
+                try:
+                    conn.execute("BEGIN IMMEDIATE")  # no other writer is committing
+                    rows = conn.execute("SELECT COUNT(*) FROM entries").fetchone()[0]
+                    conn.execute("ROLLBACK")
+                finally:
+                    conn.close()
+                if rows:
+                    return
+            if (self.root / SCRATCH).exists():
+                os.rmdir(self.root / SCRATCH)  # fails if another writer works in it
+            for name in sorted(index_files):
+                (self.root / name).unlink(missing_ok=True)
+            if set(os.listdir(self.root)) - {MARKER}:
+                return
+            (self.root / MARKER).unlink(missing_ok=True)
+            os.rmdir(self.root)
 
     # -- the index ------------------------------------------------------------------------
     def _connect(self):

@@ -14,6 +14,7 @@ import math
 
 from ..crush_law import DEGREE, LEGACY_LAW, CrushLaw
 from ..errors import CellError
+from ..params import describe
 from .columns_sheet import ColumnsWorksheet
 from .report import one_page
 
@@ -33,7 +34,7 @@ def _where(row):
 def _number(cells, row, label):
     value = cells.get((row, 2), (None, None))[0]
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise CellError(_where(row), label, repr(value), "a finite number")
+        raise CellError(_where(row), label, describe(value), "a finite number")
     return float(value)
 
 

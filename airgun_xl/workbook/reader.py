@@ -17,6 +17,8 @@ import io
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from openpyxl.utils.cell import get_column_letter
+
 from .. import limits
 from ..cells import BY_ADDRESS, CELLS, PARAMETER_COLUMNS, TIME_HEADER, UNUSED_K1
 from ..errors import AirgunXlError, CellError, WorkbookError
@@ -24,6 +26,7 @@ from ..params import Found, ShotParams, describe
 from . import guard
 from .formula_eval import Evaluator, FormulaFailure, SheetView, shown_formula
 from .law_sheet import KEY as LAW_KEY
+from .law_sheet import SHEET_NAME as LAW_SHEET
 from .law_sheet import law_from_cells
 
 #: Columns read from a sheet other than the parameter sheet (Outputs, or one a formula names).
@@ -210,14 +213,46 @@ def _disagrees(cached, value):
     return abs(cached - value) > CACHE_RTOL * max(abs(cached), abs(value))
 
 
-def parameter_values(source):
-    """Raw values of the parameter cells, evaluating formulas; and the warnings raised.
+def cell_value(evaluator, sheet, pos, cell, where, label):
+    """One cell's raw value, its formula evaluated; and the warning it raised (or None). The
+    one reader of formula cells, for the parameter sheet and the Crush law sheet alike.
 
     A formula cell is evaluated with the ``formulas`` engine. Without a cached value the result
     is used as it is; when a cached value disagrees, a warning says so and the evaluated value
     is used (spreadsheet apps recalculate on open, so that is what the macro would read). When a
-    formula cannot be evaluated, its cached value is used with a warning. Nothing is raised
-    here: a bad value is left for :meth:`ShotParams.from_cells` to report, in cell order.
+    formula cannot be evaluated (a circular reference, a function the engine does not know such
+    as HYPERLINK), its cached number is used with a warning, and anything else is left as a
+    :class:`Found` description for the caller to refuse, naming the cell.
+
+    Parameters
+    ----------
+    cell : (object, str or None)
+        The cell's (cached value, formula).
+    where, label : str
+        How messages name the cell (``E40``, ``'Crush law'!B5``) and its label.
+    """
+    cached, formula = cell
+    if formula is None:
+        return cached, None
+    try:
+        value = evaluator.value(sheet, *pos)
+    except FormulaFailure as exc:
+        if isinstance(cached, (int, float)) and not isinstance(cached, bool):
+            return cached, f"{where} ({label}): {exc}; using the cached value {cached!r}"
+        return Found(f"the formula {shown_formula(formula)} ({exc})"), None
+    warning = None
+    if isinstance(value, float) and (cached is not None) and _disagrees(cached, value):
+        warning = (f"{where} ({label}): the cached value {describe(cached)} disagrees with "
+                   f"{shown_formula(formula)} = {value!r}; using the evaluated value")
+    if isinstance(value, float):
+        return value, warning
+    return Found(f"{describe(value)} from {shown_formula(formula)}"), warning
+
+
+def parameter_values(source):
+    """Raw values of the parameter cells, evaluating formulas (:func:`cell_value`); and the
+    warnings raised. Nothing is raised here: a bad value is left for
+    :meth:`ShotParams.from_cells` to report, in cell order.
 
     Returns
     -------
@@ -230,29 +265,27 @@ def parameter_values(source):
     raw, warnings = {}, []
     for cell in CELLS:
         pos = _address(cell)
-        cached, formula = source.block.get(pos, (None, None))
-        if formula is None:
-            raw[cell.address] = cached
-            continue
-        try:
-            value = evaluator.value(sheet, *pos)
-        except FormulaFailure as exc:
-            if isinstance(cached, (int, float)) and not isinstance(cached, bool):
-                warnings.append(f"{cell.address} ({cell.label}): {exc}; using the cached value "
-                                f"{cached!r}")
-                raw[cell.address] = cached
-            else:
-                raw[cell.address] = Found(f"the formula {shown_formula(formula)} ({exc})")
-            continue
-        if isinstance(value, float) and (cached is not None) and _disagrees(cached, value):
-            warnings.append(f"{cell.address} ({cell.label}): the cached value {describe(cached)} "
-                            f"disagrees with {shown_formula(formula)} = {value!r}; using the "
-                            "evaluated value")
-        if isinstance(value, float):
-            raw[cell.address] = value
-        else:
-            raw[cell.address] = Found(f"{describe(value)} from {shown_formula(formula)}")
+        raw[cell.address], warning = cell_value(
+            evaluator, sheet, pos, source.block.get(pos, (None, None)), cell.address,
+            cell.label)
+        if warning:
+            warnings.append(warning)
     return raw, warnings
+
+
+def law_values(source):
+    """The Crush law sheet's cells with their formulas evaluated (:func:`cell_value`, as the
+    parameter sheet's), for :func:`~airgun_xl.workbook.law_sheet.law_from_cells`; and the
+    warnings raised."""
+    evaluator = Evaluator(source.view())
+    cells, warnings = {}, []
+    for pos, cell in source.law_block.items():
+        where = f"'{LAW_SHEET}'!{get_column_letter(pos[1])}{pos[0]}"
+        value, warning = cell_value(evaluator, LAW_KEY, pos, cell, where, "crush law")
+        cells[pos] = (value, None)
+        if warning:
+            warnings.append(warning)
+    return cells, warnings
 
 
 def check_time_header(source):
@@ -283,5 +316,7 @@ def read_params(path, read_law=True):
                         "effect on the run")
     params = ShotParams.from_cells(raw)
     if source.law_block is not None and read_law:
-        params = params.replace(crush_law=law_from_cells(source.law_block))
+        cells, found = law_values(source)
+        params = params.replace(crush_law=law_from_cells(cells))
+        warnings += found
     return params, source, warnings
