@@ -13,7 +13,6 @@ import statistics
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 from bench_fill import TEMPLATE, fill_cmd, run_table, timed
 

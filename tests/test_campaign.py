@@ -149,9 +149,8 @@ def test_a_law_stored_and_run_by_name_equals_the_same_law_from_its_workbook(tmp_
     """calibrate --archive --name keeps the law; fill --crush-law NAME runs it: the same
     acceleration, bit for bit, as the calibrated workbook's Crush law sheet gives; the fill's
     archive entry records the law by name."""
-    from airgun_xl.studies.calibrate import synthetic_measurement
-
     import airgun_xl
+    from airgun_xl.studies.calibrate import synthetic_measurement
 
     p = airgun_xl.load(TEMPLATE).params
     trace = synthetic_measurement(p.replace(sigmay=p.sigmay * 1.05), seed=5)
