@@ -214,6 +214,11 @@ def calibrate_law(pairs, cfc=None, degree=DEGREE, integrator="legacy",
             xs.append(x)
             errors.append(rms_error(a))
         v, x = np.concatenate(vs), np.concatenate(xs)
+        if len(v) <= degree:  # before the range: no samples has no percentiles
+            raise OptionError(f"MEASURED: {len(v)} samples of the crush law where the run "
+                              "loads the mitigator and both pulses are above the noise, "
+                              f"expected more than the law's degree ({degree}): measured "
+                              "pulses that cover the crush of their shots")
         new = fit_law(v, x, degree, shots_range(v))
         change = law_change(new, law, np.linspace(v.min(), v.max(), 101))
         out.iterations.append(Iteration(number, change, float(np.max(errors)), len(v)))
