@@ -51,6 +51,9 @@ MAX_SHOTS = 10**7
 #: Most samples a measured recording may hold: 40 s at 50 kHz, 32 MB as two float columns.
 MAX_SAMPLES = 2_000_000
 
+#: Most octaves an SRS spans (12 natural frequencies an octave): 1 Hz to 1 GHz is 30.
+MAX_SRS_OCTAVES = 40
+
 
 # -- memory, estimated before a run -------------------------------------------------------------
 #: Environment variable that sets the memory a command may plan to use, e.g. ``2GB``; by default

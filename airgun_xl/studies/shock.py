@@ -94,8 +94,22 @@ def cfc_filter(values, dt, cfc):
 
 def default_frequencies(lo=100.0, hi=10_000.0, per_octave=12):
     """Natural frequencies [Hz] from ``lo`` to ``hi`` on a geometric grid of about
-    ``per_octave`` points a doubling."""
-    n = int(round(per_octave * math.log2(hi / lo))) + 1
+    ``per_octave`` points a doubling.
+
+    Raises
+    ------
+    OptionError
+        A span of more than :data:`airgun_xl.limits.MAX_SRS_OCTAVES` octaves (1e-308 to 1e308
+        Hz would overflow the count).
+    """
+    from .. import limits
+    from ..errors import OptionError
+
+    octaves = math.log2(hi) - math.log2(lo)  # not log2(hi / lo): that quotient overflows
+    if not octaves <= limits.MAX_SRS_OCTAVES:
+        raise OptionError(f"--from/--to: found {lo:g} and {hi:g} Hz, {octaves:,.0f} octaves "
+                          f"apart, expected at most {limits.MAX_SRS_OCTAVES} octaves")
+    n = int(round(per_octave * octaves)) + 1
     return np.geomspace(lo, hi, n)
 
 
