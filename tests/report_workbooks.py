@@ -29,7 +29,11 @@ def make_all(folder):
     requirement.write_text("frequency [Hz],srs [g]\n200,150\n1000,1500\n4000,6000\n")
     out = {name: folder / f"{name}.xlsx" for name in (
         "fill", "diff", "grid", "montecarlo", "sobol", "convergence", "srs", "design_srs",
-        "compare", "calibrate_law", "calibrate_fit")}
+        "compare", "calibrate_law", "calibrate_fit", "campaign", "history")}
+    day = folder / "day"
+    day.mkdir()
+    for name in ("shot_1", "shot_2"):
+        (day / f"{name}.xlsx").write_bytes(TEMPLATE.read_bytes())
     commands = {
         "fill": ["fill", str(shot), "-o", str(out["fill"]), "--compare-models"],
         "legacy_fill": ["fill", str(LEGACY_IN), "-o", str(folder / "legacy_fill.xlsx")],
@@ -53,6 +57,9 @@ def make_all(folder):
                           "600", "-o", str(out["calibrate_law"])],
         "calibrate_fit": ["calibrate", str(shot), str(measured), "--sign", "-1", "--fit",
                           "E40,E43", "-o", str(out["calibrate_fit"])],
+        "campaign": ["fill", str(day), "--jobs", "1", "--summary", str(out["campaign"]),
+                     "--archive", str(folder / "archive")],
+        "history": ["history", str(folder / "archive"), "-o", str(out["history"])],
     }
     codes = {name: main(argv) for name, argv in commands.items()}
     return out, codes

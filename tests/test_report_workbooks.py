@@ -58,7 +58,7 @@ def test_significant_digits():
 
 
 KINDS = ("fill", "diff", "grid", "montecarlo", "sobol", "convergence", "srs", "design_srs",
-         "compare", "calibrate_law", "calibrate_fit")
+         "compare", "calibrate_law", "calibrate_fit", "campaign", "history")
 
 
 @pytest.mark.parametrize("kind", KINDS)
