@@ -517,3 +517,15 @@ def test_23_21_calibrate_refuses_an_inverted_pulse_as_compare_measured_does(tmp_
         line = _refused(capsys, [command, TEMPLATE, rec, "-o", out], "(try --sign -1)", out)
         assert line.startswith("airgun-xl: error: --sign: the measured pulse is mostly "
                                "negative")
+
+
+def test_23_2_a_tdms_channel_past_the_sample_cap_is_one_line(tmp_path, capsys, monkeypatch):
+    """Every recording format holds at most limits.MAX_SAMPLES samples: a TDMS channel past it
+    (here the cap lowered to 500) is refused before its samples are read."""
+    from airgun_xl import limits
+
+    monkeypatch.setattr(limits, "MAX_SAMPLES", 500)
+    path = _tdms(tmp_path / "long.tdms", _pulse(600))
+    out = tmp_path / "c.xlsx"
+    _refused(capsys, ["compare-measured", TEMPLATE, path, "-o", out],
+             "holds 600 samples, expected at most 500 samples", out)

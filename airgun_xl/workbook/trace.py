@@ -334,6 +334,9 @@ def _tdms_table(path, channel):
     else:
         raise WorkbookError(f"{shown}: has no waveform channel (wf_increment), "
                             f"{EXPECTED_TDMS}")
+    if len(chosen) > limits.MAX_SAMPLES:  # before the samples are read
+        raise WorkbookError(f"{shown}: channel {chosen.name!r} holds {len(chosen):,} samples, "
+                            f"expected at most {limits.MAX_SAMPLES:,} samples")
     try:  # a string, a timestamp or a complex channel is the file's fault: one line
         raw = np.asarray(chosen[:])
         if not np.issubdtype(raw.dtype, np.number) or np.iscomplexobj(raw):
