@@ -89,3 +89,25 @@ def test_design_of_a_wedge_from_a_sheet_without_one_asks_for_a_range(tmp_path, c
     shot = _variant(tmp_path, E16=0, E6=0.002)
     assert main(["design", str(shot), "--target-peak", "8kG", "--vary", "E16"]) == 2
     assert "--range: E16 is 0 on the sheet" in capsys.readouterr().err
+
+
+def test_the_shared_run_options_have_one_help_text():
+    """Issue 24.5: --integrator, --model and --force are declared once (cli/run_options.py):
+    every subcommand that takes one has it with a help text, the same text everywhere."""
+    import argparse
+
+    from airgun_xl.cli.commands import build_parser
+
+    parser = build_parser()
+    subparsers = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    helps = {}
+    for name, sub in subparsers.choices.items():
+        for action in sub._actions:
+            for flag in ("--integrator", "--model"):
+                if flag in action.option_strings and name != "convergence":  # takes a list
+                    helps.setdefault(flag, set()).add(action.help)
+            if "--force" in action.option_strings:
+                assert action.help and action.help.startswith("overwrite "), name
+    assert {flag: len(texts) for flag, texts in helps.items()} == {"--integrator": 1,
+                                                                   "--model": 1}
+    assert None not in helps["--integrator"] | helps["--model"]

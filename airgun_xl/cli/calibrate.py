@@ -2,9 +2,9 @@
 fitted to the shots that were fired."""
 from pathlib import Path
 
-from ..choices import INTEGRATORS
 from ..errors import OptionError
 from .recording_options import add_recording_options
+from .run_options import add_force, add_integrator, add_output
 
 
 def add_parser(sub):
@@ -13,16 +13,15 @@ def add_parser(sub):
                        description="Recover the crush-factor law from one or more measured "
                                    "shots by the report's iteration (force over static crush "
                                    "force against relative velocity, refit, rerun, until the "
-                                   "law moves < 1 %%), then a least-squares finish; and/or fit "
+                                   "law moves < 1 %), then a least-squares finish; and/or fit "
                                    "E40, E43 (zeta) or the law's scale by least squares. "
                                    "Writes the first shot's workbook with the fitted values "
                                    "and a Crush law sheet that fill runs.")
     p.add_argument("pairs", nargs="+", metavar="SHOT.xlsx MEASURED.csv",
                    help="each shot's workbook followed by its measured pulse (a CSV, "
                         "trace.xlsx:Sheet1!A:B or a TDMS file)")
-    p.add_argument("-o", "--output", metavar="OUT.xlsx",
-                   help="the calibrated workbook (default: SHOT.calibrated.xlsx)")
-    p.add_argument("--force", action="store_true")
+    add_output(p, "the calibrated workbook", "SHOT.calibrated.xlsx")
+    add_force(p)
     p.add_argument("--law", action="store_true",
                    help="recover the crush-factor law (the default when --fit is not given)")
     p.add_argument("--fit", metavar="NAMES",
@@ -35,7 +34,7 @@ def add_parser(sub):
                                                           "default 6 as Eq. 8)")
     add_recording_options(p, "TDMS only: the channel of every measured file (default: the "
                              "first waveform channel)")
-    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
+    add_integrator(p)
     p.add_argument("--archive", metavar="DIR",
                    help="with --name: keep the fitted law in this archive's library of crush "
                         "laws (default: $AIRGUN_XL_ARCHIVE when set), for fill --crush-law NAME")

@@ -1,5 +1,5 @@
 """``airgun-xl check SHOT.xlsx``: can this shot's run be trusted? (No run, no output.)"""
-from ..choices import INTEGRATORS
+from .run_options import add_integrator
 
 
 def add_parser(sub):
@@ -9,7 +9,7 @@ def add_parser(sub):
                                    "row count, masses). Exit 0 when it can run, 2 when the "
                                    "time step is unstable.")
     p.add_argument("shot", metavar="SHOT.xlsx", help="workbook in the report's layout")
-    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
+    add_integrator(p)
     p.set_defaults(run=run)
 
 

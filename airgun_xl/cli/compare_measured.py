@@ -1,8 +1,8 @@
 """``airgun-xl compare-measured SHOT.xlsx MEASURED.csv``: the prediction against the test."""
 from pathlib import Path
 
-from ..choices import INTEGRATORS, MODELS
 from .recording_options import add_recording_options
+from .run_options import add_force, add_output, add_run_options
 
 
 def add_parser(sub):
@@ -18,16 +18,14 @@ def add_parser(sub):
     p.add_argument("measured", metavar="MEASURED",
                    help="the measured pulse: a CSV (time, acceleration, units in the header), "
                         "a workbook's columns (trace.xlsx:Sheet1!A:B) or a LabVIEW TDMS file")
-    p.add_argument("-o", "--output", metavar="OUT.xlsx",
-                   help="scores and traces (default: SHOT.measured.xlsx)")
-    p.add_argument("--force", action="store_true")
+    add_output(p, "scores and traces", "SHOT.measured.xlsx")
+    add_force(p)
     add_recording_options(p)
     p.add_argument("--align", default="threshold", choices=("threshold", "xcorr"),
                    help="impact instant: where the zeroed pulse first holds 5%% of its peak "
                         "(or 5 sigma of its pre-trigger noise, if more) for 0.05 ms (default),"
                         " or the cross-correlation's best lag; each checks the other")
-    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
-    p.add_argument("--model", choices=MODELS, default="4-mass")
+    add_run_options(p)
     p.set_defaults(run=run)
 
 

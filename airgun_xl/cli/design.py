@@ -3,12 +3,13 @@ import dataclasses
 import time
 from pathlib import Path
 
-from ..choices import DESIGN_VARIABLES, INTEGRATORS, MODELS
+from ..choices import DESIGN_VARIABLES
 from ..errors import OptionError
 from ..outputs import from_sheet
 from ..units import parse_duration, parse_peak
 from .cluster_options import add_cluster_options, cluster_runner
 from .fill import print_summary
+from .run_options import add_force, add_output, add_run_options
 
 
 def add_parser(sub):
@@ -37,11 +38,9 @@ def add_parser(sub):
     p.add_argument("--range", metavar="LO:HI",
                    help="search range of the (first) varied parameter, in its unit")
     p.add_argument("--filtered", action="store_true", help="match the filtered peak")
-    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
-    p.add_argument("--model", choices=MODELS, default="4-mass")
-    p.add_argument("-o", "--output", metavar="OUT.xlsx",
-                   help="designed shot, filled (default: SHOT.design.xlsx)")
-    p.add_argument("--force", action="store_true")
+    add_run_options(p)
+    add_output(p, "designed shot, filled", "SHOT.design.xlsx")
+    add_force(p)
     add_cluster_options(p)
     p.set_defaults(run=run)
 

@@ -2,6 +2,7 @@
 import json
 
 from ..errors import OptionError
+from .run_options import add_force
 
 DEFAULT_RTOL = 1e-12  # as airgun_xl.diff.DEFAULT_RTOL; the module loads only for a diff
 
@@ -11,8 +12,9 @@ def add_parser(sub):
                        description="Compare the parameter cells, then every result column of "
                                    "two filled workbooks (.xlsx, .xlsm or .xls). Exit 0 within "
                                    "tolerance, 1 when they differ, 2 for bad input.")
-    p.add_argument("legacy", metavar="LEGACY")
-    p.add_argument("new", metavar="NEW")
+    p.add_argument("legacy", metavar="LEGACY",
+                   help="the workbook the macro filled (the reference)")
+    p.add_argument("new", metavar="NEW", help="the workbook airgun-xl fill wrote")
     p.add_argument("--rtol", default=str(DEFAULT_RTOL),
                    help="relative to each column's largest magnitude (default 1e-12: Calc and "
                         "Excel keep 15 digits)")
@@ -20,7 +22,7 @@ def add_parser(sub):
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.add_argument("--report", metavar="REPORT.xlsx",
                    help="also write a workbook: error table and the worst column's curves")
-    p.add_argument("--force", action="store_true", help="overwrite REPORT.xlsx")
+    add_force(p, "REPORT.xlsx")
     p.set_defaults(run=run)
 
 

@@ -2,9 +2,10 @@
 from pathlib import Path
 
 from ..archive import ENV, archive_dir
-from ..choices import HOSTS, INTEGRATORS, MODELS, SIDECAR_MODES, UNLOADINGS
+from ..choices import HOSTS, SIDECAR_MODES, UNLOADINGS
 from ..outputs import GROUPS
 from ..transaction import display
+from .run_options import add_force, add_integrator, add_model
 
 
 def add_parser(sub):
@@ -19,7 +20,7 @@ def add_parser(sub):
                         "shots), fill a campaign")
     p.add_argument("-o", "--output", metavar="OUT.xlsx",
                    help="output workbook (default: SHOT.out.xlsx beside SHOT; one shot only)")
-    p.add_argument("--force", action="store_true", help="overwrite OUT.xlsx if it exists")
+    add_force(p)
     p.add_argument("--jobs", metavar="N",
                    help="worker processes for a campaign (default: the cores this process "
                         "may use)")
@@ -38,14 +39,11 @@ def add_parser(sub):
     p.add_argument("--sidecar", choices=SIDECAR_MODES,
                    help="full time history beside the output: auto (when rows are left out), "
                         "always or never")
-    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy",
-                   help="legacy: ArtSim's scheme (the default); newmark: average-acceleration "
-                        "Newmark, unconditionally stable for the OBR chain")
+    add_integrator(p)
     p.add_argument("--allow-unstable", action="store_true",
                    help="run even when the time step is above the critical step (a diverging "
                         "run still stops)")
-    p.add_argument("--model", choices=MODELS, default="4-mass",
-                   help="4-mass: ArtSim (default); rigid: the previous rigid-body model")
+    add_model(p)
     p.add_argument("--crush-law", metavar="LAW", default="workbook",
                    help="workbook: the law the workbook's Crush law sheet names (a calibrated "
                         "workbook's fitted law), else the macro's (default); legacy: the "

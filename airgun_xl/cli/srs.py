@@ -1,8 +1,8 @@
 """``airgun-xl srs SHOT.xlsx``: the shock response spectrum of the predicted pulse."""
 from pathlib import Path
 
-from ..choices import INTEGRATORS, MODELS
 from ..errors import OptionError
+from .run_options import add_force, add_output, add_run_options
 
 
 def add_parser(sub):
@@ -11,9 +11,8 @@ def add_parser(sub):
                                    "spectrum of the test item's acceleration (Smallwood's "
                                    "ramp-invariant filter), as a table and a log-log chart.")
     p.add_argument("shot", metavar="SHOT.xlsx")
-    p.add_argument("-o", "--output", metavar="OUT.xlsx",
-                   help="the SRS workbook (default: SHOT.srs.xlsx)")
-    p.add_argument("--force", action="store_true")
+    add_output(p, "the SRS workbook", "SHOT.srs.xlsx")
+    add_force(p)
     p.add_argument("--q", type=float, default=10.0, help="quality factor (default 10: 5 %% "
                                                          "damping)")
     p.add_argument("--cfc", type=int, help="filter the pulse first: SAE J211 class 60, 180, "
@@ -22,8 +21,7 @@ def add_parser(sub):
                    help="lowest natural frequency (default 100)")
     p.add_argument("--to", dest="hi", type=float, default=10_000.0, metavar="HZ",
                    help="highest natural frequency (default 10000)")
-    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
-    p.add_argument("--model", choices=MODELS, default="4-mass")
+    add_run_options(p)
     p.set_defaults(run=run)
 
 

@@ -4,10 +4,10 @@ import time
 from pathlib import Path
 
 from .. import limits
-from ..choices import INTEGRATORS, MODELS
 from ..errors import OptionError
 from ..transaction import check_output
 from .cluster_options import add_cluster_options, cluster_runner
+from .run_options import add_force, add_output, add_run_options
 
 
 def add_parser(sub):
@@ -26,11 +26,9 @@ def add_parser(sub):
                    help="Sobol indices of the peak, pulse and crush to the --sd inputs "
                         "(SALib): N (a power of 2) x (inputs + 2) shots")
     p.add_argument("--seed", type=int, default=None, help="random seed (Monte Carlo, Sobol)")
-    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy")
-    p.add_argument("--model", choices=MODELS, default="4-mass")
-    p.add_argument("-o", "--output", metavar="OUT.xlsx",
-                   help="table and charts (default: SHOT.sweep.xlsx)")
-    p.add_argument("--force", action="store_true")
+    add_run_options(p)
+    add_output(p, "table and charts", "SHOT.sweep.xlsx")
+    add_force(p)
     add_cluster_options(p)
     p.set_defaults(run=run)
 
