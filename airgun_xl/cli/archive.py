@@ -22,7 +22,7 @@ def add_parser(sub):
                         "be repeated")
     h.add_argument("-o", "--output", metavar="SHOTS.xlsx",
                    help="also write the table across the runs, with the peak against v0")
-    h.add_argument("--force", action="store_true", help="overwrite SHOTS.xlsx if it exists")
+    add_force(h, "SHOTS.xlsx")
     h.add_argument("--json", action="store_true", help="print the list as JSON")
     h.set_defaults(run=run_history)
     s = sub.add_parser("show", help="print one archived run: inputs, figures, provenance",

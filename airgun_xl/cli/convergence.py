@@ -5,6 +5,7 @@ from pathlib import Path
 from ..choices import INTEGRATORS
 from ..errors import OptionError
 from ..transaction import check_output
+from .run_options import add_force, add_output
 
 
 def add_parser(sub):
@@ -20,9 +21,8 @@ def add_parser(sub):
     p.add_argument("--integrator", default="legacy",
                    help=f"one or more of {', '.join(sorted(INTEGRATORS))}, comma-separated")
     p.add_argument("--rtol", default="1e-3", help="tolerance on the peak (default 0.1%%)")
-    p.add_argument("-o", "--output", metavar="OUT.xlsx",
-                   help="workbook (default: SHOT.convergence.xlsx); the PNG goes beside it")
-    p.add_argument("--force", action="store_true")
+    add_output(p, "workbook; the PNG goes beside it", "SHOT.convergence.xlsx")
+    add_force(p)
     p.set_defaults(run=run)
 
 

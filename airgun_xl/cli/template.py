@@ -6,7 +6,7 @@ def add_parser(sub):
                        description="Write the report's parameter sheet, filled with shot A as "
                                    "the report's appendix ran it, with live formulas.")
     p.add_argument("output", metavar="OUT.xlsx", help="where to write the template")
-    p.add_argument("--force", action="store_true", help="overwrite OUT.xlsx if it exists")
+    add_force(p)
     p.set_defaults(run=run)
 
 
