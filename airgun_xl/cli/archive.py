@@ -4,6 +4,7 @@ import sys
 
 from ..archive import ENV, Archive, archive_dir
 from ..transaction import display
+from .run_options import add_force
 
 
 def add_parser(sub):

@@ -1,4 +1,5 @@
 """``airgun-xl template OUT.xlsx [--force]``: write a fresh shot A template."""
+from .run_options import add_force
 
 
 def add_parser(sub):
