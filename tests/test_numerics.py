@@ -221,7 +221,7 @@ def test_convergence_ladder_on_a_short_shot():
     assert all(a > b for a, b in zip(crush, crush[1:]))
     orders = [lv.order["max_crush"] for lv in lad.levels if "max_crush" in lv.order]
     assert 0.7 < np.median(orders) < 1.5
-    assert lad.recommended == lad.recommended  # some level meets 0.1 %
+    assert not math.isnan(lad.recommended)  # some level meets 0.1 %
 
 
 def test_convergence_command(tmp_path, capsys):

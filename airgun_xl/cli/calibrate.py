@@ -1,5 +1,6 @@
 """``airgun-xl calibrate SHOT.xlsx MEASURED.csv [SHOT2.xlsx MEASURED2.csv ...]``: the model
 fitted to the shots that were fired."""
+import math
 from pathlib import Path
 
 from ..errors import OptionError
@@ -131,7 +132,7 @@ def run(args):
 
 
 def _plain(value):
-    return value if value == value else None  # NaN (too short a pulse): null
+    return None if math.isnan(value) else value  # NaN (too short a pulse): null
 
 
 def _law_library(args, fits_a_law):

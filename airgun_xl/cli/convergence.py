@@ -88,5 +88,5 @@ def print_table(ladders):
               f"{abs(finest - extrapolated) / abs(extrapolated):.1e})")
         rec = lad.recommended
         print(f"  coarsest dt with peak within {lad.rtol:.1%} of the finest: "
-              + (f"{rec:.3g} s" if rec == rec else "none of the coarser levels"))
+              + (f"{rec:.3g} s" if not math.isnan(rec) else "none of the coarser levels"))
 

@@ -1,4 +1,5 @@
 """``airgun-xl fill SHOT.xlsx [-o OUT.xlsx] [--force] [...]``: run a shot into a new workbook."""
+import math
 from pathlib import Path
 
 from ..archive import ENV, archive_dir
@@ -86,7 +87,7 @@ def print_summary(output, filled):
                 if result.params.crush_law.source else
                 ", the workbook's fitted crush law (Crush law sheet)")]
     if s is not None:
-        filtered = ("no filtered samples" if s.filtered_peak_kg != s.filtered_peak_kg else
+        filtered = ("no filtered samples" if math.isnan(s.filtered_peak_kg) else
                     f"filtered {s.filtered_peak_kg:.5f} kG at "
                     f"{_ms(s.time_of_filtered_peak)}")
         lines.append(f"  peak {s.peak_kg:.5f} kG at {_ms(s.time_of_peak)}; {filtered}")

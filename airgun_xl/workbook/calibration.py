@@ -7,6 +7,8 @@ fitted). ``Calibration`` reports the iterations, the fitted values, each shot's 
 and after, the law against the macro's (the report's Figs. 7-8) and the first shot's pulses;
 ``Law`` and ``Pulses`` hold the charts' data.
 """
+import math
+
 import numpy as np
 
 from ..crush_law import LEGACY_LAW
@@ -130,7 +132,7 @@ def write_calibration(path, shot, cal, files, options, force=False):
         for i, rec in enumerate(cal.recordings, start=1):
             ws.write_string(row, 0, f"Shot {i}: baseline removed, pre-trigger noise")
             ws.write_number(row, 1, rec.base.offset, num)
-            if rec.base.noise == rec.base.noise:
+            if not math.isnan(rec.base.noise):
                 ws.write_number(row, 2, rec.base.noise, num)
             ws.write_string(row, 3, "kG")
             row += 1
@@ -171,7 +173,7 @@ def write_calibration(path, shot, cal, files, options, force=False):
                 ws.write_number(row, 3, value / cal.start[name] - 1 if cal.start[name]
                                 else 0.0, pct)
                 error = cal.errors.get(name, float("inf"))
-                if error == error and error != float("inf"):
+                if math.isfinite(error):
                     ws.write_number(row, 4, shown(error, code), style.fmt("0.00E+00"))
                 else:
                     ws.write_string(row, 4, "not identified")
@@ -187,7 +189,7 @@ def write_calibration(path, shot, cal, files, options, force=False):
             ws.write_number(row, 1, b.rms, pct)
             ws.write_number(row, 2, a.rms, pct)
             for col, iso in ((3, b.iso), (4, a.iso)):
-                if iso == iso:
+                if not math.isnan(iso):
                     ws.write_number(row, col, iso, num)
                 else:
                     ws.write_string(row, col, "n/a (too short a pulse)")

@@ -78,7 +78,7 @@ def _render(ladders, tmp, path, shot):
         row += 1
         ws.write_string(row, 0, f"{lad.integrator}: coarsest time step with the raw peak "
                                 f"within {lad.rtol:.2%} of the finest level", style.bold)
-        if lad.recommended == lad.recommended:
+        if not math.isnan(lad.recommended):
             style.number(ws, row, 7, lad.recommended, "step")
             ws.write_string(row, 8, "µs")
         else:

@@ -1,5 +1,7 @@
 """The ``compare-measured`` workbook: the scores (headline figures, ISO/TS 18571 rating,
 spectra and SRS), the aligned traces, and the report's Figs. 13-15 as native charts."""
+import math
+
 import numpy as np
 
 from ..transaction import atomic_path, check_output
@@ -109,7 +111,7 @@ def _write_scores(wb, ws, c, head, bold, models):
                  "Hz (0: none)", wb.add_format({"num_format": "#,##0"})))
     for label, value, unit, form in rows:
         ws.write_string(row, 0, label)
-        if value == value:  # NaN (no pre-trigger) stays an empty cell
+        if not math.isnan(value):  # NaN (no pre-trigger) stays an empty cell
             ws.write_number(row, 1, value, form)
         ws.write_string(row, 3, unit)
         row += 1
