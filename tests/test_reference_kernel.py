@@ -16,6 +16,7 @@ from airgun_xl.engine.integrators import displacement_bound, kernel_params
 
 compiled = pytest.importorskip("airgun_xl.engine._artsim")
 
+SHOT_A = airgun_xl.load(REFERENCE / CASES["shot_a_appendix_5us"]["input"]).params
 UNSTABLE = json.loads((REFERENCE / "unstable_cases.json").read_text())
 INPUTS = sorted({c["input"] for c in CASES.values()} | {c["input"] for c in UNSTABLE.values()})
 
@@ -80,3 +81,53 @@ def test_sheet_xml_python_twin_writes_the_same_text():
         "AB", 7, values)
     with pytest.raises(ValueError):
         sheet_xml.render_cells_python("A", 1, np.array([1.0, np.nan]))
+
+
+def _refusal(call):
+    try:
+        call()
+    except (ValueError, TypeError, BufferError) as exc:
+        return type(exc).__name__ if not isinstance(exc, ValueError) else str(exc)
+    return None
+
+
+@pytest.mark.parametrize("case", ["rows past the address space", "int64 columns",
+                                  "short columns", "batch rows past the address space",
+                                  "batch short finals", "batch int64 params"])
+def test_the_twins_refuse_the_same_inputs_and_never_write_out_of_bounds(case):
+    """Issue 24.3: lengths are compared by division, so 2**61 rows over 10-element buffers (a
+    product that overflowed) is refused by the C kernel and by its Python twin alike, with the
+    same message, before anything is written."""
+    params = [0.0] * (len(kernel_params(SHOT_A)) + 1)
+    columns = {"rows past the address space": (2**61, [np.zeros(10)] * 13),
+               "int64 columns": (5, [np.zeros(10, dtype=np.int64)] * 13),
+               "short columns": (11, [np.zeros(10)] * 13)}
+    if case in columns:
+        rows, arrays = columns[case]
+        said = [_refusal(lambda m=m: m.legacy_kernel(params, rows, *arrays))
+                for m in (compiled, ref)]
+    else:
+        n = len(params)
+        batch = {"batch rows past the address space": (np.zeros(n), 2**60, np.zeros(10),
+                                                        np.zeros(10), np.zeros(N_FINALS)),
+                 "batch short finals": (np.zeros(n), 5, np.zeros(5), np.zeros(5),
+                                        np.zeros(N_FINALS - 1)),
+                 "batch int64 params": (np.zeros(n, dtype=np.int64), 5, np.zeros(5),
+                                        np.zeros(5), np.zeros(N_FINALS))}[case]
+        p, rows, t, y, finals = batch
+        said = [_refusal(lambda m=m: m.batch_kernel(p, rows, 0, 3, t, y, finals))
+                for m in (compiled, ref)]
+    assert said[0] is not None and said[0] == said[1], said
+
+
+def test_the_sheet_xml_twins_refuse_the_same_inputs():
+    """The Python render_cells took int64 arrays and long column names, which the C one
+    refuses: now both refuse them, with the same message."""
+    from airgun_xl.workbook import sheet_xml
+
+    compiled_xml = pytest.importorskip("airgun_xl.workbook._sheet_xml")
+    for column, values in (("A" * 9, np.zeros(3)), ("A", np.zeros(3, dtype=np.int64)),
+                           ("A", np.zeros((3, 2))[:, 0])):
+        said = [_refusal(lambda f=f: f(column, 1, values))
+                for f in (compiled_xml.render_cells, sheet_xml.render_cells_python)]
+        assert said[0] is not None and said[0] == said[1], said

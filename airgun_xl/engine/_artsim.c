@@ -348,8 +348,9 @@ static PyObject *run_kernel(PyObject *args, Stepper steps)
         if (p[i] == -1.0 && PyErr_Occurred())
             return NULL;
     }
-    if (rows < 0)
-        return PyErr_Format(PyExc_ValueError, "rows must be >= 0");
+    /* rows x 8 bytes must not overflow: compare lengths by division, never by a product */
+    if (rows < 0 || rows > PY_SSIZE_T_MAX / (Py_ssize_t)sizeof(double))
+        return PyErr_Format(PyExc_ValueError, "rows must be >= 0 and fit the address space");
     for (got = 0; got < N_COLUMNS; got++) {
         if (got >= N_REQUIRED && objs[got] == Py_None) {
             views[got].obj = NULL;
@@ -360,7 +361,8 @@ static PyObject *run_kernel(PyObject *args, Stepper steps)
                                | PyBUF_FORMAT) < 0)
             goto fail;
         if (views[got].itemsize != sizeof(double) || views[got].format == NULL
-            || strcmp(views[got].format, "d") != 0 || views[got].len < rows * (Py_ssize_t)sizeof(double)) {
+            || strcmp(views[got].format, "d") != 0
+            || views[got].len / (Py_ssize_t)sizeof(double) < rows) {
             PyBuffer_Release(&views[got]);
             PyErr_SetString(PyExc_ValueError, "columns must be float64 buffers of length >= rows");
             goto fail;
@@ -607,19 +609,22 @@ static PyObject *py_batch_kernel(PyObject *self, PyObject *args)
         int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (got ? PyBUF_WRITABLE : 0);
         if (PyObject_GetBuffer(objs[got], &views[got], flags) < 0)
             goto fail;
-        if (views[got].itemsize != sizeof(double) || strcmp(views[got].format, "d")) {
+        if (views[got].itemsize != sizeof(double) || views[got].format == NULL
+            || strcmp(views[got].format, "d")) {
             PyErr_SetString(PyExc_ValueError, "buffers must be float64");
             got++;
             goto fail;
         }
     }
     n = views[0].len / (Py_ssize_t)(P_COUNT * sizeof(double));
-    if (rows < 0 || views[0].len != n * P_COUNT * (Py_ssize_t)sizeof(double)
-        || views[1].len < rows * (Py_ssize_t)sizeof(double)
-        || views[2].len < n * rows * (Py_ssize_t)sizeof(double)
-        || views[3].len < n * N_FINALS * (Py_ssize_t)sizeof(double)) {
-        PyErr_SetString(PyExc_ValueError, "buffer sizes do not match (n x 29, rows, n x rows, "
-                                          "n x 8)");
+    /* every size by division, so that no product overflows; the scratch is rows x 4 doubles */
+    if (rows < 0 || rows > PY_SSIZE_T_MAX / (Py_ssize_t)(4 * sizeof(double))
+        || views[0].len != n * P_COUNT * (Py_ssize_t)sizeof(double)
+        || views[1].len / (Py_ssize_t)sizeof(double) < rows
+        || (rows > 0 && views[2].len / (Py_ssize_t)sizeof(double) / rows < n)
+        || views[3].len / (Py_ssize_t)(N_FINALS * sizeof(double)) < n) {
+        PyErr_Format(PyExc_ValueError, "buffer sizes do not match (n x %d, rows, n x rows, "
+                                       "n x %d)", P_COUNT, N_FINALS);
         goto fail;
     }
     scratch = malloc((size_t)(rows > 0 ? rows : 1) * 4 * sizeof(double));

@@ -277,8 +277,42 @@ def _check(params, rows):
     return p
 
 
+#: Largest byte count a buffer may have (Py_ssize_t), as the C kernel bounds ``rows`` by it.
+_SSIZE_MAX = 2**63 - 1
+
+
+def _float64(buffer, writable=True):
+    """The buffer's element count, refused as the C kernel refuses it: not a C-contiguous
+    float64 buffer (writable for the outputs)."""
+    try:
+        view = memoryview(buffer)
+    except TypeError:
+        raise TypeError(f"a bytes-like object is required, not '{type(buffer).__name__}'") \
+            from None
+    if not view.c_contiguous:  # as numpy refuses PyBUF_C_CONTIGUOUS
+        raise ValueError("ndarray is not C-contiguous")
+    if view.format != "d" or view.itemsize != 8 or (writable and view.readonly):
+        raise ValueError("buffers must be float64")
+    return view.nbytes // 8
+
+
+def _check_columns(arrays, rows):
+    if rows > _SSIZE_MAX // 8:
+        raise ValueError("rows must be >= 0 and fit the address space")
+    for k, out in enumerate(arrays):
+        if out is None and k >= 5:
+            continue
+        try:
+            n = _float64(out)
+        except ValueError:
+            n = -1
+        if n < rows:
+            raise ValueError("columns must be float64 buffers of length >= rows")
+
+
 def _run(steps, params, rows, arrays):
     p = _check(params, rows)
+    _check_columns(arrays, rows)
     tracked = [name for name, out in zip(TRACKED_NAMES, arrays[5:]) if out is not None]
     cols = _Rows(p, rows, tracked)
     finals = steps(p, rows, cols)
@@ -303,6 +337,12 @@ def batch_kernel(params, rows, integrator, last, t, y, finals, lanes=True):
 
     if last not in (1, 2, 3):
         raise ValueError("last must be 1 (Y31), 2 (Y32) or 3 (Y33)")
+    sizes = [_float64(params, writable=False)] + [_float64(b) for b in (t, y, finals)]
+    n = sizes[0] // P_COUNT
+    if (rows < 0 or rows > _SSIZE_MAX // 32 or sizes[0] != n * P_COUNT or sizes[1] < rows
+            or (rows > 0 and sizes[2] // rows < n) or sizes[3] // N_FINALS < n):
+        raise ValueError(f"buffer sizes do not match (n x {P_COUNT}, rows, n x rows, "
+                         f"n x {N_FINALS})")
     steps = _newmark_steps if integrator else _legacy_steps
     for i, shot in enumerate(np.asarray(params).reshape(-1, P_COUNT)):
         p = _check(shot, rows)

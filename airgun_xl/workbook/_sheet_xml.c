@@ -43,6 +43,10 @@ static PyObject *py_render_cells(PyObject *self, PyObject *args)
         return NULL;
     }
     n = view.len / (Py_ssize_t)sizeof(double);
+    if (n > PY_SSIZE_T_MAX / CELL_MAX) {
+        PyBuffer_Release(&view);
+        return PyErr_NoMemory();
+    }
     text = malloc((size_t)(n > 0 ? n : 1) * CELL_MAX);
     lengths = malloc((size_t)(n > 0 ? n : 1) * sizeof(int));
     if (text == NULL || lengths == NULL) {

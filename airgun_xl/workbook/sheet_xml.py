@@ -8,9 +8,21 @@ from ..engine.kernel import PURE
 
 def render_cells_python(column, first_row, values):
     """'<c r="I5"><v>...</v></c>' per value (finite), rows from ``first_row`` (1-based),
-    numbers with 17 significant digits, as the C extension writes them."""
+    numbers with 17 significant digits, as the C extension writes them; refusing what it
+    refuses (a column name past 8 characters, a buffer that is not float64)."""
+    if len(column) > 8:
+        raise ValueError("column name too long")
+    try:
+        view = memoryview(values)
+    except TypeError:
+        raise TypeError(f"a bytes-like object is required, not '{type(values).__name__}'") \
+            from None
+    if not view.c_contiguous:  # as numpy refuses PyBUF_C_CONTIGUOUS
+        raise ValueError("ndarray is not C-contiguous")
+    if view.format != "d" or view.itemsize != 8:
+        raise ValueError("values must be a float64 buffer")
     out = []
-    for i, x in enumerate(values.tolist() if hasattr(values, "tolist") else values):
+    for i, x in enumerate(view.tolist()):
         if not math.isfinite(x):
             raise ValueError(f"values must be finite (index {i})")
         out.append(f'<c r="{column}{first_row + i}"><v>{x:.17g}</v></c>')
