@@ -128,7 +128,9 @@ def test_a_failing_participant_rolls_the_files_back(tmp_path):
         def release(self):
             Failing.released = True
 
-    with pytest.raises(OSError), Publication(force=True) as pub:
+    # the participant's OSError is the command's one-line OutputError (23.15)
+    with pytest.raises(OutputError, match="cannot be published"), \
+            Publication(force=True) as pub:
         pub.stage(tmp_path / "o.xlsx").write_text("new")
         pub.join(Failing())
         pub.commit()
@@ -180,3 +182,38 @@ def test_parse_bytes_and_the_budget(monkeypatch):
     limits.check_memory(2**30, "a run", "less")  # exactly the budget: allowed
     with pytest.raises(ResourceError, match="needs about 1.00 GB, more than the 1.00 GB"):
         limits.check_memory(2**30 + 1, "a run", "less")
+
+
+def test_owner_liveness_asks_psutil_not_os_kill(monkeypatch):
+    """Issue 24.4: liveness is psutil's (pid_exists and the start time) on every platform; it
+    never calls os.kill, which on Windows sends CTRL_C_EVENT instead of testing for the pid.
+    The logic, with the platform's answers mocked: a gone pid, a reused pid (another start
+    time) and the owner itself."""
+    import os as os_module
+
+    import psutil
+
+    from airgun_xl.transaction import owners
+
+    def no_kill(*args):
+        raise AssertionError("os.kill called")
+
+    monkeypatch.setattr(os_module, "kill", no_kill)
+
+    class FakeProcess:
+        def __init__(self, pid):
+            if pid not in started:
+                raise psutil.NoSuchProcess(pid)
+            self.pid = pid
+
+        def create_time(self):
+            return started[self.pid]
+
+    started = {4242: 1700000000.25}
+    monkeypatch.setattr(owners.psutil, "Process", FakeProcess)
+    monkeypatch.setattr(owners.psutil, "pid_exists", lambda pid: pid in started)
+    assert owners.owner_alive("4242.170000000025")  # the owner, same start time
+    assert not owners.owner_alive("4242.170000000024")  # pid reused by a later process
+    assert not owners.owner_alive("4343.170000000025")  # gone
+    assert not owners.owner_alive("not-a-pid.1") and not owners.owner_alive("0.1")
+    assert owners.owner_alive("4242.0")  # no start time known: the pid's existence decides

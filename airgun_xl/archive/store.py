@@ -37,7 +37,7 @@ from pathlib import Path
 
 from ..choices import ARCHIVE_ENV
 from ..errors import ArchiveError, OptionError
-from ..transaction import display, owner_alive, owner_token
+from ..transaction import display, fsync, owner_alive, owner_token
 
 ENV = ARCHIVE_ENV
 INDEX = "index.sqlite"
@@ -87,19 +87,6 @@ def sha256(path):
         for block in iter(lambda: fh.read(1 << 20), b""):
             digest.update(block)
     return digest.hexdigest()
-
-
-def _fsync_dir(path):
-    try:
-        fd = os.open(path, os.O_RDONLY)
-    except OSError:
-        return
-    try:
-        os.fsync(fd)
-    except OSError:
-        pass
-    finally:
-        os.close(fd)
 
 
 @dataclass
@@ -530,7 +517,7 @@ class PendingEntry:
             json.dump(self.manifest, fh, indent=1, default=str)
             fh.flush()
             os.fsync(fh.fileno())
-        _fsync_dir(self.work)
+        fsync(self.work, directory=True)
         self.final = self.archive.root / self.shot / f"v{version:04d}"
         return (self.final / MANIFEST).resolve()
 
@@ -543,7 +530,7 @@ class PendingEntry:
             raise ArchiveError(f"{display(self.final)}: cannot be written "
                                f"({exc.strerror})") from None
         try:
-            _fsync_dir(self.final.parent)
+            fsync(self.final.parent, directory=True)
             self.archive._insert(self.conn, self.manifest, self.final)
             self.conn.execute("COMMIT")
         except BaseException:

@@ -29,183 +29,19 @@ import json
 import os
 import re
 import secrets
-import stat
 from pathlib import Path
 
-from .errors import OutputError
+from ..errors import OutputError
+from .checks import display
+from .locks import folder_lock, fsync
+from .owners import owner_alive, owner_token
+from .signals import SIGNALS, Interrupted, signals_held
 
 SUFFIX = "airgun-xl"
 _OWNED = re.compile(r"^\.(?P<name>.+)\.(?P<owner>\d+\.\d+)-(?P<hex>[0-9a-f]{16})"
                     r"\.airgun-xl-(?P<kind>tmp|bak|journal)$")
 
 
-def display(path):
-    """A path as printable text (undecodable bytes of a name become \\x escapes)."""
-    return os.fsdecode(path).encode("utf-8", "backslashreplace").decode("utf-8")
-
-
-# -- who owns a temp file ---------------------------------------------------------------------
-def _start_time(pid):
-    """A process's start time in clock ticks since boot (Linux), 0 when unknown."""
-    try:
-        with open(f"/proc/{pid}/stat", "rb") as fh:
-            return int(fh.read().rsplit(b")", 1)[1].split()[19])
-    except (OSError, ValueError, IndexError):
-        return 0
-
-
-def owner_token():
-    """This process as ``<pid>.<start time>``: a reused pid does not look like its owner."""
-    pid = os.getpid()
-    return f"{pid}.{_start_time(pid)}"
-
-
-def owner_alive(token):
-    """Whether the process an :func:`owner_token` names is still running."""
-    pid_text, _, started = token.partition(".")
-    try:
-        pid = int(pid_text)
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        pass
-    except (ValueError, OverflowError):
-        return False
-    now = _start_time(pid)
-    return not (now and started.isdigit() and int(started) and now != int(started))
-
-
-# -- output names -----------------------------------------------------------------------------
-_KINDS = ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
-          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
-
-
-def special_kind(mode):
-    """``"a FIFO"``, ``"a character device"``... for a file that is neither a regular file,
-    a folder nor a symlink; None otherwise."""
-    return next((kind for test, kind in _KINDS if test(mode)), None)
-
-
-def check_output(path, force=False, inputs=(), suffixes=(".xlsx",), force_word="--force"):
-    """Refuse an output that cannot be written as a new regular file.
-
-    Refused: a name without one of ``suffixes``; a folder, FIFO, device or socket; an
-    existing file or symlink without ``force`` (with it, a symlink itself is replaced, never
-    its target); one of ``inputs``; a missing or read-only folder.
-
-    Raises
-    ------
-    OutputError
-    """
-    path = Path(path)
-    shown = display(path)
-    try:
-        st = os.lstat(path)
-    except FileNotFoundError:
-        st = None
-    except OSError as exc:
-        raise OutputError(f"{shown}: cannot be checked ({exc.strerror})") from None
-    if st is not None:
-        if stat.S_ISDIR(st.st_mode):
-            raise OutputError(f"{shown}: is a folder, expected an output file name")
-        kind = special_kind(st.st_mode)
-        if kind is not None:
-            raise OutputError(f"{shown}: is {kind}, expected a regular file name")
-        if not force:
-            link = " (a symbolic link)" if stat.S_ISLNK(st.st_mode) else ""
-            raise OutputError(f"{shown}: already exists{link}, expected a new file name or "
-                              f"{force_word}")
-    if suffixes and path.suffix.lower() not in suffixes:
-        raise OutputError(f"{shown}: has the extension {path.suffix or '(none)'!s}, expected "
-                          f"{' or '.join(suffixes)}")
-    for given in inputs:
-        with contextlib.suppress(OSError):
-            if os.path.exists(path) and os.path.samefile(path, given):
-                raise OutputError(f"{shown}: is the input workbook, expected a different "
-                                  "output file (the input is never modified)")
-    folder = path.parent
-    if not folder.is_dir():
-        raise OutputError(f"{shown}: its folder {display(folder)} does not exist, expected an "
-                          "existing folder")
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise OutputError(f"{shown}: its folder {display(folder)} is not writable, expected a "
-                          "writable folder")
-
-
-# -- locks and signals ------------------------------------------------------------------------
-@contextlib.contextmanager
-def folder_lock(folder):
-    """An exclusive ``flock`` on a folder (no lock file is created); a no-op off POSIX."""
-    try:
-        import fcntl
-    except ImportError:  # Windows: publication is still atomic per file
-        yield
-        return
-    fd = os.open(folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX)
-        yield
-    finally:
-        os.close(fd)  # releases the lock
-
-
-class Interrupted(KeyboardInterrupt):
-    """SIGINT, SIGTERM or SIGHUP, raised where the program is, so that cleanup runs."""
-
-    def __init__(self, signum):
-        super().__init__(signum)
-        self.signum = signum
-
-
-#: The signal state of this command: sections holding signals back, a signal that arrived
-#: while held (or was swallowed by a finalizer), and whether a publication has committed.
-SIGNALS = {"held": 0, "pending": None, "committed": False}
-
-
-def reset_signals():
-    SIGNALS.update(held=0, pending=None, committed=False)
-
-
-def on_signal(signum, frame=None):
-    """The handler the CLI installs for SIGINT, SIGTERM and SIGHUP: raise :class:`Interrupted`,
-    or, inside :func:`signals_held`, note the signal for the end of the section. Python runs
-    it in the main thread, whichever thread the signal reached."""
-    if SIGNALS["held"]:
-        SIGNALS["pending"] = signum
-        return
-    raise Interrupted(signum)
-
-
-def note_signal(signum):
-    """A signal whose :class:`Interrupted` was swallowed (raised inside a finalizer)."""
-    SIGNALS["pending"] = signum
-
-
-@contextlib.contextmanager
-def signals_held():
-    """Hold SIGINT, SIGTERM and SIGHUP back (see :func:`on_signal`); one that arrived is
-    raised when the section ends normally."""
-    SIGNALS["held"] += 1
-    try:
-        yield
-    finally:
-        SIGNALS["held"] -= 1
-    if not SIGNALS["held"] and SIGNALS["pending"] is not None:
-        signum, SIGNALS["pending"] = SIGNALS["pending"], None
-        raise Interrupted(signum)
-
-
-def _fsync(path, directory=False):
-    with contextlib.suppress(OSError):
-        fd = os.open(path, os.O_RDONLY | (getattr(os, "O_DIRECTORY", 0) if directory else 0))
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
-
-
-# -- the publication --------------------------------------------------------------------------
 class Publication:
     """Files staged and published together; see the module docstring.
 
@@ -292,7 +128,7 @@ class Publication:
     def _commit(self):
         folder = self.files[0][1].parent
         for temp, _ in self.files:
-            _fsync(temp)
+            fsync(temp)
         with folder_lock(folder), signals_held():
             if SIGNALS["pending"] is not None:  # swallowed earlier: stop before publishing
                 signum, SIGNALS["pending"] = SIGNALS["pending"], None
@@ -308,7 +144,7 @@ class Publication:
                     json.dump(record, fh)
                     fh.flush()
                     os.fsync(fh.fileno())
-                _fsync(folder, directory=True)
+                fsync(folder, directory=True)
                 for temp, final in self.files:
                     self._publish(temp, final)
                 for final in self.removals:
@@ -324,7 +160,7 @@ class Publication:
                     self.participant.release()
                 raise
             os.unlink(journal)  # the commit point
-            _fsync(folder, directory=True)
+            fsync(folder, directory=True)
             self.committed = True
             _clean(folder, record)
             SIGNALS["held"] += 1  # done: a signal from now on no longer stops the command
