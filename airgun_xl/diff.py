@@ -185,6 +185,8 @@ class DiffReport:
     labels: tuple = ("LEGACY", "NEW")
     #: Whether the parameter cells were compared here (archived runs: by the caller).
     inputs_compared: bool = True
+    #: The column furthest apart, for --report: (name, time, legacy values, new values).
+    worst: tuple = None
 
     @property
     def same(self):
@@ -193,6 +195,7 @@ class DiffReport:
 
     def as_dict(self):
         out = asdict(self)
+        out.pop("worst", None)  # arrays, for the report workbook only
         out["same"] = self.same
         return out
 
@@ -238,17 +241,39 @@ def _compare(col, header, x, y, times, rtol, atol):
 
 
 def diff_workbooks(legacy_path, new_path, rtol=DEFAULT_RTOL, atol=0.0):
-    """Compare two filled workbooks; see the module docstring.
+    """Compare two filled workbooks; see the module docstring: the parameter cells
+    (:func:`_differing_inputs`), the result columns by time (:func:`_compare_columns`), the
+    final masses (:func:`_compare_finals`), and the column furthest apart
+    (:func:`_worst_column`).
 
     Returns
     -------
     DiffReport
     """
     a, b = read_results(legacy_path), read_results(new_path)
-    labels = {c.address: c.label for c in CELLS}
-    inputs = [(addr, labels[addr], a.params[addr], b.params[addr]) for addr in a.params
-              if not _same_param(a.params[addr], b.params[addr])]
     ia, ib = _align(a, b)
+    columns, only_legacy, only_new = _compare_columns(a, b, ia, ib, rtol, atol)
+    columns += _compare_finals(a, b, rtol, atol)
+    notes = []
+    if len(ia) < max(len(a.time), len(b.time)):
+        notes.append(f"only {len(ia):,} rows share a time; legacy has {len(a.time):,}, new "
+                     f"{len(b.time):,}")
+    return DiffReport(str(legacy_path), str(new_path), (len(a.time), len(b.time)),
+                      _differing_inputs(a, b), columns, only_legacy, only_new, rtol, atol,
+                      notes, worst=_worst_column(a, b, ia, ib))
+
+
+def _differing_inputs(a, b):
+    """(cell, label, legacy, new) of the parameter cells that differ."""
+    labels = {c.address: c.label for c in CELLS}
+    return [(addr, labels[addr], a.params[addr], b.params[addr]) for addr in a.params
+            if not _same_param(a.params[addr], b.params[addr])]
+
+
+def _compare_columns(a, b, ia, ib, rtol, atol):
+    """Each result column both sheets fill under one header, compared on the shared times
+    (AB by row: its rows may run past the time grid); and the columns only one side fills
+    (or fills under another header)."""
     columns, only_legacy, only_new = [], [], []
     for col in sorted(set(a.data) | set(b.data)):
         xa, xb = a.data.get(col), b.data.get(col)
@@ -271,6 +296,12 @@ def diff_workbooks(legacy_path, new_path, rtol=DEFAULT_RTOL, atol=0.0):
         elif has_a and has_b:
             only_legacy.append(f"{_letter(col)} {ha}")
             only_new.append(f"{_letter(col)} {hb}")
+    return columns, only_legacy, only_new
+
+
+def _compare_finals(a, b, rtol, atol):
+    """The final masses below column I, each compared as a one-row column."""
+    out = []
     for k, label in enumerate(("Final M1", "Final m31")):
         x, y = np.array([a.finals[k]]), np.array([b.finals[k]])
         if np.isfinite(x).any() or np.isfinite(y).any():
@@ -278,8 +309,13 @@ def diff_workbooks(legacy_path, new_path, rtol=DEFAULT_RTOL, atol=0.0):
             d.column = f"I{len(a.time) + 3 + k}"
             d.first_outside = ({**d.first_outside, "row": len(a.time) + 3 + k}
                                if d.first_outside else None)
-            columns.append(d)
-    notes = []
+            out.append(d)
+    return out
+
+
+def _worst_column(a, b, ia, ib):
+    """(name, time, legacy, new) of the column whose largest difference is the largest
+    fraction of its magnitude (AB and empty columns aside); None when there is none."""
     worst = None
     for col in sorted(set(a.data) & set(b.data)):
         x, y = a.data[col], b.data[col]
@@ -290,13 +326,7 @@ def diff_workbooks(legacy_path, new_path, rtol=DEFAULT_RTOL, atol=0.0):
         err = np.nanmax(np.abs(x - y)) / scale if (np.isfinite(x) & np.isfinite(y)).any() else 0
         if worst is None or err > worst[0]:
             worst = (err, f"{_letter(col)} {a.headers[col]}", a.time[ia], x, y)
-    if len(ia) < max(len(a.time), len(b.time)):
-        notes.append(f"only {len(ia):,} rows share a time; legacy has {len(a.time):,}, new "
-                     f"{len(b.time):,}")
-    report = DiffReport(str(legacy_path), str(new_path), (len(a.time), len(b.time)), inputs,
-                        columns, only_legacy, only_new, rtol, atol, notes)
-    report.worst = worst[1:] if worst else None  # (name, time, legacy, new), for --report
-    return report
+    return worst[1:] if worst else None
 
 
 def diff_histories(name_a, a, name_b, b, rtol=DEFAULT_RTOL, atol=0.0):
@@ -314,10 +344,8 @@ def diff_histories(name_a, a, name_b, b, rtol=DEFAULT_RTOL, atol=0.0):
         columns[-1].header = ""
     only_a = [k for k in a if k not in b]
     only_b = [k for k in b if k not in a]
-    report = DiffReport(name_a, name_b, (len(ta), len(tb)), [], columns, only_a, only_b, rtol,
-                        atol, labels=(name_a, name_b), inputs_compared=False)
-    report.worst = None
-    return report
+    return DiffReport(name_a, name_b, (len(ta), len(tb)), [], columns, only_a, only_b, rtol,
+                      atol, labels=(name_a, name_b), inputs_compared=False)
 
 
 def format_report(report):
