@@ -103,9 +103,16 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
                   progress=None):
     """Run ``shot`` and write ``output`` (and its sidecar) as ``outputs`` selects.
 
+    The steps, each its own function: refuse what cannot be written (:func:`_check_outputs`)
+    or run (:func:`_check_run`), run and watch (:func:`_run_watched`), run the comparison a
+    reader needs beside it (:func:`_compared_run`), then write and publish everything as one
+    transaction (:func:`_publish`).
+
     ``warn`` and ``note`` take lists of messages (warnings; notices such as a large run's
     memory); ``progress(stage)`` is told each stage as it starts (see
-    :mod:`airgun_xl.cli.progress`).
+    :mod:`airgun_xl.cli.progress`). Every warning is kept in one record, written into the
+    workbook and the archive entry and given to ``warn`` once the fill succeeds (a refusal
+    stays one line, 23.24).
 
     Raises
     ------
@@ -113,76 +120,119 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
         Before anything is written: an existing output, an unstable time step, divergence.
     """
     started = time.perf_counter() if started is None else started
-    inputs = [shot.source.path] if shot.source is not None else []
-    model_shot = dataclasses.replace(shot, params=apply_model(shot.params, options.model))
-    rows = shot.params.rows
+    note, progress = note or (lambda messages: None), progress or (lambda stage: None)
     output = Path(output)
-    sidecar = sidecar_path(output) if outputs.writes_sidecar(rows) else None
-    check_output(output, options.force, inputs=inputs,  # before the run, not after
-                 force_word=options.force_word)
+    model_shot = dataclasses.replace(shot, params=apply_model(shot.params, options.model))
+    sidecar = _check_outputs(shot, output, outputs, options)
+    record = [str(w) for w in shot.warnings]
+    crit, track = _check_run(model_shot, outputs, options, sidecar, record, note)
+    progress("running")
+    result = _run_watched(shot, model_shot, crit, track, options, record)
+    compared = _compared_run(shot, model_shot, result, options, record)
+    result = dataclasses.replace(result, model=options.model)
+    progress("summarizing")
+    needs_summary = outputs.groups & {"summary", "spectrum", "charts"}
+    summary = summarize(result) if needs_summary else None
+    info = _provenance(shot, result, crit, compared, options, record, started)
+    filled = Filled(result, summary, outputs.stride(shot.params.rows), sidecar, compared,
+                    warnings=record)
+    filled.entry = _publish(shot, filled, output, outputs, info, options, record, progress,
+                            started)
+    warn(record)
+    return filled
+
+
+def _check_outputs(shot, output, outputs, options):
+    """Refuse, before the run, outputs that cannot be written (and a foreign archive folder);
+    return the sidecar's path, or None."""
+    inputs = [shot.source.path] if shot.source is not None else []
+    sidecar = sidecar_path(output) if outputs.writes_sidecar(shot.params.rows) else None
+    check_output(output, options.force, inputs=inputs, force_word=options.force_word)
     if sidecar is not None:
         check_output(sidecar, options.force, inputs=inputs, suffixes=(".parquet", ".csv"),
                      force_word=options.force_word)
     if options.archive is not None:
         Archive(options.archive.root, create=True, dry_run=True)  # a foreign folder: now
-    record = []  # every warning, for the workbook and the archive entry as for the terminal
+    return sidecar
 
-    def say(messages):  # printed once the fill succeeds: a refusal stays one line (23.24)
-        record.extend(str(m) for m in messages)
 
-    say(shot.warnings)
+def _check_run(model_shot, outputs, options, sidecar, record, note):
+    """Refuse an unstable step and a run past the memory budget; return the critical steps
+    and the step values to track. Findings go to ``record``; notices (a large run) to
+    ``note``, after the refusals."""
     crit, findings = before_run(model_shot.params, options.integrator)
     if crit.ratio > 1 and not options.allow_unstable:
         error = next(f for f in findings if f.level == "error")
         raise StabilityError(f"{error}; {WAY_OUT}")
-    say(f for f in findings if f.level != "note")
-    note, progress = note or (lambda messages: None), progress or (lambda stage: None)
+    record.extend(str(f) for f in findings if f.level != "note")
+    rows = model_shot.params.rows
     track = outputs.tracked_series(sidecar is not None or options.track_all)
     check_memory(fill_bytes(rows, len(track)),  # Shot.run checks too, in the API's words
                  f"a run of {rows:,} rows ({len(track)} step values tracked)",
                  "fewer rows (a larger E2 or a shorter E6) or fewer outputs (--only summary; "
                  "an archived run tracks every step value)")
-    note(notices(rows, track, sidecar))  # after the refusals: a refusal stays one line
-    progress("running")
+    note(notices(rows, track, sidecar))
+    return crit, track
+
+
+def _run_watched(shot, model_shot, crit, track, options, record):
+    """The run, and what watching it found: a divergence after an unloading is refused
+    (unless allowed), the rest recorded."""
     result = model_shot.run(integrator=options.integrator, host=options.host, track=track)
     diverged = unloading_diverged(result, crit, options.integrator)
     if diverged is not None and not options.allow_unstable:
         raise StabilityError(f"{diverged}; {UNLOADING_WAY_OUT}")
-    say([str(diverged)] if diverged is not None else [])
-    say(result.warnings[len(shot.warnings):])
-    say(str(f) for f in after_run(result))
-    compared = None
+    if diverged is not None:
+        record.append(str(diverged))
+    record.extend(str(w) for w in result.warnings[len(shot.warnings):])
+    record.extend(str(f) for f in after_run(result))
+    return result
+
+
+def _compared_run(shot, model_shot, result, options, record):
+    """The run shown beside this one: the other model (``compare_models``), or, when the
+    macro's unloading quirk fired, the same shot without it; None otherwise."""
     if options.compare_models:
         other = "rigid" if options.model == "4-mass" else "4-mass"
         compared = dataclasses.replace(shot, params=apply_model(shot.params, other)).run(
             integrator=options.integrator, host=options.host, track=())
-        compared = dataclasses.replace(compared, model=other)
-    elif quirk_fired(result):
-        compared, error = compare_continuous(model_shot, options)
-        say([f"the run without the quirk (--unloading continuous) fails too, so the quirk is "
-             f"not the only cause: {error}" if compared is None else
-             f"without the quirk (--unloading continuous) the peak is {compared.peak_kg:.5g} "
-             f"kG, against {result.peak_kg:.5g} kG with it; both are in the workbook"])
-    result = dataclasses.replace(result, model=options.model)
-    needs_summary = outputs.groups & {"summary", "spectrum", "charts"}
-    progress("summarizing")
-    summary = summarize(result) if needs_summary else None
+        return dataclasses.replace(compared, model=other)
+    if not quirk_fired(result):
+        return None
+    compared, error = compare_continuous(model_shot, options)
+    record.append(f"the run without the quirk (--unloading continuous) fails too, so the quirk "
+                  f"is not the only cause: {error}" if compared is None else
+                  f"without the quirk (--unloading continuous) the peak is "
+                  f"{compared.peak_kg:.5g} kG, against {result.peak_kg:.5g} kG with it; both "
+                  "are in the workbook")
+    return compared
+
+
+def _provenance(shot, result, crit, compared, options, record, started):
+    """What the Summary says of the run beside its figures."""
     info = {"version": __version__, "command": " ".join(options.command), "warnings": record,
             "dt_crit": crit.dt_crit, "dt_compacted": crit.dt_compacted,
-            "dt_unloading": crit.dt_unloading,
-            "dt_ratio": crit.ratio, "compared": compared,
+            "dt_unloading": crit.dt_unloading, "dt_ratio": crit.ratio, "compared": compared,
             "srs_requirement": options.srs_requirement}
     if shot.source is not None:
         info.update(input=str(shot.source.path), sha256=shot.source.sha256)
     if not options.reproducible:
         info.update(kernel_seconds=result.history.kernel_seconds,
                     run_seconds=time.perf_counter() - started)
-    filled = Filled(result, summary, outputs.stride(rows), sidecar, compared, warnings=record)
+    return info
+
+
+def _publish(shot, filled, output, outputs, info, options, record, progress, started):
+    """Write the workbook, the sidecar and the archive entry, and publish them together (a
+    failure or a signal leaves none of them, nor an archive folder this fill created);
+    return the archive entry, or None."""
+    result, sidecar = filled.result, filled.sidecar
     with Publication(options.force, options.force_word) as pub:
         progress("writing the workbook")
         # what writing found (a parameter cell's text cut, say) reaches the archive entry too;
         # the Summary was written before it was known
-        say(render_workbook(result, pub.stage(output), outputs, summary, info, shown=output))
+        record.extend(render_workbook(result, pub.stage(output), outputs, filled.summary,
+                                      info, shown=output))
         workbook = pub.files[0][0]
         if sidecar is not None:
             progress("writing the sidecar")
@@ -206,6 +256,4 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
             if archive is not None:
                 archive.remove_if_unused()
             raise
-    filled.entry = pending.entry if pending is not None else None
-    warn(record)
-    return filled
+    return pending.entry if pending is not None else None
