@@ -80,3 +80,38 @@ def shot_copy(tmp_path):
     path = tmp_path / "shot.xlsx"
     path.write_bytes(TEMPLATE.read_bytes())
     return path
+
+
+#: Modules whose tests take a second or more each (child processes, LibreOffice, fills of
+#: long runs, Monte Carlo and calibration): marked slow, so that pytest -m "not slow" runs the
+#: rest in about a minute (issue 24.8). Measured with --durations on the CI's 2-core VM.
+SLOW_MODULES = {
+    "test_readme_workflow", "test_report_workbooks", "test_printing", "test_campaign",
+    "test_recorder", "test_design", "test_design_srs", "test_calibrate", "test_cluster",
+    "test_writer_fallback", "test_hostile_faults", "test_hostile_inputs",
+    "test_hostile_outputs", "test_hostile_properties", "test_hostile_measured_properties",
+    "test_hostile_archive", "test_pure_python", "test_typing", "test_sensitivity",
+}
+
+
+#: Single tests of a second or more in the other modules (their names, parameters aside).
+SLOW_TESTS = {
+    "test_output_is_deterministic", "test_a_fill_killed_at_random_moments_leaves_the_archive_whole",
+    "test_parameter_block_is_copied_with_formulas",
+    "test_a_long_run_fits_the_sheet_and_keeps_everything_in_the_sidecar",
+    "test_parameters_round_trip_exactly", "test_reduced_models_run",
+    "test_libreoffice_reads_the_output", "test_summary_matches_the_report_figures",
+    "test_two_processes_filling_at_once_lose_nothing", "test_libreoffice_renders_every_chart",
+    "test_the_estimate_is_above_the_measured_peak",
+    "test_23_11_durations_with_an_exponent_and_a_unit_run",
+    "test_23_16_a_file_size_limit_is_one_line_with_no_zipfile_traceback",
+    "test_an_error_cell_in_the_parameters_is_read",
+    "test_template_at_half_a_microsecond_has_12002_rows", "test_libreoffice_reads_the_template",
+}
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if (item.module.__name__.rsplit(".", 1)[-1] in SLOW_MODULES
+                or item.originalname in SLOW_TESTS):
+            item.add_marker(pytest.mark.slow)

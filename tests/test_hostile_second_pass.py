@@ -407,7 +407,7 @@ def _failing_journal(monkeypatch, error):
     import json
     import types
 
-    import airgun_xl.transaction as transaction
+    import airgun_xl.transaction.publication as transaction
 
     def dump(obj, fh, *args, **kwargs):
         raise error
