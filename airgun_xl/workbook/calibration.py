@@ -13,15 +13,13 @@ import numpy as np
 
 from ..crush_law import LEGACY_LAW
 from ..studies.calibrate import AT_BOUND
-from ..transaction import atomic_path, check_output, display
+from ..transaction import display
 from .charts import line_series, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
 from .law_sheet import write_law_sheet
-from .report import Style, axis, chart_size, not_printed, one_page, shown
+from .report import Style, axis, chart_size, not_printed, one_page, report_workbook, shown
 from .sheets import write_about, write_number_columns, write_parameters, write_warnings
 from .writer import (
-    close_workbook,
-    new_workbook,
     print_outputs_block,
     sheet_names,
     write_cells,
@@ -94,11 +92,9 @@ def _pulse_chart(wb, a):
 
 def write_calibration(path, shot, cal, files, options, force=False):
     """Write the calibrated workbook at ``path`` (atomically); returns the copy's warnings."""
-    check_output(path, force)
     params = cal.params[0]
     law = params.crush_law
-    with atomic_path(path, force) as tmp:
-        wb = new_workbook(tmp)
+    with report_workbook(path, force) as wb:
         names = sheet_names(shot.source.sheet_title)
         warnings = _parameter_sheet(wb, shot, params, names, cal.fitted)
         if not law.is_legacy:
@@ -223,5 +219,4 @@ def write_calibration(path, shot, cal, files, options, force=False):
             ws.insert_chart(1 + k * CHART_ROWS, 7, chart)
         one_page(ws, max(row, 1 + len(charts) * CHART_ROWS), 7 + CHART_COLS,
                  shot=display(shot.source.path.name), title="Calibration")
-        close_workbook(wb, path)
     return warnings

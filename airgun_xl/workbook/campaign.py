@@ -3,11 +3,10 @@ the peak against the impact speed, and every warning; one printed page."""
 import numpy as np
 
 from ..campaign import TABLE, TABLE_TITLE
-from ..transaction import atomic_path, check_output
 from .charts import nice_range
-from .report import Style, axis, chart_size, one_page
+from .report import Style, axis, chart_size, one_page, report_workbook
 from .sheets import write_warnings
-from .writer import PROPERTIES, close_workbook, new_workbook
+from .writer import PROPERTIES
 
 #: Widths (characters) of the table's text columns.
 TEXT_WIDTHS = {"file": 28, "status": 12, "output": 28, "entry": 18, "created": 20,
@@ -29,9 +28,7 @@ def write_campaign(path, rows, title, force=False, columns=TABLE, label=None):
     label : str, optional
         What the page header names (the folder, the archive).
     """
-    check_output(path, force)
-    with atomic_path(path, force) as tmp:
-        wb = new_workbook(tmp)
+    with report_workbook(path, force) as wb:
         wb.set_properties(dict(PROPERTIES, title=TABLE_TITLE))  # a folder campaign skips it
         style = Style(wb)
         ws = wb.add_worksheet("Shots")
@@ -86,4 +83,3 @@ def write_campaign(path, rows, title, force=False, columns=TABLE, label=None):
             last = chart_row + 18
         one_page(ws, last, len(columns) - 1, shot=label, title="Shots")
         ws.freeze_panes(head + 1, 0)
-        close_workbook(wb, path)

@@ -5,18 +5,14 @@ from pathlib import Path
 import numpy as np
 
 from ..engine.decimate import minmax_indices
-from ..transaction import atomic_path, check_output
 from .charts import nice_range
 from .columns_sheet import ColumnsWorksheet
-from .report import Style, axis, chart_size, one_page
+from .report import Style, axis, chart_size, one_page, report_workbook
 from .sheets import write_number_columns
-from .writer import close_workbook, new_workbook
 
 
 def write_diff_report(report, path, force=False):
-    check_output(path, force)
-    with atomic_path(path, force) as tmp:
-        wb = new_workbook(tmp)
+    with report_workbook(path, force) as wb:
         style = Style(wb)
         ws = wb.add_worksheet("Diff")
         shot = f"{Path(report.legacy).name} vs {Path(report.new).name}"
@@ -69,7 +65,6 @@ def write_diff_report(report, path, force=False):
         one_page(ws, max(row, 16), len(headers) - 1, shot=shot, title="Diff")
         if report.worst is not None:
             _write_worst(wb, *report.worst, shot=shot)
-        close_workbook(wb, path)
 
 
 def _write_worst(wb, name, time, x, y, shot=None):

@@ -4,13 +4,11 @@ import math
 
 import numpy as np
 
-from ..transaction import atomic_path, check_output
 from .charts import line_series, log_axis, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
-from .report import axis, chart_size, not_printed, one_page
+from .report import axis, chart_size, not_printed, one_page, report_workbook
 from .sheets import write_about, write_number_columns, write_warnings
 from .srs import G_PER_KG
-from .writer import close_workbook, new_workbook
 
 ROWS = (("Peak acceleration", "peak_kg", "kG", 1.0, "0.000"),
         ("Time of peak, after impact", "time_of_peak", "ms", 1e3, "0.0000"),
@@ -174,9 +172,7 @@ def write_comparison(path, comparison, about, force=False, models=("4-mass", "ri
     sheets (Traces, Spectra, SRS) at ``path``; ``models`` names the prediction's model and the
     compared one, ``shot`` the input in the page headers."""
     c = comparison
-    check_output(path, force)
-    with atomic_path(path, force) as tmp:
-        wb = new_workbook(tmp)
+    with report_workbook(path, force) as wb:
         ws = wb.add_worksheet("Compared")
         bold = wb.add_format({"bold": True})
         ws.set_column(0, 0, 50)
@@ -218,4 +214,3 @@ def write_comparison(path, comparison, about, force=False, models=("4-mass", "ri
         charts.insert_chart(22, 0, _spectrum_chart(wb, c, n_spec))
         charts.insert_chart(22, CHART_COLS, _srs_chart(wb, c, len(c.srs_frequencies)))
         one_page(charts, 42, 2 * CHART_COLS - 1, shot=shot, title="Charts")
-        close_workbook(wb, path)

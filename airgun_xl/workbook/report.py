@@ -19,6 +19,7 @@ calibrate) goes through this module:
 The header carries the print date as a field (``&D``), so a workbook's bytes depend on the
 run alone (the same run gives the same file).
 """
+import contextlib
 from dataclasses import dataclass
 
 from .. import __version__
@@ -190,3 +191,25 @@ def axis(title, lo, hi, code=None, log=False, gridlines=True, num_format=None):
         out["num_format"] = num_format or "#,##0.###"
         out["minor_gridlines"] = {"visible": gridlines, "line": {"color": "#eeeeee"}}
     return out
+
+
+@contextlib.contextmanager
+def report_workbook(path, force=False, inputs=()):
+    """The one way a command writes a workbook: refuse an output it may not write
+    (:func:`~airgun_xl.transaction.check_output`), write into a temp file beside it, and
+    publish it whole when the block ends without an error (nothing is left otherwise).
+
+    Yields
+    ------
+    xlsxwriter.Workbook
+        With the project's options and fixed properties
+        (:func:`~airgun_xl.workbook.writer.new_workbook`).
+    """
+    from ..transaction import atomic_path, check_output
+    from .writer import close_workbook, new_workbook
+
+    check_output(path, force, inputs=inputs)
+    with atomic_path(path, force) as tmp:
+        wb = new_workbook(tmp)
+        yield wb
+        close_workbook(wb, path)

@@ -3,12 +3,10 @@ when there is one) and its table; the ``srs`` workbook, and the SRS sheets of a 
 required spectrum."""
 import numpy as np
 
-from ..transaction import atomic_path, check_output
 from ..units import KG_MS2, G
 from .charts import log_axis, titled
-from .report import Style, chart_size, one_page
+from .report import Style, chart_size, one_page, report_workbook
 from .sheets import write_about
-from .writer import close_workbook, new_workbook
 
 #: The macro's kG in standard g: shock labs give spectra in g.
 G_PER_KG = KG_MS2 / G
@@ -107,8 +105,5 @@ def write_srs(path, frequencies, spectrum, about, force=False, shot=None, requir
     """Write the SRS workbook (:func:`add_srs_sheets`): frequencies [Hz], the maximax response
     [kG]; ``about`` is a list of (label, text) lines for the head of the sheet (shot, Q,
     filter)."""
-    check_output(path, force)
-    with atomic_path(path, force) as tmp:
-        wb = new_workbook(tmp)
+    with report_workbook(path, force) as wb:
         add_srs_sheets(wb, frequencies, spectrum, about, shot, requirement)
-        close_workbook(wb, path)

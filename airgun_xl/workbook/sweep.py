@@ -5,12 +5,10 @@ from xlsxwriter.utility import xl_range_abs
 
 from ..cells import BY_ADDRESS
 from ..engine.batch import FIGURES
-from ..transaction import atomic_path, check_output
 from .charts import nice_range
 from .columns_sheet import ColumnsWorksheet
-from .report import Style, axis, chart_size, general_format, not_printed, one_page
+from .report import Style, axis, chart_size, general_format, not_printed, one_page, report_workbook
 from .sheets import write_number_columns
-from .writer import close_workbook, new_workbook
 
 FIGURE_HEADERS = {"peak_kg": "Peak (kG)", "time_of_peak": "Time of peak (s)",
                   "filtered_peak_kg": "Filtered peak (kG)",
@@ -45,9 +43,7 @@ def write_sweep(result, path, force, stats=None, sensitivity=None, shot=None):
     inputs: a family of curves, one series per level of the second); with ``stats`` (a Monte
     Carlo) the Spread sheet and the band's convergence; with ``sensitivity`` (Sobol) the
     Sensitivity sheet and its bar charts. ``shot`` names the input in the page headers."""
-    check_output(path, force)
-    with atomic_path(path, force) as tmp:
-        wb = new_workbook(tmp)
+    with report_workbook(path, force) as wb:
         style = Style(wb)
         ws = wb.add_worksheet("Sweep", worksheet_class=ColumnsWorksheet)
         headers = ([_label(c) for c in result.cells]
@@ -75,7 +71,6 @@ def write_sweep(result, path, force, stats=None, sensitivity=None, shot=None):
             _write_band(wb, result, style, shot)
         if sensitivity is not None:
             _write_sensitivity(wb, sensitivity, style, shot)
-        close_workbook(wb, path)
 
 
 def families(result, i):

@@ -17,9 +17,8 @@ legacy macro reads) cached values of .xlsx files without recalculating them.
 """
 from ..outputs import SHEET_NAME as OUTPUTS_SHEET
 from ..outputs import block_cells
-from ..transaction import atomic_path, check_output
 from .formula_eval import Evaluator, SheetView
-from .writer import close_workbook, new_workbook
+from .report import report_workbook
 
 SHEET = "Sheet1"
 
@@ -95,10 +94,8 @@ def write_template(path, force=False):
     airgun_xl.errors.OutputError
         When ``path`` exists and ``force`` is false, or its folder is unusable.
     """
-    check_output(path, force)
     values = template_values()
-    with atomic_path(path, force) as tmp:
-        wb = new_workbook(tmp)
+    with report_workbook(path, force) as wb:
         ws = wb.add_worksheet(SHEET)
         for columns, width in COLUMN_WIDTHS.items():
             ws.set_column(columns, width)
@@ -111,7 +108,6 @@ def write_template(path, force=False):
             else:
                 ws.write_number(address, content)
         write_outputs_sheet(wb)
-        close_workbook(wb, path)
 
 
 def write_outputs_sheet(wb):
