@@ -143,7 +143,7 @@ def bench_stages(repeat, tmp):
     medians = [statistics.median(s[i] for s in samples) for i in range(len(names))]
     total = sum(medians)
     return [(f"  stage: {name}", "", f"{med * 1e3:.1f} ms", f"{med / total:.0%}")
-            for name, med in zip(names, medians)]
+            for name, med in zip(names, medians, strict=True)]
 
 
 def warm_bytecode():
@@ -166,7 +166,7 @@ def run_table(doc, benches):
     print(f"medians of {args.repeat} runs after a warm-up\n")
     widths = [max(len(r[i]) for r in rows) for i in range(4)]
     for r in rows:
-        print("  ".join(cell.ljust(w) for cell, w in zip(r, widths)))
+        print("  ".join(cell.ljust(w) for cell, w in zip(r, widths, strict=True)))
 
 
 def main():

@@ -51,7 +51,7 @@ def benches(repeat, tmp):
 
     def recordings(known, prefix):
         out = []
-        for i, (v0, rate) in enumerate(zip(SPEEDS, RATES)):
+        for i, (v0, rate) in enumerate(zip(SPEEDS, RATES, strict=True)):
             rec = Recorder(rate=rate)
             run = airgun_xl.Shot(p.replace(v31=v0, v32=v0, v33=v0, **known)).run(track=())
             out.append(str(rec.csv(rec.record(run, seed=i), tmp / f"{prefix}{i}.csv",
@@ -67,8 +67,8 @@ def benches(repeat, tmp):
         shots.append(str(tmp / f"shot{i}.xlsx"))
     measured = recordings({"crush_law": truth}, "law")
     fitted = recordings({"sigmay": p.sigmay * 1.07}, "e40")
-    law_pairs = [x for pair in zip(shots, measured) for x in pair]
-    e40_pairs = [x for pair in zip(shots, fitted) for x in pair]
+    law_pairs = [x for pair in zip(shots, measured, strict=True) for x in pair]
+    e40_pairs = [x for pair in zip(shots, fitted, strict=True) for x in pair]
     commands = [
         ("compare-measured, shot A at 20 kHz, CFC 1000 (ISO, FFT, SRS, rigid model, 3 charts)",
          ["compare-measured", shots[0], measured[0], "--sign", "-1", "--cfc", "1000"], 1.0),

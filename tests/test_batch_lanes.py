@@ -66,7 +66,7 @@ def test_each_legacy_case_in_a_batch_equals_its_single_shot_run(name):
 def test_random_batches_equal_the_scalar_loop_bit_for_bit(seed):
     shots = _random_shots(seed, 37)  # 37: four full groups of 8 lanes and a part
     lanes, scalar = _batch(shots, lanes=True), _batch(shots, lanes=False)
-    for a, b in zip(lanes, scalar):
+    for a, b in zip(lanes, scalar, strict=True):
         assert np.array_equal(a, b, equal_nan=True)
     assert 0 < (lanes[2][:, 2] >= 0).sum() < len(shots)  # some lanes diverged, not all
 

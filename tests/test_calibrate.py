@@ -32,7 +32,8 @@ def _shot(v0, **changes):
 
 def _csv(path, trace):
     lines = ["time [s],acceleration [kG]"]
-    lines += [f"{t!r},{a!r}" for t, a in zip(trace.time.tolist(), trace.accel_kg.tolist())]
+    lines += [f"{t!r},{a!r}" for t, a in zip(trace.time.tolist(), trace.accel_kg.tolist(),
+                                            strict=True)]
     path.write_text("\n".join(lines) + "\n")
     return path
 
@@ -72,7 +73,7 @@ def test_the_crush_law_is_recovered_within_2_percent(tmp_path):
     v = np.linspace(lo, hi, 201)
     assert np.max(np.abs(law(v) / TRUTH(v) - 1)) < 0.02
     assert np.max(np.abs(LEGACY_LAW(v) / TRUTH(v) - 1)) > 0.1  # it had to move
-    for before, after in zip(cal.before, cal.after):
+    for before, after in zip(cal.before, cal.after, strict=True):
         assert after.rms < 0.01 < before.rms  # 1 % white noise, filtered: well below 1 %
         assert after.iso > 0.99 > before.iso
 

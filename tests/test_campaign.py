@@ -156,7 +156,8 @@ def test_a_law_stored_and_run_by_name_equals_the_same_law_from_its_workbook(tmp_
     trace = synthetic_measurement(p.replace(sigmay=p.sigmay * 1.05), seed=5)
     measured = tmp_path / "m.csv"
     measured.write_text("time [s],acceleration [kG]\n" + "".join(
-        f"{t!r},{a!r}\n" for t, a in zip(trace.time.tolist(), trace.accel_kg.tolist())))
+        f"{t!r},{a!r}\n" for t, a in zip(trace.time.tolist(), trace.accel_kg.tolist(),
+                                           strict=True)))
     archive = tmp_path / "archive"
     calibrated = tmp_path / "cal.xlsx"
     assert main(["calibrate", str(TEMPLATE), str(measured), "--cfc", "1000", "-o",

@@ -27,7 +27,7 @@ def client():
 def _shots(n, **changes):
     base = SHOT.replace(**changes)
     return [base.replace(v31=v, v32=v, v33=v, sigmay=s)
-            for v, s in zip(np.linspace(80, 260, n), np.linspace(2.5e7, 2.9e7, n))]
+            for v, s in zip(np.linspace(80, 260, n), np.linspace(2.5e7, 2.9e7, n), strict=True)]
 
 
 def _same(a, b):

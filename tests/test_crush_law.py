@@ -62,7 +62,7 @@ def test_a_fitted_law_bit_for_bit_in_c_and_python(integrator):
         out.append((getattr(module, integrator)(values, p.rows, *arrays), arrays))
     (fc, ac), (fr, ar) = out
     assert np.array_equal(fc, fr, equal_nan=True)
-    assert all(np.array_equal(x, y, equal_nan=True) for x, y in zip(ac, ar))
+    assert all(np.array_equal(x, y, equal_nan=True) for x, y in zip(ac, ar, strict=True))
 
 
 def test_lanes_carry_each_shots_own_law():

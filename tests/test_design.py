@@ -89,7 +89,7 @@ def test_batch_equals_single_shots_to_the_last_bit():
     params.append(SHOT_A.replace(sigmay=2.5e7, filter_frequency=6000.0))  # fractional filter
     params.append(apply_model(SHOT_A, "rigid"))
     batch = run_batch(params)
-    for row, p in zip(batch.figures, params):
+    for row, p in zip(batch.figures, params, strict=True):
         s = summarize(Shot(p).run())
         single = [getattr(s, name) for name in FIGURES]
         np.testing.assert_array_equal(row, single)  # equal, NaN for NaN

@@ -16,7 +16,7 @@ G_PER_KG = 9800.0 / 9.80665  # the macro's kG in standard g
 
 def _spec(path, frequencies, levels_g):
     lines = ["frequency [Hz],srs [g]"]
-    lines += [f"{f!r},{a!r}" for f, a in zip(frequencies.tolist(), levels_g.tolist())]
+    lines += [f"{f!r},{a!r}" for f, a in zip(frequencies.tolist(), levels_g.tolist(), strict=True)]
     path.write_text("\n".join(lines) + "\n")
     return path
 

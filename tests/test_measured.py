@@ -25,7 +25,8 @@ def _write(path, shot, time_unit="ms", accel_unit="g", sign=1.0, noise=0.0, ever
     scale_t = {"s": 1.0, "ms": 1e3}[time_unit]
     scale_a = {"g": G_PER_KG, "m/s^2": 9800.0}[accel_unit]
     lines = [f"time [{time_unit}],acceleration [{accel_unit}]"]
-    lines += [f"{float(ti) * scale_t!r},{float(ai) * scale_a!r}" for ti, ai in zip(t, a_kg)]
+    lines += [f"{float(ti) * scale_t!r},{float(ai) * scale_a!r}"
+              for ti, ai in zip(t, a_kg, strict=True)]
     path.write_text("\n".join(lines) + "\n")
     return path
 
@@ -90,7 +91,7 @@ def test_units_from_the_header(tmp_path):
     """The same pulse in s and m/s^2 scores as in ms and g (to rounding of the CSV digits)."""
     a, b = _write(tmp_path / "a.csv", SHOT), _write(tmp_path / "b.csv", SHOT, "s", "m/s^2")
     outs = [tmp_path / "a.xlsx", tmp_path / "b.xlsx"]
-    for m, out in zip((a, b), outs):
+    for m, out in zip((a, b), outs, strict=True):
         assert main(["compare-measured", str(TEMPLATE), str(m), "-o", str(out)]) == 0
     sa, sb = _scores(outs[0]), _scores(outs[1])
     for key in ("Peak acceleration", "Velocity change"):
@@ -160,7 +161,7 @@ def test_a_workbook_column_range_scores_as_the_csv(tmp_path):
     ws.title = "Recorder"
     ws["A1"] = "shot 17, channel 3"
     ws.append([None, None, "time [ms]", "accel [g]"])
-    for ti, ai in zip(t.tolist(), a.tolist()):
+    for ti, ai in zip(t.tolist(), a.tolist(), strict=True):
         ws.append([None, None, ti * 1e3, ai * G_PER_KG])
     wb.save(tmp_path / "trace.xlsx")
     csv_scores = _score_of(tmp_path, _write(tmp_path / "m.csv", SHOT))

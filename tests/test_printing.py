@@ -149,7 +149,8 @@ def test_compare_and_calibration_workbooks_print_their_reports(tmp_path):
     trace = synthetic_measurement(p.replace(sigmay=p.sigmay * 1.05), seed=5)
     m = tmp_path / "m.csv"
     m.write_text("time [s],acceleration [kG]\n" + "".join(
-        f"{t!r},{a!r}\n" for t, a in zip(trace.time.tolist(), trace.accel_kg.tolist())))
+        f"{t!r},{a!r}\n" for t, a in zip(trace.time.tolist(), trace.accel_kg.tolist(),
+                                           strict=True)))
     compared = tmp_path / "compared.xlsx"
     assert main(["compare-measured", str(TEMPLATE), str(m), "--cfc", "1000", "-o",
                  str(compared)]) == 0

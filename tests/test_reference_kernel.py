@@ -45,7 +45,7 @@ def test_legacy_scheme_bit_for_bit_on_every_legacy_case(name):
     p = airgun_xl.load(REFERENCE / name).params
     (fc, ac), (fr, ar) = _both("legacy_kernel", p)
     assert _same(fc, fr)
-    for i, (x, y) in enumerate(zip(ac, ar)):
+    for i, (x, y) in enumerate(zip(ac, ar, strict=True)):
         assert _same(x, y), (name, i)
 
 
@@ -53,7 +53,7 @@ def test_legacy_scheme_bit_for_bit_on_every_legacy_case(name):
 def test_newmark_bit_for_bit(changes):
     p = airgun_xl.load(REFERENCE / CASES["shot_a_appendix_5us"]["input"]).params
     (fc, ac), (fr, ar) = _both("newmark_kernel", p.replace(**changes))
-    assert _same(fc, fr) and all(_same(x, y) for x, y in zip(ac, ar))
+    assert _same(fc, fr) and all(_same(x, y) for x, y in zip(ac, ar, strict=True))
 
 
 @pytest.mark.parametrize("integrator", [0, 1])
@@ -66,7 +66,7 @@ def test_batch_bit_for_bit(integrator):
         t, y, finals = np.empty(base.rows), np.empty((3, base.rows)), np.empty((3, N_FINALS))
         module.batch_kernel(matrix, base.rows, integrator, 3, t, y, finals)
         results.append((t, y, finals))
-    for x, z in zip(*results):
+    for x, z in zip(*results, strict=True):
         assert _same(x, z)
 
 

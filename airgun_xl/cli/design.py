@@ -83,7 +83,7 @@ def run(args):
                                              args.filtered, args.integrator, args.model,
                                              runner=runner)
     solve_seconds = time.perf_counter() - started
-    for var, value in zip(design.variables, design.values):
+    for var, value in zip(design.variables, design.values, strict=True):
         print(f"{var.cell}{'..A30' if var.cell == 'A28' else ''} = {value:.6g} {var.unit}")
     print(f"  achieved peak {design.peak_kg:.5f} kG (target {target:.5f} kG), pulse "
           f"{design.duration * 1e3:.4f} ms"
@@ -153,7 +153,7 @@ def with_cells(shot, design):
     from openpyxl.utils.cell import coordinate_to_tuple
 
     block = dict(shot.source.block)
-    for var, value in zip(design.variables, design.values):
+    for var, value in zip(design.variables, design.values, strict=True):
         for address in var.cells:
             block[coordinate_to_tuple(address)] = (float(value), None)
     source = dataclasses.replace(shot.source, block=block)

@@ -131,5 +131,5 @@ def run(args):
         found = sensitivity.indices["peak_kg"]
         print("  Sobol indices of the peak: " + ", ".join(
             f"{cell} S1 {s1:.3f} ST {st:.3f}" for cell, s1, st in
-            zip(sensitivity.cells, found["S1"], found["ST"])))
+            zip(sensitivity.cells, found["S1"], found["ST"], strict=True)))
     return 0

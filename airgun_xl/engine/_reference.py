@@ -172,9 +172,9 @@ class _Rows:
         n = self.written
         t, y1, y31, y32, y33 = arrays[:5]
         t[:len(self.t)] = self.t
-        for out, values in zip((y1, y31, y32, y33), self.y):
+        for out, values in zip((y1, y31, y32, y33), self.y, strict=True):
             out[:n] = values[:n]
-        for name, out in zip(TRACKED_NAMES, arrays[5:]):
+        for name, out in zip(TRACKED_NAMES, arrays[5:], strict=True):
             if out is not None:
                 stop = n - 1 if name in ("v1", "v31") else n
                 if stop > 0:
@@ -313,7 +313,7 @@ def _check_columns(arrays, rows):
 def _run(steps, params, rows, arrays):
     p = _check(params, rows)
     _check_columns(arrays, rows)
-    tracked = [name for name, out in zip(TRACKED_NAMES, arrays[5:]) if out is not None]
+    tracked = [name for name, out in zip(TRACKED_NAMES, arrays[5:], strict=True) if out is not None]
     cols = _Rows(p, rows, tracked)
     finals = steps(p, rows, cols)
     cols.copy_to(arrays)

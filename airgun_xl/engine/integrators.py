@@ -64,9 +64,10 @@ def divergence_error(integrator, p, row, arrays):
     if quirk is not None:
         return DivergenceError(
             f"{where}; the cause is {quirk}; expected --unloading continuous (the same shot "
-            "without the quirk)", row, time_at, dict(zip(names, values)), "unloading quirk")
+            "without the quirk)", row, time_at, dict(zip(names, values, strict=True)),
+            "unloading quirk")
     return DivergenceError(f"{where}; expected a smaller E2 (Timestep) or the newmark "
-                           "integrator", row, time_at, dict(zip(names, values)))
+                           "integrator", row, time_at, dict(zip(names, values, strict=True)))
 
 
 @dataclass

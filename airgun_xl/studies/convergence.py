@@ -105,7 +105,7 @@ def ladder(shot, deltas, integrator="legacy", rtol=1e-3):
     for q, _, _ in QUANTITIES:
         for lv in levels:
             lv.errors[q] = _relative(lv.figures[q], ref[q])
-        for a, b in zip(levels, levels[1:-1]):  # orders need a non-zero error at b
+        for a, b in zip(levels, levels[1:-1], strict=False):  # orders need a non-zero error at b
             ea, eb = a.errors[q], b.errors[q]
             if ea > 0 and eb > 0:
                 a.order[q] = math.log(ea / eb) / math.log(a.delta / b.delta)

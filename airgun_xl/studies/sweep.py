@@ -99,7 +99,7 @@ def _evaluate(p, varied, rows_values, integrator, model, progress, runner=None):
     for i, row in enumerate(rows_values):
         q = p
         try:
-            for (cell, fields), value in zip(varied, row, strict=True):
+            for (_cell, fields), value in zip(varied, row, strict=True):
                 q = _set(q, fields, value)
             params.append(apply_model(q, model))
         except AirgunXlError:
@@ -134,7 +134,7 @@ def monte_carlo(p, sds, n, seed=None, integrator="legacy", model="4-mass", progr
     check_spreads(p, sds)
     rng = np.random.default_rng(seed)
     columns = []
-    for cell, fields, sd, relative in sds:
+    for _cell, fields, sd, relative in sds:
         mean = getattr(p, fields[0])
         columns.append(rng.normal(mean, sd * abs(mean) if relative else sd, n))
     samples = np.column_stack(columns) if columns else np.zeros((n, 0))

@@ -179,7 +179,7 @@ def write_calibration(path, shot, cal, files, options, force=False):
         ws.write_row(row, 0, ["Shot", "RMS error before", "RMS error after",
                               "ISO/TS 18571 before", "ISO/TS 18571 after"], style.header)
         ws.set_row(row, 30)
-        for i, (b, a) in enumerate(zip(cal.before, cal.after), start=1):
+        for i, (b, a) in enumerate(zip(cal.before, cal.after, strict=True), start=1):
             row += 1
             style.number(ws, row, 0, i, "count")
             ws.write_number(row, 1, b.rms, pct)

@@ -126,15 +126,16 @@ class ColumnsWorksheet(SafeWorksheet):
                 style = f'" s="{fmt._get_xf_index()}"><v>'
                 texts[k] = [t.replace('"><v>', style, 1) for t in texts[k]]
         spans = [(col, first, first + len(values), t)
-                 for (col, first, values), t in zip(pieces, texts)]
+                 for (col, first, values), t in zip(pieces, texts, strict=True)]
         edges = sorted({s[1] for s in spans} | {s[2] for s in spans})
         rows = {}
-        for a, b in zip(edges, edges[1:]):  # the set of covering runs is fixed in [a, b)
+        # the set of covering runs is fixed in [a, b)
+        for a, b in zip(edges, edges[1:], strict=False):
             cover = [(col, t[a - first:b - first]) for col, first, end, t in spans
                      if first <= a and b <= end]
             if cover:
                 cols = [col for col, _ in cover]
-                for row, parts in enumerate(zip(*(t for _, t in cover)), start=a):
+                for row, parts in enumerate(zip(*(t for _, t in cover), strict=True), start=a):
                     rows[row] = (cols, parts)
         return rows
 
@@ -158,7 +159,7 @@ class ColumnsWorksheet(SafeWorksheet):
                 else:
                     write(f'<row r="{row + 1}">')
                 if table:  # merge xlsxwriter's own cells in column order
-                    by_col = dict(zip(cols, parts))
+                    by_col = dict(zip(cols, parts, strict=True))
                     for col in sorted(set(table) | set(cols)):
                         if col in table:
                             self._write_cell(row, col, table[col])

@@ -97,15 +97,16 @@ def _read_zip(path, data):
                                       keep_links=False)
         sheets = {}
         wanted = None  # after the first sheet: the other sheets its formulas name, and Outputs
-        for ws_f, ws_v in zip(wb_f.worksheets, wb_v.worksheets):
+        for ws_f, ws_v in zip(wb_f.worksheets, wb_v.worksheets, strict=True):
             first = not sheets
             if not first and ws_f.title.upper() not in wanted:
                 continue  # e.g. the Tracked or ChartData sheets of a filled workbook
             cells = {}
             max_col = PARAMETER_COLUMNS if first else OTHER_COLUMNS
             for row_f, row_v in zip(ws_f.iter_rows(max_row=limits.BLOCK_ROWS, max_col=max_col),
-                                    ws_v.iter_rows(max_row=limits.BLOCK_ROWS, max_col=max_col)):
-                for cf, cv in zip(row_f, row_v):
+                                    ws_v.iter_rows(max_row=limits.BLOCK_ROWS, max_col=max_col),
+                                    strict=True):
+                for cf, cv in zip(row_f, row_v, strict=True):
                     if cf.value is None or not hasattr(cf, "column"):
                         continue
                     cells[(cf.row, cf.column)] = (cv.value, _formula_text(cf))

@@ -52,11 +52,11 @@ def write_about(ws, about, bold):
 
 def write_number_columns(ws, first_row, columns):
     """Write ``{col: array}`` down from ``first_row``; NaN cells are left empty."""
-    for col, values in columns.items():
-        values = np.asarray(values, dtype=float)
+    for col, given in columns.items():
+        values = np.asarray(given, dtype=float)
         finite = np.concatenate(([False], np.isfinite(values), [False]))
         edges = np.flatnonzero(np.diff(finite.astype(np.int8)))
-        for start, stop in zip(edges[0::2].tolist(), edges[1::2].tolist()):
+        for start, stop in zip(edges[0::2].tolist(), edges[1::2].tolist(), strict=True):
             if ws.write_number_column(first_row + start, col, values[start:stop]) == -1:
                 raise OutputError(f"{ws.get_name()}: {stop - start:,} rows from row "
                                   f"{first_row + start + 1:,} pass the sheet's last row; "
@@ -252,11 +252,12 @@ def write_summary(wb, result, summary, timings, name="Summary"):
         ws.write_string(0, col, heading, style.bold)
     rows = _summary_rows(result, summary, timings)
     flags = flagged_figures(timings.get("warnings", []))
-    for row, (label, value, code, note) in enumerate(rows, 1):
+    for row, (label, value, code, definition) in enumerate(rows, 1):
         ws.write_string(row, 0, label)
+        note = definition
         if label in flags:  # a figure the warnings below put in doubt, flagged where shown
             note = f"DOUBTED: see the warnings on {', '.join(flags[label])}" + (
-                f"; {note}" if note else "")
+                f"; {definition}" if definition else "")
         if isinstance(value, (float, int, np.floating, np.integer)) and not isinstance(value,
                                                                                          bool):
             ws.write_number(row, 1, shown(float(value), code),

@@ -62,7 +62,7 @@ def add_srs_sheets(wb, frequencies, spectrum_kg, about, shot=None, requirement=N
 
     # the chart's series: one contiguous copy, right of the printed range
     ws.write_row(0, CHART_DATA_COL, ["Chart data: frequency (Hz)", "SRS (g)"], style.bold)
-    for i, (f, v) in enumerate(zip(frequencies.tolist(), g.tolist()), start=1):
+    for i, (f, v) in enumerate(zip(frequencies.tolist(), g.tolist(), strict=True), start=1):
         style.number(ws, i, CHART_DATA_COL, f, "Hz-plain")
         style.number(ws, i, CHART_DATA_COL + 1, v, "g")
     chart = wb.add_chart({"type": "scatter", "subtype": "straight"})

@@ -212,7 +212,7 @@ def _write_spread(wb, result, stats, style, shot):
     peaks = result.figures[:, 0][np.isfinite(result.figures[:, 0])]
     counts, edges = np.histogram(peaks, bins=min(30, max(5, len(peaks) // 20)))
     ws.write_row(7, 0, ["Bin centre (kG)", "Shots"], style.bold)
-    for i, (c, lo, hi) in enumerate(zip(counts, edges, edges[1:]), start=8):
+    for i, (c, lo, hi) in enumerate(zip(counts, edges, edges[1:], strict=False), start=8):
         style.number(ws, i, 0, float(0.5 * (lo + hi)), "kG")
         style.number(ws, i, 1, int(c), "count")
     chart = wb.add_chart({"type": "column"})

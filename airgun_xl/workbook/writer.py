@@ -138,7 +138,7 @@ def _sheet1_columns(result, outputs, keep):
 def _filtered_cells(result, stride):
     """(sheet row, value) of the filtered samples that fall on written rows."""
     return [(r // stride + 1, v) for r, v in zip(result.filtered.rows.tolist(),
-                                                  result.filtered.values.tolist())
+                                                  result.filtered.values.tolist(), strict=True)
             if r % stride == 0]
 
 
