@@ -147,8 +147,9 @@ def fill_one(path, settings, warn, note=None, progress_for=None, started=None):
     try:
         filled = fill_workbook(shot, output, outputs, options, warn, started, note, progress)
     finally:
-        if hasattr(progress, "close"):
-            progress.close()
+        close = getattr(progress, "close", None)
+        if close is not None:
+            close()
     return output, filled, root
 
 
@@ -228,7 +229,7 @@ def fill_task(path, settings):
     faults: they are its row's status)."""
     path = Path(path)
     output = Path(settings.output) if settings.output else default_output(path)
-    warnings = []
+    warnings: list = []
     try:
         output, filled, _ = fill_one(path, settings, warnings.extend, None,
                                      lambda rows: _check_stop)

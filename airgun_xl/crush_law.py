@@ -43,8 +43,8 @@ class CrushLaw:
         coefficients are the same law).
     """
 
-    coefficients: tuple = LEGACY_COEFFICIENTS
-    v_range: tuple = CRUSH_FIT_RANGE
+    coefficients: tuple[float, ...] = LEGACY_COEFFICIENTS
+    v_range: tuple[float, float] = CRUSH_FIT_RANGE
     name: str = "legacy"
     source: str = field(default="", compare=False)
 

@@ -166,7 +166,7 @@ class ColumnDiff:
     max_abs: float
     max_rel: float
     outside: int
-    first_outside: dict = None  # row (sheet), time, legacy, new
+    first_outside: dict | None = None  # row (sheet), time, legacy, new
 
 
 @dataclass
@@ -186,7 +186,7 @@ class DiffReport:
     #: Whether the parameter cells were compared here (archived runs: by the caller).
     inputs_compared: bool = True
     #: The column furthest apart, for --report: (name, time, legacy values, new values).
-    worst: tuple = None
+    worst: tuple | None = None
 
     @property
     def same(self):

@@ -32,7 +32,7 @@ class Options:
     command: tuple = ()  # the command line, for provenance
     archive: object = None  # an ArchiveRequest: also store the run as an archive entry
     force_word: str = "--force"  # how messages name `force`
-    srs_requirement: tuple = None  # (frequencies [Hz], levels [kG], Q): SRS sheets, drawn over
+    srs_requirement: tuple | None = None  # (frequencies [Hz], levels [kG], Q): SRS sheets
 
 
 @dataclasses.dataclass

@@ -19,7 +19,8 @@ LIBRARIES = ("numpy", "pandas", "openpyxl", "xlsxwriter", "formulas", "python-ca
 
 
 def _versions():
-    out = {"python": platform.python_version(), "airgun-xl": __version__}
+    out: dict[str, str | None] = {"python": platform.python_version(),
+                                  "airgun-xl": __version__}
     for name in LIBRARIES:
         try:
             out[name] = metadata.version(name)

@@ -115,14 +115,14 @@ def load_law(root, ref):
         record = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError) as exc:
         raise ArchiveError(f"{display(path)}: cannot be read ({exc})") from None
-    name = m.group("name")
+    name = str(ref).strip().partition("@")[0]
     return _law(record, f"{name}@{version}", path), record
 
 
 def list_laws(root):
     """Every stored law version: ``[{"ref", "v_range", "shots", "created"}]``, by name."""
     base = Path(root) / LAWS
-    out = []
+    out: list = []
     if not base.is_dir():
         return out
     for folder in sorted(p for p in base.iterdir() if p.is_dir() and not p.is_symlink()):

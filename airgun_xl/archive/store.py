@@ -34,6 +34,7 @@ import sqlite3
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from ..choices import ARCHIVE_ENV
 from ..errors import ArchiveError, OptionError
@@ -413,6 +414,7 @@ class Archive:
             found = [e for e in candidates if e.id == int(by_id.group(1))]
         else:
             match = re.fullmatch(r"(.+?)(?:@(\d+)|/v(\d+))?", ref)
+            assert match is not None  # any non-empty text matches
             name, version = match.group(1), match.group(2) or match.group(3)
             found = [e for e in candidates if e.shot == safe_name(name)
                      and (version is None or e.version == int(version))]
@@ -494,10 +496,10 @@ class PendingEntry:
 
     def __init__(self, archive, shot, work):
         self.archive, self.shot, self.work = archive, shot, work
-        self.manifest = None
-        self.conn = None
-        self.final = None
-        self.entry = None
+        self.manifest: Any = None  # the entry's manifest, set by Archive.prepare
+        self.conn: Any = None  # the index connection holding the write lock, from prepare
+        self.final: Any = None  # the entry's folder, from prepare
+        self.entry: Entry | None = None  # once committed
 
     def prepare(self, txn=None):
         """Lock the index, recover, pick the version; return the path of the manifest that

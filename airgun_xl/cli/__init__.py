@@ -27,8 +27,8 @@ def _signals(restore=True):
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    wanted = {getattr(signal, n): on_signal for n in ("SIGINT", "SIGTERM", "SIGHUP")
-              if hasattr(signal, n)}
+    wanted: dict = {getattr(signal, n): on_signal for n in ("SIGINT", "SIGTERM", "SIGHUP")
+                    if hasattr(signal, n)}
     if hasattr(signal, "SIGXFSZ"):
         wanted[signal.SIGXFSZ] = signal.SIG_IGN
     reset_signals()
@@ -82,8 +82,10 @@ def main(argv=None):
     if argv is None:  # the command itself, not a caller's in-process run
         sys.unraisablehook = _unraisable(sys.unraisablehook)
     for stream in (sys.stdout, sys.stderr):  # a file name may hold undecodable bytes
-        with contextlib.suppress(AttributeError, ValueError, OSError):
-            stream.reconfigure(errors="backslashreplace")
+        reconfigure = getattr(stream, "reconfigure", None)  # a TextIOWrapper's
+        with contextlib.suppress(ValueError, OSError):
+            if reconfigure is not None:
+                reconfigure(errors="backslashreplace")
     try:
         with _signals(restore=argv is not None):  # before numpy and the engine load
             from .commands import build_parser
@@ -126,7 +128,7 @@ def main(argv=None):
         return 0
 
 
-_WARNED = set()
+_WARNED: set = set()
 
 
 def note(messages):

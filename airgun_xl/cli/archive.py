@@ -70,8 +70,8 @@ def parse_where(text):
     cell, _, value = str(text).partition("=")
     cell = cell.strip().upper()
     try:
-        lo, _, hi = value.partition(":")
-        lo, hi = float(lo), float(hi) if hi.strip() else float(lo)
+        first, _, second = value.partition(":")
+        lo, hi = float(first), float(second) if second.strip() else float(first)
         ok = math.isfinite(lo) and math.isfinite(hi) and lo <= hi
     except ValueError:
         ok = False

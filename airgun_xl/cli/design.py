@@ -79,9 +79,9 @@ def run(args):
             design = solve_peak(shot.params, target, variables[0], args.filtered,
                                 args.integrator, args.model, bounds, runner=runner)
         else:
-            design = solve_peak_and_duration(shot.params, target, duration, *variables,
-                                             args.filtered, args.integrator, args.model,
-                                             runner=runner)
+            design = solve_peak_and_duration(shot.params, target, duration, variables[0],
+                                             variables[1], args.filtered, args.integrator,
+                                             args.model, runner=runner)
     solve_seconds = time.perf_counter() - started
     for var, value in zip(design.variables, design.values, strict=True):
         print(f"{var.cell}{'..A30' if var.cell == 'A28' else ''} = {value:.6g} {var.unit}")

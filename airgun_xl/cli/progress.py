@@ -22,7 +22,7 @@ STAGES = {"running": 0.0, "summarizing": 0.15, "writing the workbook": 0.25,
 WIDTH = 30
 
 #: The bar on screen now, if any: other messages clear its line first.
-ACTIVE = []
+ACTIVE: list = []
 
 
 def clear_line(stream):
@@ -86,7 +86,8 @@ class Progress:
         if not self.enabled:
             return
         self._stop.set()
-        self._thread.join()
+        if self._thread is not None:
+            self._thread.join()
         ACTIVE.clear()
         self.stream.write("\r\x1b[K")
         self.stream.flush()

@@ -32,7 +32,7 @@ class Batch:
 
     figures: np.ndarray
     diverged: np.ndarray
-    stats: list = None  # each shot's KernelStats (None where it diverged)
+    stats: list | None = None  # each shot's KernelStats (None where it diverged)
 
     def column(self, name):
         return self.figures[:, FIGURES.index(name)]
@@ -58,7 +58,7 @@ def run_batch(params, integrator="legacy", host="excel", threads=2, progress=Non
     figures = np.full((n, len(FIGURES)), np.nan)
     diverged = np.zeros(n, dtype=bool)
     stats = [None] * n
-    groups = {}
+    groups: dict = {}
     for i, p in enumerate(params):
         groups.setdefault(_grid_key(p), []).append(i)
     pool = ThreadPoolExecutor(threads) if threads > 1 else None

@@ -33,7 +33,7 @@ class KernelStats:
     min_relative_velocity: float
     max_crushed_mass: float
     max_crush: float
-    past_bound: int = None  # first row index past displacement_bound (the quirk's run), or None
+    past_bound: int | None = None  # first row index past displacement_bound (quirk's run)
     unloading_onsets: int = 0  # unloading phases begun
     second_onset: int = -1  # row index of the second (where the macro's force jumps), or -1
 
@@ -59,7 +59,7 @@ def divergence_error(integrator, p, row, arrays):
     where = (f"the {integrator} scheme diverged at step {row - 1:,} (t = {time_at:.6g} s): "
              f"{names[worst]} = {values[worst]:.3g} m, beyond the {displacement_bound(p):.3g} m "
              "no physical run reaches")
-    quirk = (unloading_quirk(History(*arrays, np.nan, np.nan, 0.0), stop=row)
+    quirk = (unloading_quirk(History.from_arrays(arrays, np.nan, np.nan, 0.0), stop=row)
              if p.unloading == "macro" and _chain_stable(p, integrator) else None)
     if quirk is not None:
         return DivergenceError(
@@ -103,22 +103,32 @@ class History:
     y31: np.ndarray
     y32: np.ndarray
     y33: np.ndarray
-    crush_factor: np.ndarray
-    m31: np.ndarray
-    deflection: np.ndarray
-    x_plastic: np.ndarray
-    force: np.ndarray
-    m1: np.ndarray
-    v1: np.ndarray
-    v31: np.ndarray
+    crush_factor: np.ndarray | None  # the tracked step values: None when not tracked
+    m31: np.ndarray | None
+    deflection: np.ndarray | None
+    x_plastic: np.ndarray | None
+    force: np.ndarray | None
+    m1: np.ndarray | None
+    v1: np.ndarray | None
+    v31: np.ndarray | None
     final_m1: float
     final_m31: float
     kernel_seconds: float
-    stats: KernelStats = None
+    stats: KernelStats | None = None
+
+    @classmethod
+    def from_arrays(cls, arrays, final_m1, final_m31, kernel_seconds):
+        """From the kernel's 13 buffers in :data:`COLUMNS` order (time, the four
+        displacements, then the tracked step values, None where not tracked)."""
+        return cls(**dict(zip(COLUMNS, arrays, strict=True)), final_m1=final_m1,
+                   final_m31=final_m31, kernel_seconds=kernel_seconds)
 
 
 #: The step values an integrator can record, in :class:`History` order.
 TRACKED = choices.TRACKED
+
+#: The kernel's buffers, in its order: :class:`History`'s arrays.
+COLUMNS = ("time", "y1", "y31", "y32", "y33") + tuple(TRACKED)
 
 
 def kernel_stats(finals, past_bound=None):
@@ -176,7 +186,7 @@ def _run(kernel, name, p, track):
         if f["bad_row"] >= 0:
             raise divergence_error(name, p, f["bad_row"], arrays)
         past_bound = error.row
-    history = History(*arrays, f["final_m1"], f["final_m31"], elapsed)
+    history = History.from_arrays(arrays, f["final_m1"], f["final_m31"], elapsed)
     history.stats = kernel_stats(f, past_bound)
     return blank_left_out(history, p)
 

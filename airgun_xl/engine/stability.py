@@ -77,10 +77,10 @@ class CriticalStep:
     dt_crit: float
     ratio: float
     limiting: str
-    dt_compacted: float = None
-    unstable_length: float = None
-    unstable_crush: float = None
-    dt_unloading: float = None
+    dt_compacted: float | None = None
+    unstable_length: float | None = None
+    unstable_crush: float | None = None
+    dt_unloading: float | None = None
 
     @property
     def verdict(self):

@@ -78,8 +78,8 @@ class LawCalibration:
     law: CrushLaw
     iterations: list = field(default_factory=list)
     converged: bool = False
-    velocity: np.ndarray = None  # the last iteration's samples: V [m/s]
-    factor: np.ndarray = None  # and X [-], the measured crush factor
+    velocity: np.ndarray | None = None  # the last iteration's samples: V [m/s]
+    factor: np.ndarray | None = None  # and X [-], the measured crush factor
 
 
 @dataclass
@@ -260,7 +260,8 @@ def refine_law(pairs, law, integrator="legacy", degree=DEGREE):
     """
     from scipy.optimize import least_squares
 
-    nodes = _chebyshev_nodes(*law.v_range, degree + 1)
+    lo, hi = law.v_range
+    nodes = _chebyshev_nodes(lo, hi, degree + 1)
     x0 = np.concatenate([law.poly(nodes), np.zeros(len(pairs))])
     steps = np.array([rec.trace.dt for _, rec in pairs])
     evaluations = [0]
@@ -441,8 +442,8 @@ class Calibration:
     seconds: float = 0.0
     errors: dict = field(default_factory=dict)  # standard error of each fitted value
     bounds: dict = field(default_factory=dict)  # (low, high) of each fitted value
-    law_nodes: np.ndarray = None  # [m/s] where the law's standard errors are
-    law_errors: np.ndarray = None  # [-] standard errors of the law's values there
+    law_nodes: np.ndarray | None = None  # [m/s] where the law's standard errors are
+    law_errors: np.ndarray | None = None  # [-] standard errors of the law's values there
     recordings: list = field(default_factory=list)  # each shot's measured Recording
     warnings: list = field(default_factory=list)
     notes: list = field(default_factory=list)  # said with the figures; no verdict on them

@@ -128,7 +128,7 @@ def before_run(p, integrator="legacy"):
                              "of rows: the legacy filtered column is ill-defined (Excel "
                              "drifts a row per sample, LibreOffice writes zeros)"))
     masses = {c: m for c, m in (("B2", p.m31), ("C2", p.m32), ("D2", p.m33)) if m > 0}
-    light = min(masses, key=masses.get)
+    light = min(masses, key=lambda cell: masses[cell])
     heavy = max(list(masses.values()) + [p.m1 + p.mmitigator])
     if heavy / masses[light] >= MASS_RATIO_WARNING:
         found.append(Finding("warning", light, f"{masses[light]:.3g} kg is "

@@ -60,7 +60,7 @@ class ClusterRunner:
         futures = [self.client.submit(run_chunk, params[i:i + self.chunk], integrator, host,
                                       pure=False) for i in starts]
         index = {f.key: n for n, f in enumerate(futures)}
-        parts = [None] * len(futures)
+        parts: list = [None] * len(futures)
         for future in as_completed(futures):
             n = index[future.key]
             parts[n] = future.result()

@@ -74,7 +74,9 @@ MIN_TIMED = 0.05
 def run_level(shot, delta, integrator):
     """Run one level; its times are the fastest of enough repeats to measure."""
     leveled = shot.with_params(delta=delta)
-    totals, kernels, spent = [], [], 0.0
+    totals: list = []
+    kernels: list = []
+    spent = 0.0
     while not totals or (spent < MIN_TIMED and len(totals) < 5):
         started = time.perf_counter()
         result = leveled.run(integrator=integrator, track=("deflection", "v31", "v1"))

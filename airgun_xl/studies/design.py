@@ -178,13 +178,13 @@ def solve_peak_and_duration(p, target_kg, target_s, var1, var2, filtered=False,
 
     lo, hi = var2.bounds(p)
     xs = np.linspace(lo, hi, 9)
-    ds = []
+    durations = []
     for x in xs:
         try:
-            ds.append(duration_at(x)[0])
+            durations.append(duration_at(x)[0])
         except DesignError:
-            ds.append(math.nan)
-    ds = np.array(ds)
+            durations.append(math.nan)
+    ds = np.array(durations)
     bracket = _bracket(xs, ds, target_s)
     if bracket is None:
         finite = ds[np.isfinite(ds)]

@@ -53,15 +53,15 @@ class Comparison:
     interval: tuple = (np.nan, np.nan)  # the rating's evaluation interval [s], as ``time``
     predicted_spectrum: object = None  # engine.summary.Spectrum of the aligned traces
     measured_spectrum: object = None
-    srs_frequencies: np.ndarray = None  # [Hz]
-    predicted_srs: np.ndarray = None  # maximax, Q = 10 [kG]
-    measured_srs: np.ndarray = None
-    rigid_kg: np.ndarray = None  # the rigid model's prediction on ``time`` (Fig. 13)
+    srs_frequencies: np.ndarray | None = None  # [Hz]
+    predicted_srs: np.ndarray | None = None  # maximax, Q = 10 [kG]
+    measured_srs: np.ndarray | None = None
+    rigid_kg: np.ndarray | None = None  # the rigid model's prediction on ``time`` (Fig. 13)
     baseline: object = None  # the recording's Baseline: offset and noise (pre-trigger)
     noise_filtered: float = np.nan  # [kG], the pre-trigger noise after the filter
     level: float = IMPACT_FRACTION  # the impact level, a fraction of the peak
     shifts: dict = field(default_factory=dict)  # {"threshold": s, "xcorr": s}
-    anti_alias: float = None  # [Hz] modelled on the prediction, or None
+    anti_alias: float | None = None  # [Hz] modelled on the prediction, or None
     srs_record: str = ""  # which record the SRS are of
     warnings: list = field(default_factory=list)
 
@@ -208,7 +208,7 @@ class Recording:
     sustain: int  # samples the level must hold
     cfc: object
     warnings: list = field(default_factory=list)
-    anti_alias: float = None  # [Hz] modelled on the prediction, or None
+    anti_alias: float | None = None  # [Hz] modelled on the prediction, or None
 
 
 def prepare(trace, cfc=None, anti_alias=None, dt_model=None):

@@ -48,7 +48,7 @@ class Recorder:
     """
 
     rate: float = 50_000.0
-    anti_alias: float = None
+    anti_alias: float | None = None
     poles: int = 4
     noise: float = 0.03
     offset_g: float = 50.0

@@ -31,12 +31,15 @@ def parse_vary(text):
     """``A28=100:260:161`` -> (cell, fields, values)."""
     match = re.fullmatch(r"\s*([A-Za-z]+[0-9]+)\s*=\s*([^:]+):([^:]+):(\d+)\s*", text)
     try:
+        if match is None:
+            raise ValueError(text)
         lo, hi, n = float(match.group(2)), float(match.group(3)), int(match.group(4))
-    except (AttributeError, ValueError):
+    except ValueError:
         n = 0
     if n < 1 or n > limits.MAX_SHOTS or not (math.isfinite(lo) and math.isfinite(hi)):
         raise OptionError(f"--vary: found {text!r}, expected CELL=LO:HI:N with finite LO and "
                           f"HI and 1 <= N <= {limits.MAX_SHOTS:,}, such as A28=100:260:161")
+    assert match is not None  # n = 0 above otherwise
     cell, fields = fields_of(match.group(1), "--vary")
     return cell, fields, np.linspace(lo, hi, n)
 
@@ -45,11 +48,14 @@ def parse_sd(text):
     """``E40=3%`` (relative) or ``E40=8e5`` (absolute) -> (cell, fields, sd, relative)."""
     match = re.fullmatch(r"\s*([A-Za-z]+[0-9]+)\s*=\s*([0-9.eE+-]+)\s*(%?)\s*", text)
     try:
+        if match is None:
+            raise ValueError(text)
         sd = float(match.group(2))
-    except (AttributeError, ValueError):
+    except ValueError:
         sd = -1.0
     if not (sd >= 0 and math.isfinite(sd)):
         raise OptionError(f"--sd: found {text!r}, expected CELL=SD or CELL=SD% such as E40=3%")
+    assert match is not None  # sd = -1 above otherwise
     cell, fields = fields_of(match.group(1), "--sd")
     return cell, fields, sd / 100 if match.group(3) else sd, bool(match.group(3))
 
@@ -78,12 +84,12 @@ class SweepResult:
     figures: np.ndarray  # shots x FIGURES
     diverged: np.ndarray
     invalid: np.ndarray  # shots whose sampled values were not a valid shot
-    flags: list = None  # each shot's warnings (str), as a fill of it would say them
+    flags: list | None = None  # each shot's warnings (str), as a fill of it would say them
     kind: str = "grid"  # "grid" (every combination), "montecarlo" or "sobol" (samples)
 
     def flagged(self):
         """How many shots have a warning, and how often each cell is named: (n, {cell: n})."""
-        cells = {}
+        cells: dict = {}
         for found in self.flags or []:
             for cell in sorted({text.split(" ", 1)[0] for text in found}):
                 cells[cell] = cells.get(cell, 0) + 1
@@ -109,9 +115,9 @@ def _evaluate(p, varied, rows_values, integrator, model, progress, runner=None):
     diverged = np.zeros(len(rows_values), dtype=bool)
     figures[~invalid] = batch.figures
     diverged[~invalid] = batch.diverged
-    flags = [[] for _ in rows_values]
-    for i, q, stats in zip(np.flatnonzero(~invalid), params, batch.stats, strict=True):
-        flags[i] = ([] if stats is None else [str(f) for f in shot_findings(q, stats)])
+    flags: list = [[] for _ in rows_values]
+    for k, q, stats in zip(np.flatnonzero(~invalid), params, batch.stats, strict=True):
+        flags[k] = ([] if stats is None else [str(f) for f in shot_findings(q, stats)])
     return figures, diverged, invalid, flags
 
 

@@ -257,8 +257,8 @@ def recover(folder):
         entries = list(os.scandir(folder))
     except OSError:
         return
-    owned = [(e, _OWNED.match(e.name)) for e in entries]
-    owned = [(e, m) for e, m in owned if m and not owner_alive(m["owner"])]
+    matches = [(e, _OWNED.match(e.name)) for e in entries]
+    owned = [(e, m) for e, m in matches if m is not None and not owner_alive(m["owner"])]
     for entry, m in owned:
         if m["kind"] != "journal":
             continue

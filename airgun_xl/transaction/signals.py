@@ -1,6 +1,7 @@
 """The command's signal state: SIGINT, SIGTERM and SIGHUP raise :class:`Interrupted` where
 the program is, so that cleanup runs, or are held back during a commit."""
 import contextlib
+from typing import Any
 
 
 class Interrupted(KeyboardInterrupt):
@@ -9,11 +10,12 @@ class Interrupted(KeyboardInterrupt):
     def __init__(self, signum):
         super().__init__(signum)
         self.signum = signum
+        self.rows: list = []  # a campaign's rows so far, when it stopped one
 
 
 #: The signal state of this command: sections holding signals back, a signal that arrived
 #: while held (or was swallowed by a finalizer), and whether a publication has committed.
-SIGNALS = {"held": 0, "pending": None, "committed": False}
+SIGNALS: dict[str, Any] = {"held": 0, "pending": None, "committed": False}
 
 
 def reset_signals():

@@ -192,7 +192,7 @@ def write_calibration(path, shot, cal, files, options, force=False):
         row += 2
 
         # the law against the macro's, over its range; the last iteration's samples
-        grid = np.linspace(*law.v_range, 101)
+        grid = np.linspace(law.v_range[0], law.v_range[1], 101)
         data = wb.add_worksheet("Law", worksheet_class=ColumnsWorksheet)
         data.write_row(0, 0, ["Relative velocity (m/s)", "Macro's law (-)", "Fitted law (-)",
                               "Sample velocity (m/s)", "Sample crush factor (-)"], bold)

@@ -41,10 +41,10 @@ class ChartSpec:
     x_title: str
     y_title: str
     series: tuple
-    x_range: tuple = None  # (min, max); None: the run's time span
-    y2_title: str = None
-    y_format: str = None  # the y axis's number format (None: by its span)
-    x_format: str = None  # the x axis's ("0.0," shows Hz as kHz)
+    x_range: tuple | None = None  # (min, max); None: the run's time span
+    y2_title: str | None = None
+    y_format: str | None = None  # the y axis's number format (None: by its span)
+    x_format: str | None = None  # the x axis's ("0.0," shows Hz as kHz)
 
 
 #: Lowest frequency the spectrum chart shows: below it the pulse's own content (4.2 kG at 0 Hz
@@ -255,7 +255,8 @@ def add_charts(workbook, sheet, refs, data, max_time, labels=None, x_ranges=None
             on_axis = [s for s in present if s.y2 == secondary]
             if not on_axis:
                 continue
-            ys = np.concatenate([_in_range(*data[s.key], x_range) for s in on_axis])
+            ys = np.concatenate([_in_range(data[s.key][0], data[s.key][1], x_range)
+                                 for s in on_axis])
             ylo, yhi = nice_range(ys, include_zero=True)
             if secondary:
                 chart.set_y2_axis(_axis(spec.y2_title, ylo, yhi, gridlines=False))

@@ -64,7 +64,8 @@ def write_diff_report(report, path, force=False):
                 ws.write_string(row, 1, "; ".join(names))
         one_page(ws, max(row, 16), len(headers) - 1, shot=shot, title="Diff")
         if report.worst is not None:
-            _write_worst(wb, *report.worst, shot=shot)
+            name, time, legacy, new = report.worst
+            _write_worst(wb, name, time, legacy, new, shot=shot)
 
 
 def _write_worst(wb, name, time, x, y, shot=None):

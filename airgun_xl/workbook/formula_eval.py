@@ -111,8 +111,8 @@ def _compile(formula):
 
 def _scalar(result):
     """A Python value from a ``formulas`` result: float, str, bool, None, or '#ERR!' text."""
-    value = np.asarray(result, dtype=object)
-    value = value.reshape(-1)[0] if value.size else None
+    cells = np.asarray(result, dtype=object)
+    value = cells.reshape(-1)[0] if cells.size else None
     if value is None:
         return None
     if value is _empty():
@@ -188,7 +188,7 @@ class Evaluator:
             part = np.full(max_row - min_row + 1, _empty(), dtype=object)
             values = column[min_row - 1:max_row]
             part[:len(values)] = values
-            part[np.equal(part, None)] = _empty()
+            part[np.array([v is None for v in part], dtype=bool)] = _empty()
             return part.reshape(-1, 1)
         block = np.empty((max_row - min_row + 1, max_col - min_col + 1), dtype=object)
         for r in range(min_row, max_row + 1):

@@ -95,8 +95,8 @@ def _read_zip(path, data):
                                       keep_links=False)
         wb_v = openpyxl.load_workbook(io.BytesIO(data), read_only=True, data_only=True,
                                       keep_links=False)
-        sheets = {}
-        wanted = None  # after the first sheet: the other sheets its formulas name, and Outputs
+        sheets: dict = {}
+        wanted: set = set()  # after the first sheet: the sheets its formulas name, Outputs
         for ws_f, ws_v in zip(wb_f.worksheets, wb_v.worksheets, strict=True):
             first = not sheets
             if not first and ws_f.title.upper() not in wanted:
@@ -160,7 +160,7 @@ def _read_xls(path, data):
 
         wb = CalamineWorkbook.from_filelike(io.BytesIO(data))
         names = list(wb.sheet_names)
-        sheets = {}
+        sheets: dict = {}
         for name in names[:1] + [n for n in names[1:] if n.upper() in ("OUTPUTS", LAW_KEY)]:
             first = not sheets
             rows = wb.get_sheet_by_name(name).to_python(skip_empty_area=False)

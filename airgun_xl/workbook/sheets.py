@@ -25,8 +25,8 @@ class Ref:
     first_row: int
     last_row: int
     total: int  # points of the full-resolution series
-    x_sheet: str = None  # the x values on another sheet (None: on ``sheet``) ...
-    x_first_row: int = None  # ... from this row, as many as the y values
+    x_sheet: str | None = None  # the x values on another sheet (None: on ``sheet``) ...
+    x_first_row: int | None = None  # ... from this row, as many as the y values
 
     @property
     def points(self):
@@ -289,7 +289,7 @@ _DOUBTED = {"E19": _CRUSH_FIGURES, "E25": _CRUSH_FIGURES[2:],
 def flagged_figures(warnings):
     """{Summary label: [cells of the warnings that doubt it]} for a run's warnings (each
     starts with the cell it names, as ``E19 (...)``); a warning naming no cell doubts none."""
-    out = {}
+    out: dict = {}
     for text in warnings:
         cell = text.split(" ", 1)[0]
         if not (cell[:1].isalpha() and cell[1:].isdigit()):

@@ -183,7 +183,7 @@ def _write_warnings(wb, result, style, shot):
         ws.write_string(row, 0, cell)
         ws.write_string(row, 1, f"{n:,}")
         row += 1
-    counts = {}
+    counts: dict = {}
     for found in result.flags or []:
         for text in found:
             key = text if len(text) < 200 else text[:200] + "..."

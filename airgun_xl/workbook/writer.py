@@ -275,7 +275,8 @@ def _write_srs_sheets(wb, result, requirement, shot, name):
 def print_outputs_block(ws, block, shot):
     """The Outputs block on one page, its columns wide enough for their text (a label used
     to run past the print area and be cut off)."""
-    widths, cells_in_row = {}, {}
+    widths: dict = {}
+    cells_in_row: dict = {}
     for (row, _), (cached, _) in block.items():
         cells_in_row[row] = cells_in_row.get(row, 0) + (cached is not None)
     for (row, col), (cached, _) in block.items():
