@@ -1,7 +1,7 @@
 """The caps that keep an untrusted file, option or run from taking the machine down.
 
 Every cap is checked before the work it bounds starts, and each refusal is one line naming the
-file, cell or option, what was found and what is expected. README ("Security and limits")
+file, cell or option, what was found and what is expected. docs/security.md
 lists them; this module is the one place that holds the numbers.
 """
 

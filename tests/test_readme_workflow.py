@@ -1,6 +1,6 @@
-"""README's shell blocks (```sh), pasted in order, line by line, into a shell in one temp
-folder, work as written: each command exits 0, or the code its trailing '# exit N' comment
-states. The Python block runs as a script there too.
+"""README's shell blocks (```sh), and those of the documents in docs/, pasted in order, line
+by line, into a shell in one temp folder, work as written: each command exits 0, or the code
+its trailing '# exit N' comment states. The Python block runs as a script there too.
 
 Four commands are left out, each for a reason the test cannot reproduce: `pip install` (the
 test already runs in the installed package), `python -m pytest` (it would run this test again),
@@ -19,9 +19,24 @@ ROOT = Path(__file__).resolve().parents[1]
 NOT_RUN = ("pip install", "python -m pytest", "apt-get ", "../shared/legacy/run-legacy-macro")
 
 
+#: README, then the documents it links, in the order their sections had in README (later
+#: blocks use files that earlier ones made).
+DOCUMENTS = ("README.md", "docs/cell-map.md", "docs/output.md", "docs/trust.md",
+             "docs/studies.md", "docs/legacy.md", "docs/security.md", "docs/speed.md",
+             "docs/layout.md", "docs/dependencies.md")
+
+
 def _blocks(language):
-    text = (ROOT / "README.md").read_text()
+    text = "\n".join((ROOT / name).read_text() for name in DOCUMENTS)
     return re.findall(rf"^```{language}\n(.*?)^```", text, re.S | re.M)
+
+
+def test_the_documents_are_all_linked_from_the_readme():
+    """Every document in docs/ is in DOCUMENTS (its blocks run) and linked from README."""
+    readme = (ROOT / "README.md").read_text()
+    docs = sorted(f"docs/{p.name}" for p in (ROOT / "docs").glob("*.md"))
+    assert docs == sorted(DOCUMENTS[1:])
+    assert all(f"]({name})" in readme for name in docs)
 
 
 def _workspace(tmp_path):

@@ -95,3 +95,19 @@ def test_bad_sobol_options(tmp_path, capsys, args, start):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith(f"airgun-xl: error: {start}"), err
     assert not out.exists()
+
+
+def test_without_salib_sobol_names_its_extra(tmp_path, capsys, monkeypatch):
+    """Issue 24.10: SALib is an extra (it brings matplotlib, pandas and multiprocess); without
+    it, --sobol is one line naming the extra, and nothing is written."""
+    import sys
+
+    for name in [m for m in sys.modules if m == "SALib" or m.startswith("SALib.")]:
+        monkeypatch.delitem(sys.modules, name)
+    monkeypatch.setitem(sys.modules, "SALib", None)  # import SALib raises ImportError
+    out = tmp_path / "s.xlsx"
+    assert main(["sweep", str(TEMPLATE), "--sobol", "8", "--sd", "E40=3%", "--sd", "A28=2%",
+                 "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "pip install 'airgun-xl[sobol]'" in err
+    assert not out.exists()

@@ -65,7 +65,8 @@ def run(args):
     warn(shot.warnings)
     ladders = [ladder(shot, deltas, name, rtol) for name in integrators]
     drew = write_convergence(ladders, output, args.force, shot, png)
-    warn([] if drew else ["matplotlib is not installed: no PNG"])
+    warn([] if drew else ["matplotlib is not installed: no PNG (pip install "
+                          "'airgun-xl[plots]')"])
     print_table(ladders)
     print(f"wrote {output} and {png}")
     return 0

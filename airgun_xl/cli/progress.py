@@ -118,6 +118,11 @@ class CountBar:
         self.failed += bool(failed)
         self._draw()
 
+    def advance(self, n=1):
+        """``n`` more shots done (a study's chunk)."""
+        self.done += int(n)
+        self._draw()
+
     def _draw(self):
         if not self.enabled:
             return

@@ -1,5 +1,4 @@
 """``airgun-xl sweep SHOT.xlsx --vary A28=100:260:161``: many shots at once."""
-import sys
 import time
 from pathlib import Path
 
@@ -34,13 +33,14 @@ def add_parser(sub):
 
 
 def _progress_bar(total):
-    """A tqdm bar on a terminal; nothing when stderr is not a TTY (logs, CI)."""
-    if not sys.stderr.isatty():
-        return None, None
-    from tqdm import tqdm
+    """The one progress bar (cli/progress.py) on a terminal; nothing when stderr is not a TTY
+    (logs, CI)."""
+    from .progress import CountBar
 
-    bar = tqdm(total=total, unit="shot", file=sys.stderr)
-    return bar, bar.update
+    bar = CountBar(total)
+    if not bar.enabled:
+        return None, None
+    return bar, bar.advance
 
 
 def run(args):

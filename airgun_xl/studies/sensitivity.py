@@ -67,8 +67,12 @@ def sobol(p, sds, n, seed=None, integrator="legacy", model="4-mass", progress=No
         For fewer than two inputs, n not a power of 2, or sampled shots that are invalid or
         diverge (the indices need every shot).
     """
-    from SALib.analyze import sobol as analyze
-    from SALib.sample import sobol as sample
+    try:
+        from SALib.analyze import sobol as analyze
+        from SALib.sample import sobol as sample
+    except ImportError:
+        raise OptionError("--sobol: needs SALib, expected it installed: pip install "
+                          "'airgun-xl[sobol]'") from None
 
     if len(sds) < 2:
         raise OptionError(f"--sd: found {len(sds)}, expected two or more uncertain inputs for "
