@@ -210,8 +210,8 @@ def test_owner_liveness_asks_psutil_not_os_kill(monkeypatch):
             return started[self.pid]
 
     started = {4242: 1700000000.25}
-    monkeypatch.setattr(owners.psutil, "Process", FakeProcess)
-    monkeypatch.setattr(owners.psutil, "pid_exists", lambda pid: pid in started)
+    monkeypatch.setattr(psutil, "Process", FakeProcess)
+    monkeypatch.setattr(psutil, "pid_exists", lambda pid: pid in started)
     assert owners.owner_alive("4242.170000000025")  # the owner, same start time
     assert not owners.owner_alive("4242.170000000024")  # pid reused by a later process
     assert not owners.owner_alive("4343.170000000025")  # gone
