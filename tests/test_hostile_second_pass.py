@@ -529,3 +529,14 @@ def test_23_2_a_tdms_channel_past_the_sample_cap_is_one_line(tmp_path, capsys, m
     out = tmp_path / "c.xlsx"
     _refused(capsys, ["compare-measured", TEMPLATE, path, "-o", out],
              "holds 600 samples, expected at most 500 samples", out)
+
+
+def test_23_7_a_fitted_law_that_diverges_is_named_not_the_time_step(tmp_path, capsys):
+    """A 16-sample recording: the law the calibration fits makes the run diverge. The one
+    line names the fitted law and the recordings (it blamed E2, which the shot runs with)."""
+    t = np.arange(16) * 1e-5
+    rec = _csv(tmp_path / "short.csv", t, 10000 * np.sin(np.pi * t / 1.6e-4))
+    out = tmp_path / "cal.xlsx"
+    line = _refused(capsys, ["calibrate", TEMPLATE, rec, "-o", out],
+                    "the crush law fitted to the recordings makes the run diverge", out)
+    assert "E2" not in line.split("(")[0]

@@ -101,6 +101,20 @@ def _run(p, integrator):
     return Shot(p).run(integrator=integrator, track=TRACK)
 
 
+def _run_law(p, law, integrator):
+    """A run of ``p`` with a law the calibration fitted: when that law makes the run diverge,
+    the refusal names the law and the recordings, not the shot's time step."""
+    from ..errors import DivergenceError, StabilityError
+
+    try:
+        return _run(p.replace(crush_law=law), integrator)
+    except (DivergenceError, StabilityError) as exc:
+        raise OptionError(f"MEASURED: the crush law fitted to the recordings makes the run "
+                          f"diverge ({str(exc).split(';')[0]}), expected measured pulses that "
+                          "cover the crush of their shots (a longer record, the right --sign "
+                          "and units)") from None
+
+
 def align(result, rec, nudge=0.0):
     """The run's pulse on the measured :class:`~airgun_xl.studies.measured.Recording`'s grid,
     both filtered alike (its CFC class, and its anti-alias model on the run) and aligned at
@@ -208,7 +222,8 @@ def calibrate_law(pairs, cfc=None, degree=DEGREE, integrator="legacy",
     for number in range(1, max_iterations + 1):
         vs, xs, errors = [], [], []
         for p, trace in pairs:
-            a = align(_run(p.replace(crush_law=law), integrator), trace)
+            a = align(_run_law(p, law, integrator) if number > 1 else  # a fitted law
+                      _run(p.replace(crush_law=law), integrator), trace)
             v, x = law_samples(a)
             vs.append(v)
             xs.append(x)
@@ -269,7 +284,7 @@ def refine_law(pairs, law, integrator="legacy", degree=DEGREE):
     def residuals(x):
         evaluations[0] += 1
         trial = law_through(nodes, x[:len(nodes)], law.v_range)
-        aligned = [align(_run(p.replace(crush_law=trial), integrator), rec, nudge * dt)
+        aligned = [align(_run_law(p, trial, integrator), rec, nudge * dt)
                    for (p, rec), nudge, dt in zip(pairs, x[len(nodes):], steps, strict=True)]
         return _objective_residuals(aligned, "l2")
 
