@@ -60,6 +60,18 @@ def _say(text):
     print(text.encode(encoding, "backslashreplace").decode(encoding, "replace"), file=stream)
 
 
+def _interrupt_behind(exc):
+    """The :class:`Interrupted` a signal raised inside an import, which the importing module
+    (numpy, for one) turned into an ImportError; None when there is none."""
+    seen = 0
+    while exc is not None and seen < 20:
+        if isinstance(exc, Interrupted):
+            return exc
+        exc = exc.__cause__ or exc.__context__
+        seen += 1
+    return None
+
+
 #: Write errors a full disk or ``ulimit -f`` gives: already said in one line by the command.
 _FULL = (errno.EFBIG, errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC))
 
@@ -115,6 +127,13 @@ def main(argv=None):
     except Interrupted as exc:
         _say(f"airgun-xl: stopped by signal {exc.signum}; nothing was left half-written")
         return 128 + exc.signum
+    except ImportError as exc:  # a signal during a lazy import: the import reports it
+        signal_error = _interrupt_behind(exc)
+        if signal_error is None:
+            raise
+        _say(f"airgun-xl: stopped by signal {signal_error.signum}; nothing was left "
+             "half-written")
+        return 128 + signal_error.signum
     except KeyboardInterrupt:
         _say("airgun-xl: interrupted; nothing was left half-written")
         return 130
