@@ -80,3 +80,20 @@ def test_one_target_only(tmp_path, capsys):
     assert "not allowed with argument" in capsys.readouterr().err
     assert main(["design", str(TEMPLATE), "--target-srs", "r.csv", "--workers", "2"]) == 2
     assert "--workers: found with --target-srs" in capsys.readouterr().err
+
+
+def test_the_spectrums_sheet_carries_the_runs_warnings(tmp_path, capsys):
+    """Warnings travel with the figures: a designed shot that warns (E34 = 6,000 Hz makes
+    1/(E2 E34) fractional) lists the warning on its SRS sheet too, not only on the Summary."""
+    from conftest import template_with
+
+    shot = template_with(tmp_path, E34=6000.0)
+    spec = _spec(tmp_path / "req.csv", FREQUENCIES, _srs_at(200.0) * G_PER_KG * 0.9)
+    out = tmp_path / "d.xlsx"
+    assert main(["design", str(shot), "--target-srs", str(spec), "-o", str(out)]) == 0
+    printed = [line.removeprefix("airgun-xl: warning: ")
+               for line in capsys.readouterr().err.splitlines() if "E34" in line]
+    texts = [c for r in openpyxl.load_workbook(out)["SRS"].iter_rows(values_only=True)
+             for c in r if isinstance(c, str)]
+    assert printed and all(w in texts for w in printed)
+    assert any(t.startswith("Warnings (") for t in texts)

@@ -6,7 +6,7 @@ import numpy as np
 from ..units import KG_MS2, G
 from .charts import log_axis, titled
 from .report import Style, chart_size, one_page, report_workbook
-from .sheets import write_about
+from .sheets import write_about, write_warnings
 
 #: The macro's kG in standard g: shock labs give spectra in g.
 G_PER_KG = KG_MS2 / G
@@ -19,7 +19,7 @@ TABLE_ROWS = 27
 
 
 def add_srs_sheets(wb, frequencies, spectrum_kg, about, shot=None, requirement=None,
-                   name="SRS"):
+                   name="SRS", warnings=None):
     """Add the SRS sheet (the about lines and the chart, one landscape page) and the
     ``{name} table`` sheet (frequency [Hz], SRS [g] and [kG], in column groups of
     :data:`TABLE_ROWS`, one page).
@@ -34,6 +34,8 @@ def add_srs_sheets(wb, frequencies, spectrum_kg, about, shot=None, requirement=N
         Label and text lines for the head of the SRS sheet.
     requirement : (numpy.ndarray, numpy.ndarray), optional
         A required spectrum's frequencies [Hz] and levels [kG], drawn over the SRS.
+    warnings : list of str, optional
+        The run's warnings, listed under the about lines (the spectrum is of that run).
     """
     style = Style(wb)
     table = f"{name} table"
@@ -42,6 +44,8 @@ def add_srs_sheets(wb, frequencies, spectrum_kg, about, shot=None, requirement=N
     ws.set_column(0, 0, 22)
     ws.set_column(1, 1, 14)
     head = write_about(ws, about, style.bold)
+    if warnings is not None:  # the run's warnings travel with its spectrum
+        head = write_warnings(wb, ws, head + 1, warnings, 8, line_chars=110) + 1
     g = np.asarray(spectrum_kg, dtype=float) * G_PER_KG
     n = len(frequencies)
     for group in range(-(-n // TABLE_ROWS)):

@@ -254,7 +254,7 @@ def _write_sheet1(wb, result, outputs, keep, stride, title):
     return refs, warnings
 
 
-def _write_srs_sheets(wb, result, requirement, shot, name):
+def _write_srs_sheets(wb, result, requirement, shot, name, warnings):
     """The SRS and SRS table sheets of a design to a required spectrum: the designed shot's
     SRS over the requirement's band (and at least 100 Hz-10 kHz), the requirement drawn
     over it."""
@@ -269,7 +269,7 @@ def _write_srs_sheets(wb, result, requirement, shot, name):
              ("Required", f"{len(frequencies)} levels, {frequencies[0]:,.0f} to "
                           f"{frequencies[-1]:,.0f} Hz (design --target-srs)")]
     add_srs_sheets(wb, freqs, srs(pulse, result.params.delta, freqs, q), about, shot,
-                   (frequencies, required), name)
+                   (frequencies, required), name, warnings)
 
 
 def print_outputs_block(ws, block, shot):
@@ -390,7 +390,8 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
                    {"spectrum": (np.floor(summary.spectrum.band_start / 100) * 100,
                                  SPECTRUM_MAX_HZ)}, shot)
     if info.get("srs_requirement") is not None:
-        _write_srs_sheets(wb, result, info["srs_requirement"], shot, names["SRS"])
+        _write_srs_sheets(wb, result, info["srs_requirement"], shot, names["SRS"],
+                          info.get("warnings", []))
     if source is not None and source.outputs_block:
         outputs_ws = wb.add_worksheet(names[SHEET_NAME], worksheet_class=ColumnsWorksheet)
         warnings += write_cells(outputs_ws, source.outputs_block)
