@@ -133,3 +133,22 @@ def test_srs_command_leaves_an_existing_output_alone(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "already exists" in err[0] and "--force" in err[0]
     assert out.read_bytes() == b"an earlier result"
+
+
+def test_the_srs_workbook_carries_the_runs_warnings(tmp_path, capsys):
+    """The srs command gives the warnings a fill of the shot gives (here: E34 = 6,000 Hz makes
+    1/(E2 E34) fractional), on the terminal and on the SRS sheet."""
+    import openpyxl
+    from conftest import template_with
+
+    from airgun_xl.cli import main
+
+    shot = template_with(tmp_path, E34=6000.0)
+    out = tmp_path / "s.xlsx"
+    assert main(["srs", str(shot), "-o", str(out)]) == 0
+    printed = [line.removeprefix("airgun-xl: warning: ")
+               for line in capsys.readouterr().err.splitlines()]
+    assert any("E34" in w for w in printed)
+    texts = [c for r in openpyxl.load_workbook(out)["SRS"].iter_rows(values_only=True)
+             for c in r if isinstance(c, str)]
+    assert all(w in texts for w in printed) and f"Warnings ({len(printed)})" in texts

@@ -32,6 +32,7 @@ def run(args):
 
     from ..models import apply_model
     from ..shot import Shot
+    from ..studies.check import after_run, before_run
     from ..studies.shock import (
         CFC_CLASSES,
         cfc_coefficients,
@@ -41,6 +42,7 @@ def run(args):
     )
     from ..transaction import check_output
     from ..workbook.srs import write_srs
+    from . import warn
 
     if args.cfc is not None and args.cfc not in CFC_CLASSES:
         cfc_coefficients(args.cfc, 1.0)  # its one-line error, before the run
@@ -52,8 +54,15 @@ def run(args):
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".srs.xlsx")
     check_output(output, args.force, inputs=[args.shot])  # before the run, not after
-    result = dataclasses.replace(shot, params=apply_model(shot.params, args.model)).run(
-        integrator=args.integrator, track=())
+    model_params = apply_model(shot.params, args.model)
+    _, findings = before_run(model_params, args.integrator)
+    result = dataclasses.replace(shot, params=model_params).run(integrator=args.integrator,
+                                                                track=())
+    # the warnings a fill of the shot gives, with the spectrum of its run (Summary-like)
+    warnings = ([str(w) for w in shot.warnings] + [str(f) for f in findings
+                                                    if f.level != "note"]
+                + [str(w) for w in result.warnings[len(shot.warnings):]]
+                + [str(f) for f in after_run(result)])
     pulse = result.accel_kg[np.isfinite(result.accel_kg)]
     dt = shot.params.delta
     if args.cfc is not None:
@@ -63,8 +72,10 @@ def run(args):
     about = [("Shot", str(args.shot)), ("Quality factor Q", f"{args.q:g}"),
              ("Filter", f"CFC {args.cfc}" if args.cfc else "none"),
              ("Model, integrator", f"{args.model}, {args.integrator}")]
-    write_srs(output, freqs, spectrum, about, args.force, shot=shot_path.name)
+    write_srs(output, freqs, spectrum, about, args.force, shot=shot_path.name,
+              warnings=warnings)
     k = int(np.argmax(spectrum))
     print(f"wrote {output}: SRS at {len(freqs)} frequencies, {args.lo:g}-{args.hi:g} Hz, "
           f"Q = {args.q:g}; largest {spectrum[k]:.4f} kG at {freqs[k]:,.0f} Hz")
+    warn(warnings)
     return 0

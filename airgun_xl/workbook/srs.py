@@ -105,9 +105,11 @@ def add_srs_sheets(wb, frequencies, spectrum_kg, about, shot=None, requirement=N
     one_page(ws, head + 28, 15, shot=shot, title=name)
 
 
-def write_srs(path, frequencies, spectrum, about, force=False, shot=None, requirement=None):
+def write_srs(path, frequencies, spectrum, about, force=False, shot=None, requirement=None,
+              warnings=None):
     """Write the SRS workbook (:func:`add_srs_sheets`): frequencies [Hz], the maximax response
     [kG]; ``about`` is a list of (label, text) lines for the head of the sheet (shot, Q,
-    filter)."""
+    filter); ``warnings``, the run's, are listed under them."""
     with report_workbook(path, force) as wb:
-        add_srs_sheets(wb, frequencies, spectrum, about, shot, requirement)
+        add_srs_sheets(wb, frequencies, spectrum, about, shot, requirement,
+                       warnings=warnings)
