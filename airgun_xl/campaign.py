@@ -230,14 +230,16 @@ def fill_task(path, settings):
     path = Path(path)
     output = Path(settings.output) if settings.output else default_output(path)
     warnings: list = []
+    if not settings.force and os.path.lexists(output):  # filled before: not run again
+        return _failed(path, output, "skipped", f"{display(output)}: already exists "
+                                                "(--force overwrites it)")
     try:
         output, filled, _ = fill_one(path, settings, warnings.extend, None,
                                      lambda rows: _check_stop)
     except Interrupted:
         return _failed(path, output, "interrupted", "stopped before it was published")
     except AirgunXlError as exc:
-        status = "skipped" if _exists_refusal(exc, output, settings) else "failed"
-        return _failed(path, output, status, str(exc))
+        return _failed(path, output, "failed", str(exc))
     except MemoryError:
         return _failed(path, output, "failed", "out of memory during the run")
     except Exception as exc:  # noqa: BLE001 - a fault of ours in one shot: the batch goes on
@@ -245,12 +247,6 @@ def fill_task(path, settings):
                                                f"{exc}); please report it")
     entry = filled.entry.ref if filled.entry is not None else None
     return row_of(path, output, filled, entry)
-
-
-def _exists_refusal(exc, output, settings):
-    """Whether ``exc`` is the refusal of an output that exists (a shot filled before)."""
-    return (not settings.force and output.exists()
-            and "already exists" in str(exc) and display(output) in str(exc))
 
 
 # -- the parent side ---------------------------------------------------------------------

@@ -64,6 +64,14 @@ def columns_off_the_macro(legacy, new):
     return off
 
 
+def write_trace_csv(path, trace):
+    """``trace`` (time [s], accel_kg [kG]) as a measured-pulse CSV, every float exact."""
+    path.write_text("time [s],acceleration [kG]\n" + "".join(
+        f"{t!r},{a!r}\n" for t, a in zip(trace.time.tolist(), trace.accel_kg.tolist(),
+                                           strict=True)))
+    return path
+
+
 def template_with(tmp_path, **cells):
     """A copy of the template in ``tmp_path`` with some parameter cells changed (openpyxl)."""
     shot = tmp_path / "shot.xlsx"

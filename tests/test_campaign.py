@@ -9,7 +9,7 @@ import time
 import numpy as np
 import openpyxl
 import pytest
-from conftest import TEMPLATE, template_with
+from conftest import TEMPLATE, template_with, write_trace_csv
 
 from airgun_xl.archive import Archive
 from airgun_xl.cli import main
@@ -154,10 +154,7 @@ def test_a_law_stored_and_run_by_name_equals_the_same_law_from_its_workbook(tmp_
 
     p = airgun_xl.load(TEMPLATE).params
     trace = synthetic_measurement(p.replace(sigmay=p.sigmay * 1.05), seed=5)
-    measured = tmp_path / "m.csv"
-    measured.write_text("time [s],acceleration [kG]\n" + "".join(
-        f"{t!r},{a!r}\n" for t, a in zip(trace.time.tolist(), trace.accel_kg.tolist(),
-                                           strict=True)))
+    measured = write_trace_csv(tmp_path / "m.csv", trace)
     archive = tmp_path / "archive"
     calibrated = tmp_path / "cal.xlsx"
     assert main(["calibrate", str(TEMPLATE), str(measured), "--cfc", "1000", "-o",

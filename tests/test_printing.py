@@ -11,7 +11,7 @@ import zipfile
 import numpy as np
 import openpyxl
 import pytest
-from conftest import CASES, REFERENCE, TEMPLATE
+from conftest import CASES, REFERENCE, TEMPLATE, write_trace_csv
 
 import airgun_xl
 from airgun_xl.cli import main
@@ -147,10 +147,7 @@ def test_compare_and_calibration_workbooks_print_their_reports(tmp_path):
 
     p = airgun_xl.load(TEMPLATE).params
     trace = synthetic_measurement(p.replace(sigmay=p.sigmay * 1.05), seed=5)
-    m = tmp_path / "m.csv"
-    m.write_text("time [s],acceleration [kG]\n" + "".join(
-        f"{t!r},{a!r}\n" for t, a in zip(trace.time.tolist(), trace.accel_kg.tolist(),
-                                           strict=True)))
+    m = write_trace_csv(tmp_path / "m.csv", trace)
     compared = tmp_path / "compared.xlsx"
     assert main(["compare-measured", str(TEMPLATE), str(m), "--cfc", "1000", "-o",
                  str(compared)]) == 0

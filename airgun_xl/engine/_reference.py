@@ -281,9 +281,10 @@ def _check(params, rows):
 _SSIZE_MAX = 2**63 - 1
 
 
-def _float64(buffer, writable=True):
-    """The buffer's element count, refused as the C kernel refuses it: not a C-contiguous
-    float64 buffer (writable for the outputs)."""
+def float64_count(buffer, writable=True, refusal="buffers must be float64"):
+    """The buffer's element count, refused as the C extensions refuse it (the kernel and
+    the sheet XML twin alike): not a buffer, not C-contiguous, not float64 (``refusal``), or
+    read-only when ``writable``."""
     try:
         view = memoryview(buffer)
     except TypeError:
@@ -292,7 +293,7 @@ def _float64(buffer, writable=True):
     if not view.c_contiguous:  # as numpy refuses PyBUF_C_CONTIGUOUS
         raise ValueError("ndarray is not C-contiguous")
     if view.format != "d" or view.itemsize != 8 or (writable and view.readonly):
-        raise ValueError("buffers must be float64")
+        raise ValueError(refusal)
     return view.nbytes // 8
 
 
@@ -303,7 +304,7 @@ def _check_columns(arrays, rows):
         if out is None and k >= 5:
             continue
         try:
-            n = _float64(out)
+            n = float64_count(out)
         except ValueError:
             n = -1
         if n < rows:
@@ -337,7 +338,7 @@ def batch_kernel(params, rows, integrator, last, t, y, finals, lanes=True):
 
     if last not in (1, 2, 3):
         raise ValueError("last must be 1 (Y31), 2 (Y32) or 3 (Y33)")
-    sizes = [_float64(params, writable=False)] + [_float64(b) for b in (t, y, finals)]
+    sizes = [float64_count(params, writable=False)] + [float64_count(b) for b in (t, y, finals)]
     n = sizes[0] // P_COUNT
     if (rows < 0 or rows > _SSIZE_MAX // 32 or sizes[0] != n * P_COUNT or sizes[1] < rows
             or (rows > 0 and sizes[2] // rows < n) or sizes[3] // N_FINALS < n):

@@ -3,6 +3,7 @@
 compares them). ``AIRGUN_XL_PURE=1`` forces the twin, as it does the kernel's."""
 import math
 
+from ..engine._reference import float64_count
 from ..engine.kernel import PURE
 
 
@@ -12,17 +13,9 @@ def render_cells_python(column, first_row, values):
     refuses (a column name past 8 characters, a buffer that is not float64)."""
     if len(column) > 8:
         raise ValueError("column name too long")
-    try:
-        view = memoryview(values)
-    except TypeError:
-        raise TypeError(f"a bytes-like object is required, not '{type(values).__name__}'") \
-            from None
-    if not view.c_contiguous:  # as numpy refuses PyBUF_C_CONTIGUOUS
-        raise ValueError("ndarray is not C-contiguous")
-    if view.format != "d" or view.itemsize != 8:
-        raise ValueError("values must be a float64 buffer")
+    float64_count(values, writable=False, refusal="values must be a float64 buffer")
     out = []
-    for i, x in enumerate(view.tolist()):
+    for i, x in enumerate(memoryview(values).tolist()):
         if not math.isfinite(x):
             raise ValueError(f"values must be finite (index {i})")
         out.append(f'<c r="{column}{first_row + i}"><v>{x:.17g}</v></c>')
