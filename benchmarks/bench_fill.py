@@ -6,6 +6,10 @@ Reports medians over N runs (after one warm-up run) and the machine they came fr
 - kernel throughput on shot A at dt = 5 ns (1.2M steps), the C loop alone;
 - `airgun-xl fill templates/shot_a.xlsx` as a fresh process: the full default output (legacy
   columns, Summary, Charts, Tracked, Spectrum), and a summary-only run for comparison;
+- the bare xlsxwriter floor: a process that writes the same cells as the full fill's output
+  (every sheet, read back with python-calamine) through xlsxwriter's public write_number and
+  write_string, and the fill's time over it (issue 24.11: at most 0.6 s, or at most 0.6 times
+  the floor);
 - the same fill at dt = 5 ns (1.2M steps): wall time and peak RSS (/usr/bin/time -v);
 - where the time of a full fill goes: imports, reading, kernel, derived, summary, writing.
 """
@@ -79,10 +83,63 @@ def bench_fills(repeat, tmp):
     out = tmp / "o.xlsx"
     full, full_min = timed(fill_cmd(TEMPLATE, out), repeat)
     only, _ = timed(fill_cmd(TEMPLATE, out, "--only", "summary"), repeat)
-    return [("fill shot A 0.5 us, full output (process)", "12,002 rows", f"{full:.3f} s",
+    return bench_floor(repeat, tmp, full) + [
+            ("fill shot A 0.5 us, full output (process)", "12,002 rows", f"{full:.3f} s",
              f"min {full_min:.3f} s"),
             ("fill shot A 0.5 us, --only summary", "12,002 rows", f"{only:.3f} s",
              f"{full / only:.1f}x faster than full")]
+
+
+FLOOR = """
+import pickle, sys
+import xlsxwriter
+with open(sys.argv[1], "rb") as f:
+    sheets = pickle.load(f)
+wb = xlsxwriter.Workbook(sys.argv[2])
+for name, rows in sheets:
+    ws = wb.add_worksheet(name)
+    for r, row in enumerate(rows):
+        for c, v in enumerate(row):
+            if isinstance(v, float):
+                ws.write_number(r, c, v)
+            elif v is not None:
+                ws.write_string(r, c, v)
+wb.close()
+"""
+
+#: Issue 24.11's target for the full fill of shot A as a process: an absolute time [s], or a
+#: fraction of the bare xlsxwriter floor measured in the same run.
+TARGET_FILL_SECONDS, TARGET_FLOOR_RATIO = 0.6, 0.6
+
+
+def bench_floor(repeat, tmp, full):
+    """The bare xlsxwriter write of the full fill's cells, as a process; ``full`` is the fill's
+    median [s] from :func:`bench_fills`."""
+    import pickle
+
+    from python_calamine import CalamineWorkbook
+
+    out = tmp / "floor_source.xlsx"
+    subprocess.run(fill_cmd(TEMPLATE, out), check=True, capture_output=True)
+    book = CalamineWorkbook.from_path(str(out))
+    sheets, cells = [], 0
+    for name in book.sheet_names:
+        rows = [[v if v is None or isinstance(v, float) else
+                 float(v) if isinstance(v, int) else str(v) for v in row]
+                for row in book.get_sheet_by_name(name).to_python()]
+        rows = [[None if v == "" else v for v in row] for row in rows]
+        cells += sum(v is not None for row in rows for v in row)
+        sheets.append((name, rows))
+    with open(tmp / "cells.pkl", "wb") as f:
+        pickle.dump(sheets, f)
+    floor, _ = timed([sys.executable, "-c", FLOOR, str(tmp / "cells.pkl"),
+                      str(tmp / "floor.xlsx")], repeat)
+    ratio = full / floor
+    met = ("met" if full <= TARGET_FILL_SECONDS or ratio <= TARGET_FLOOR_RATIO else "NOT met")
+    return [("bare xlsxwriter floor: the same cells, public API (process)",
+             f"{cells:,} cells", f"{floor:.3f} s", f"fill / floor = {ratio:.2f}"),
+            (f"  target (issue 24.11): fill <= {TARGET_FILL_SECONDS:g} s or <= "
+             f"{TARGET_FLOOR_RATIO:g} x floor", "", met, f"fill {full:.3f} s")]
 
 
 def bench_long(repeat, tmp):

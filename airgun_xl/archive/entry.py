@@ -2,7 +2,6 @@
 import dataclasses
 import datetime
 import platform
-from importlib import metadata
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +18,8 @@ LIBRARIES = ("numpy", "pandas", "openpyxl", "xlsxwriter", "formulas", "python-ca
 
 
 def _versions():
+    from importlib import metadata  # here: 11 ms that a fill without --archive does not pay
+
     out: dict[str, str | None] = {"python": platform.python_version(),
                                   "airgun-xl": __version__}
     for name in LIBRARIES:

@@ -10,9 +10,13 @@ one step it maps (y[n], y[n-1]) to (y[n+1], y[n]) by the matrix
     G(dt) = [[2I - dt^2 M^-1 K - dt M^-1 C,  -I + dt M^-1 C],
              [I,                              0            ]]
 
-and the run stays bounded while the spectral radius of G is at most 1. The critical step is
-found by bisection on that radius. For one undamped mode it is 2/omega; with the macro's
-dampers it is (2 sqrt(1 + zeta^2) - 2 zeta)/omega.
+and the run stays bounded while the spectral radius of G is at most 1. For one undamped mode
+the critical step is 2/omega; with the macro's dampers it is (2 sqrt(1 + zeta^2) - 2 zeta)/omega,
+where an eigenvalue of G leaves the unit circle through -1. For the whole model the step where
+an eigenvalue reaches -1 solves a quadratic eigenvalue problem (eq. 1, :func:`_crossing`): one
+eigen-solve, where a bisection on the radius took 60. The radius just below that step is then
+checked; should the model lose stability some other way first (a complex pair leaving the
+circle), the bisection on the radius decides, as before.
 
 The matrices are the model's:
 - the OBR chain's springs k2, k3 and dampers c2, c3 (from the initial masses, as the macro
@@ -136,6 +140,29 @@ def _stable(dt, M, C, K):
     return spectral_radius(dt, M, C, K) <= 1 + RADIUS_TOLERANCE
 
 
+#: Relative distance below the -1 crossing where the radius is checked, and the relative
+#: imaginary part up to which a root of eq. 1 counts as real.
+CROSSING_CHECK, REAL_ROOT = 1e-9, 1e-9
+
+
+def _crossing(M, C, K):
+    """Smallest step [s] where an eigenvalue of G(dt) is -1, or inf.
+
+    With y[n] = (-1)^n v the update gives (4 M - 2 dt C - dt^2 K) v = 0, so nu = 1/dt solves
+
+        -4 M nu^2 v + 2 C nu v + K v = 0,                                        (1)
+
+    a quadratic eigenvalue problem; its companion matrix [[0, I], [M^-1 K / 4, M^-1 C / 2]]
+    has nu among its eigenvalues. The largest real positive nu is the first crossing.
+    """
+    n = len(M)
+    Minv = np.diag(1 / np.diag(M))
+    companion = np.block([[np.zeros((n, n)), np.eye(n)], [Minv @ K / 4, Minv @ C / 2]])
+    nu = np.linalg.eigvals(companion)
+    real = nu[(np.abs(nu.imag) <= REAL_ROOT * np.abs(nu)) & (nu.real > 0)].real
+    return float(1 / real.max()) if real.size else math.inf
+
+
 def _critical(M, C, K):
     if not (np.isfinite(M).all() and np.isfinite(C).all() and np.isfinite(K).all()):
         return 0.0, math.inf  # the inputs overflow: no step is stable
@@ -143,6 +170,14 @@ def _critical(M, C, K):
         return math.inf, 0.0  # no spring: free flight is stable at any step
     omega_max = math.sqrt(max(np.max(np.real(np.linalg.eigvals(np.linalg.solve(M, K)))),
                               1e-300))
+    crossing = _crossing(M, C, K)
+    if math.isfinite(crossing) and _stable(crossing * (1 - CROSSING_CHECK), M, C, K):
+        return crossing, omega_max
+    return _bisected(M, C, K, omega_max), omega_max
+
+
+def _bisected(M, C, K, omega_max):
+    """The critical step [s] by bisection on the spectral radius."""
     lo, hi = 0.0, 4.0 / omega_max  # the damped bound is below 2/omega, so hi is unstable
     while _stable(hi, M, C, K):
         hi *= 2
@@ -152,7 +187,7 @@ def _critical(M, C, K):
             lo = mid
         else:
             hi = mid
-    return lo, omega_max
+    return lo
 
 
 def _mass_range(p, samples):

@@ -3,8 +3,18 @@
 Each formula is parsed and compiled by ``formulas``; its inputs (cells and ranges) are resolved
 recursively through a :class:`SheetView`, so only the cells a parameter depends on are computed.
 Whole-column ranges such as ``I:I`` are cut to the sheet's used rows.
+
+``formulas`` takes 0.1-0.2 s to import and compile, more than the rest of reading a shot. The
+template's formulas are all sums, differences, products and quotients of numbers and cells on
+the same sheet (``=A2+E25``, ``=1/A11``, ``=-B6``), so those are computed here by
+:func:`arithmetic`, a short version tested against ``formulas`` itself
+(``tests/test_formula_arithmetic.py``). Anything else, and any case whose result the short
+version cannot vouch for (a text, logical or error operand, a division by zero, an overflow),
+goes to ``formulas``.
 """
 import logging
+import math
+import re
 from contextlib import contextmanager
 from functools import lru_cache
 
@@ -109,6 +119,126 @@ def _compile(formula):
                                  f"{_reason(exc)}") from None
 
 
+#: One token of the arithmetic subset: a number, a same-sheet cell, an operator or a bracket.
+#: An exponent has its sign (``1E+3``, as Excel stores it): ``formulas`` refuses ``1e3``.
+_TOKEN = re.compile(r"\s*(?:(?P<num>(?:\d+(?:\.\d+)?|\.\d+)(?:[eE][-+]\d+)?)"
+                    r"|(?P<ref>\$?(?P<col>[A-Za-z]{1,3})\$?(?P<row>[1-9]\d{0,6})(?![\w.!:(]))"
+                    r"|(?P<op>[-+*/()]))")
+
+#: Excel's last column (XFD) and row.
+_MAX_COL, _MAX_ROW = 16_384, 1_048_576
+
+
+class _NotArithmetic(Exception):
+    """The short version cannot vouch for this formula or its operands: use ``formulas``."""
+
+
+def _column_number(letters):
+    n = 0
+    for ch in letters.upper():
+        n = n * 26 + ord(ch) - 64
+    return n
+
+
+@lru_cache(maxsize=256)
+def arithmetic(formula):
+    """The formula as a postfix program if it is arithmetic on numbers and same-sheet cells
+    (``+ - * /``, unary signs, brackets), else None.
+
+    The program is a tuple of ``("num", x)``, ``("ref", row, col)``, ``("neg",)`` and
+    ``("bin", op)`` steps; :meth:`Evaluator.evaluate` runs it.
+    """
+    text = formula[1:] if formula.startswith("=") else None
+    if not text or len(text) > MAX_FORMULA:
+        return None
+    tokens: list[tuple] = []
+    pos = 0
+    while pos < len(text):
+        match = _TOKEN.match(text, pos)
+        if match is None or match.end() == pos:
+            if text[pos:].strip():
+                return None
+            break
+        pos = match.end()
+        if match["num"]:
+            tokens.append(("num", float(match["num"])))
+        elif match["ref"]:
+            col, row = _column_number(match["col"]), int(match["row"])
+            if col > _MAX_COL or row > _MAX_ROW:
+                return None
+            tokens.append(("ref", row, col))
+        else:
+            tokens.append(("op", match["op"]))
+    program: list = []
+    try:
+        end = _expression(tokens, 0, program)
+    except _NotArithmetic:
+        return None
+    return tuple(program) if end == len(tokens) else None
+
+
+def _expression(tokens, i, program):
+    """expression := term (("+" | "-") term)*; returns the index after it."""
+    i = _term(tokens, i, program)
+    while i < len(tokens) and tokens[i] in (("op", "+"), ("op", "-")):
+        op = tokens[i][1]
+        i = _term(tokens, i + 1, program)
+        program.append(("bin", op))
+    return i
+
+
+def _term(tokens, i, program):
+    """term := factor (("*" | "/") factor)*."""
+    i = _factor(tokens, i, program)
+    while i < len(tokens) and tokens[i] in (("op", "*"), ("op", "/")):
+        op = tokens[i][1]
+        i = _factor(tokens, i + 1, program)
+        program.append(("bin", op))
+    return i
+
+
+def _factor(tokens, i, program):
+    """factor := ("-" | "+") factor | number | cell | "(" expression ")"."""
+    if i >= len(tokens):
+        raise _NotArithmetic
+    token = tokens[i]
+    if token in (("op", "-"), ("op", "+")):
+        i = _factor(tokens, i + 1, program)
+        if token[1] == "-":
+            program.append(("neg",))
+        return i
+    if token[0] in ("num", "ref"):
+        program.append(token)
+        return i + 1
+    if token == ("op", "("):
+        i = _expression(tokens, i + 1, program)
+        if i < len(tokens) and tokens[i] == ("op", ")"):
+            return i + 1
+    raise _NotArithmetic
+
+
+def _run(program, operand):
+    """Run an :func:`arithmetic` program; ``operand(row, col)`` gives a cell's number."""
+    stack: list = []
+    for step in program:
+        if step[0] == "num":
+            stack.append(step[1])
+        elif step[0] == "ref":
+            stack.append(operand(step[1], step[2]))
+        elif step[0] == "neg":
+            stack.append(-stack.pop())
+        else:
+            b, a = stack.pop(), stack.pop()
+            if step[1] == "/" and b == 0:
+                raise _NotArithmetic  # #DIV/0!: the library's word
+            stack.append(a + b if step[1] == "+" else a - b if step[1] == "-" else
+                         a * b if step[1] == "*" else a / b)
+    value = stack.pop()
+    if not math.isfinite(value):
+        raise _NotArithmetic  # an overflow: #NUM! in the library
+    return value + 0.0  # -0.0 shows as 0
+
+
 def _scalar(result):
     """A Python value from a ``formulas`` result: float, str, bool, None, or '#ERR!' text."""
     cells = np.asarray(result, dtype=object)
@@ -156,6 +286,17 @@ class Evaluator:
 
     def evaluate(self, formula, sheet):
         """Evaluate formula text (``=...``) as if it stood on ``sheet``."""
+        program = arithmetic(formula)
+        if program is not None:
+            try:
+                return _run(program, lambda row, col: self._number(sheet, row, col))
+            except _NotArithmetic:
+                pass
+        return self.library(formula, sheet)
+
+    def library(self, formula, sheet):
+        """Evaluate formula text with ``formulas`` alone (:meth:`evaluate` without the short
+        version)."""
         func = _compile(formula)
         args = [self._resolve(ref, sheet) for ref in func.inputs]
         with _quiet():
@@ -164,6 +305,18 @@ class Evaluator:
             except Exception as exc:  # noqa: BLE001 - any failure inside formulas
                 raise FormulaFailure(f"cannot evaluate {shown_formula(formula)}: "
                                  f"{_reason(exc)}") from None
+
+    def _number(self, sheet, row, col):
+        """A cell's value as an operand of :func:`arithmetic`: a blank is 0, a number itself;
+        anything else is left to ``formulas`` (Excel's rules for text and logicals)."""
+        if sheet not in self.view.sheets:
+            raise _NotArithmetic
+        value = self.value(sheet, row, col)
+        if value is None:
+            return 0.0
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            return float(value)
+        raise _NotArithmetic
 
     def _resolve(self, ref, sheet):
         if "!" in ref:
