@@ -68,6 +68,8 @@ class FillSettings:
     name: str | None = None
     reproducible: bool = False
     argv: tuple = ()
+    profile: str | None = None  # a tolerance profile (issue 25), under each shot's sheet
+    spec: object = None  # the specification fields of the options, over each shot's sheet
 
 
 def default_output(shot_path):
@@ -136,9 +138,12 @@ def fill_one(path, settings, warn, note=None, progress_for=None, started=None):
     outputs = from_sheet(shot.source.outputs_block).with_flags(
         settings.only, settings.no_charts, settings.every, settings.max_sheet_rows,
         settings.sidecar)
+    from .specification import combine
+
     options = Options(settings.integrator, settings.host, settings.model,
                       settings.compare_models, settings.force, settings.allow_unstable,
-                      settings.reproducible, command=tuple(settings.argv))
+                      settings.reproducible, command=tuple(settings.argv),
+                      spec=combine(settings.profile, shot.spec, settings.spec))
     if root is not None:
         outputs = dataclasses.replace(outputs, sidecar="never")  # the entry holds the history
         options.track_all = True

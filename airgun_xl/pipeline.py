@@ -33,6 +33,7 @@ class Options:
     archive: object = None  # an ArchiveRequest: also store the run as an archive entry
     force_word: str = "--force"  # how messages name `force`
     srs_requirement: tuple | None = None  # (frequencies [Hz], levels [kG], Q): SRS sheets
+    spec: object = None  # a Specification to judge the prediction by (else the shot's sheet)
 
 
 @dataclasses.dataclass
@@ -50,6 +51,7 @@ class Filled:
     sidecar: object
     compared: object = None  # the other model's (or unloading's) Result, shown beside it
     entry: object = None  # the archive Entry, when the run was archived
+    verdict: object = None  # the predicted Verdict, when the shot has a specification
     warnings: list = dataclasses.field(default_factory=list)  # all the run said, in order
 
 
@@ -133,13 +135,29 @@ def fill_workbook(shot, output, outputs, options, warn, started=None, note=None,
     progress("summarizing")
     needs_summary = outputs.groups & {"summary", "spectrum", "charts"}
     summary = summarize(result) if needs_summary else None
+    verdict = _predicted_verdict(shot, result, options, record)
     info = _provenance(shot, result, crit, compared, options, record, started)
+    info["verdict"] = verdict
     filled = Filled(result, summary, outputs.stride(shot.params.rows), sidecar, compared,
-                    warnings=record)
+                    warnings=record, verdict=verdict)
     filled.entry = _publish(shot, filled, output, outputs, info, options, record, progress,
                             started)
     warn(record)
     return filled
+
+
+def _predicted_verdict(shot, result, options, record):
+    """The prediction judged by the specification (the options', else the shot's sheet's);
+    None without one. Its warnings join the run's."""
+    spec = options.spec if options.spec is not None else shot.spec
+    if spec is None:
+        return None
+    from .specification import check
+    from .studies.acceptance import predicted_verdict
+
+    verdict = predicted_verdict(result, check(spec, "the specification"))
+    record.extend(w for w in verdict.warnings if w not in record)
+    return verdict
 
 
 def _check_outputs(shot, output, outputs, options):

@@ -56,11 +56,14 @@ class Shot:
         The workbook the parameters were read from; None for a shot built in code.
     warnings : list of str
         What reading the workbook found worth saying (e.g. stale cached formula values).
+    spec : airgun_xl.specification.Specification or None
+        What the shot must meet: its workbook's Specification sheet (issue 25), or None.
     """
 
     params: ShotParams
     source: Any = None
     warnings: list[str] = field(default_factory=list)
+    spec: Any = None
 
     @classmethod
     def from_workbook(cls, path: str | os.PathLike[str], read_law: bool = True) -> Shot:
@@ -73,19 +76,21 @@ class Shot:
             A :class:`~airgun_xl.errors.CellError` naming the cell, or a
             :class:`~airgun_xl.errors.WorkbookError` for the file.
         """
-        from .workbook.reader import read_params
+        from .workbook.reader import read_params, read_spec
 
         params, source, warnings = read_params(path, read_law)
-        return cls(params, source, warnings)
+        spec, found = read_spec(source)
+        return cls(params, source, warnings + found, spec)
 
     def with_params(self, **changes: float) -> Shot:
         """The same shot with some parameters changed (checked again)."""
-        return Shot(self.params.replace(**changes), self.source, list(self.warnings))
+        return Shot(self.params.replace(**changes), self.source, list(self.warnings),
+                    self.spec)
 
     def with_law(self, law: CrushLaw | None) -> Shot:
         """The same shot with another crush-factor law (None: the macro's, Eq. 8)."""
         return Shot(self.params.replace(crush_law=law or LEGACY_LAW), self.source,
-                    list(self.warnings))
+                    list(self.warnings), self.spec)
 
     def run(self, integrator: str = "legacy", host: str = "excel",
             track: Collection[str] = TRACKED) -> Result:

@@ -168,7 +168,7 @@ def test_template_command_matches_the_committed_template(tmp_path):
     for data_only in (False, True):
         a = openpyxl.load_workbook(out, data_only=data_only)
         b = openpyxl.load_workbook(TEMPLATE, data_only=data_only)
-        assert a.sheetnames == b.sheetnames == ["Sheet1", "Outputs"]
+        assert a.sheetnames == b.sheetnames == ["Sheet1", "Outputs", "Specification"]
         for sa, sb in zip(a.worksheets, b.worksheets, strict=True):
             assert [[c.value for c in r] for r in sa.iter_rows()] == \
                 [[c.value for c in r] for r in sb.iter_rows()]

@@ -3,24 +3,22 @@ the shots they were fitted on and their scores, so that ``fill --crush-law NAME`
 
 Each law is a JSON file ``.laws/<name>/vNNNN.json`` of the archive folder (a hidden folder:
 entry scans skip it). A name keeps every version: storing it again adds the next one, and
-``NAME`` runs the latest, ``NAME@N`` version N. A version is written to a temp file and then
-linked to its name, which fails if another writer took that version first (it then takes the
-next), so two calibrations can store at once and none is ever half-written.
+``NAME`` runs the latest, ``NAME@N`` version N. Versions are written by
+:func:`airgun_xl.archive.records.store_record`, so two calibrations can store at once and none
+is ever half-written.
 """
 import datetime
 import json
-import os
 import re
-import uuid
 from pathlib import Path
 
 from ..crush_law import DEGREE, CrushLaw
 from ..errors import ArchiveError, OptionError
 from ..transaction import display
+from .records import store_record, versions
 from .store import Archive, safe_name
 
 LAWS = ".laws"
-_VERSION = re.compile(r"^v(\d{4,})\.json$")
 _REF = re.compile(r"^(?P<name>[^@]+?)(?:@(?P<version>\d+))?$")
 
 
@@ -28,12 +26,7 @@ def _folder(root, name):
     return Path(root) / LAWS / safe_name(name)
 
 
-def _versions(folder):
-    if not folder.is_dir():
-        return []
-    found = [(int(m.group(1)), p) for p in folder.iterdir()
-             if (m := _VERSION.match(p.name)) and p.is_file()]
-    return sorted(found)
+_versions = versions
 
 
 def store_law(root, name, law, shots, scores, command=()):
@@ -52,35 +45,11 @@ def store_law(root, name, law, shots, scores, command=()):
         raise OptionError(f"--name: found {name!r}, expected a law name of letters, digits, "
                           "'-', '_' and '.' (such as LOT-2026-07)")
     Archive(root, create=True)
-    folder = _folder(root, name)
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ArchiveError(f"{display(folder)}: cannot be created ({exc.strerror})") from None
     record = {"name": name, "coefficients": list(law.coefficients),
               "v_range": list(law.v_range), "shots": shots, "scores": scores,
               "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
               "command": list(command)}
-    tmp = folder / f".{uuid.uuid4().hex}.tmp"
-    try:
-        with open(tmp, "x", encoding="utf-8") as fh:
-            json.dump(record, fh, indent=1)
-            fh.flush()
-            os.fsync(fh.fileno())
-        for _ in range(1000):  # a version another writer took first: the next one
-            version = (_versions(folder)[-1][0] if _versions(folder) else 0) + 1
-            try:
-                os.link(tmp, folder / f"v{version:04d}.json")
-                break
-            except FileExistsError:
-                continue
-        else:
-            raise ArchiveError(f"{display(folder)}: no free version, expected fewer writers")
-    except OSError as exc:
-        raise ArchiveError(f"{display(folder)}: the law cannot be written "
-                           f"({exc.strerror or exc})") from None
-    finally:
-        tmp.unlink(missing_ok=True)
+    version = store_record(_folder(root, name), record, "the law")
     return f"{name}@{version}"
 
 

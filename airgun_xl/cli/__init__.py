@@ -1,7 +1,8 @@
 """The ``airgun-xl`` command: parses arguments and hands off to one module per subcommand.
 
 Exit codes: 0 done, 1 a comparison found differences, 2 bad input (one line on stderr, nothing
-written), 128 + N for signal N. SIGTERM and SIGHUP clean up like Ctrl-C (temp files go, nothing
+written), 3 a shot or a design that fails its specification (accept, design --confidence),
+128 + N for signal N. SIGTERM and SIGHUP clean up like Ctrl-C (temp files go, nothing
 is half published); SIGXFSZ is ignored, so a file-size limit (``ulimit -f``) is a write error.
 """
 import contextlib
@@ -100,10 +101,10 @@ def main(argv=None):
                 reconfigure(errors="backslashreplace")
     try:
         with _signals(restore=argv is not None):  # before numpy and the engine load
-            from .commands import build_parser
+            from .commands import build_parser, joined_values
 
             parser = build_parser()
-            args = parser.parse_args(argv)
+            args = parser.parse_args(joined_values(sys.argv[1:] if argv is None else argv))
             args.argv = ["airgun-xl", *(sys.argv[1:] if argv is None else argv)]
             if args.command is None:  # the usage goes with the exit status, to stderr (23.26)
                 parser.print_help(sys.stderr)

@@ -4,6 +4,7 @@ import argparse
 from .. import __version__
 from ..errors import OptionError
 from . import (
+    accept,
     archive,
     calibrate,
     check,
@@ -18,7 +19,7 @@ from . import (
 )
 
 COMMANDS = (fill, diff, archive, check, convergence, design, sweep, srs, compare_measured,
-            calibrate, template)
+            calibrate, accept, template)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -27,6 +28,25 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message):  # "fill: the following arguments are required: SHOT.xlsx"
         command = self.prog.removeprefix("airgun-xl").strip()
         raise OptionError(f"{command}: {message}" if command else message)
+
+
+#: Options whose value starts with a minus sign as typed (``--srs-tol -3dB,+6dB``), which
+#: argparse would take for an option.
+DASHED_VALUES = ("--srs-tol",)
+
+
+def joined_values(argv):
+    """``argv`` with ``--srs-tol -3dB,+6dB`` joined as ``--srs-tol=-3dB,+6dB``."""
+    out, k = [], 0
+    while k < len(argv):
+        if argv[k] in DASHED_VALUES and k + 1 < len(argv) and argv[k + 1].startswith("-") \
+                and not argv[k + 1].startswith("--"):
+            out.append(f"{argv[k]}={argv[k + 1]}")
+            k += 2
+        else:
+            out.append(argv[k])
+            k += 1
+    return out
 
 
 def build_parser():

@@ -7,6 +7,7 @@ from ..choices import HOSTS, SIDECAR_MODES, UNLOADINGS
 from ..outputs import GROUPS
 from ..transaction import display
 from .run_options import add_force, add_integrator, add_model
+from .spec_options import add_spec_options
 
 
 def add_parser(sub):
@@ -65,6 +66,7 @@ def add_parser(sub):
                                   "label in the sheet, else SHOT's file name)")
     p.add_argument("--reproducible", action="store_true",
                    help="leave run times out of the Summary, so equal inputs give equal bytes")
+    add_spec_options(p)
     p.set_defaults(run=run)
 
 
@@ -103,19 +105,26 @@ def print_summary(output, filled):
         lines.append(f"  {variant_name(c)}: peak {c.peak_kg:.5f} kG at {_ms(c.time_of_peak)}")
     if sidecar is not None:
         lines.append(f"  full history in {sidecar}")
+    v = filled.verdict
+    if v is not None:
+        lines.append(f"  specification ({v.spec.source or 'options'}), predicted: {v.word}: "
+                     + "; ".join(f"{c.name} {c.value:.5g} {c.unit} {c.margin:+.2f} "
+                                 f"{c.margin_unit} {'PASS' if c.passed else 'FAIL'}"
+                                 for c in v.criteria))
     print("\n".join(lines))
 
 
 def settings_of(args):
     """The :class:`~airgun_xl.campaign.FillSettings` the command line asks for."""
     from ..campaign import FillSettings
+    from .spec_options import options_spec
 
     return FillSettings(
         args.output, args.force, args.host, args.only, args.no_charts, args.every,
         args.max_sheet_rows, args.sidecar, args.integrator, args.allow_unstable, args.model,
         args.crush_law, args.unloading, args.compare_models,
         str(archive_dir(args.archive, required=False) or "") or None, args.name,
-        args.reproducible, tuple(args.argv))
+        args.reproducible, tuple(args.argv), args.profile, options_spec(args))
 
 
 def run(args):

@@ -28,6 +28,9 @@ from .formula_eval import Evaluator, FormulaFailure, SheetView, shown_formula
 from .law_sheet import KEY as LAW_KEY
 from .law_sheet import SHEET_NAME as LAW_SHEET
 from .law_sheet import law_from_cells
+from .spec_sheet import KEY as SPEC_KEY
+from .spec_sheet import SHEET_NAME as SPEC_SHEET
+from .spec_sheet import spec_from_cells
 
 #: Columns read from a sheet other than the parameter sheet (Outputs, or one a formula names).
 OTHER_COLUMNS = 26
@@ -69,6 +72,11 @@ class Source:
     def law_block(self):
         """Cells of the workbook's Crush law sheet, if it has one."""
         return self.other_sheets.get(LAW_KEY)
+
+    @property
+    def spec_block(self):
+        """Cells of the workbook's Specification sheet, if it has one."""
+        return self.other_sheets.get(SPEC_KEY)
 
     def view(self, extra_columns=None):
         """A :class:`SheetView` over the parameter sheet and the other sheets."""
@@ -119,7 +127,7 @@ def _read_zip(path, data):
             if first:
                 text = " ".join(f for _, f in cells.values() if f).upper()
                 wanted = {t.upper() for t in wb_f.sheetnames[1:]
-                          if t.upper() in text or t.upper() in ("OUTPUTS", LAW_KEY)}
+                          if t.upper() in text or t.upper() in ("OUTPUTS", LAW_KEY, SPEC_KEY)}
     except AirgunXlError:
         raise
     except Exception as exc:  # noqa: BLE001 - any parser failure on untrusted bytes is one line
@@ -161,7 +169,8 @@ def _read_xls(path, data):
         wb = CalamineWorkbook.from_filelike(io.BytesIO(data))
         names = list(wb.sheet_names)
         sheets: dict = {}
-        for name in names[:1] + [n for n in names[1:] if n.upper() in ("OUTPUTS", LAW_KEY)]:
+        for name in names[:1] + [n for n in names[1:] if n.upper() in ("OUTPUTS", LAW_KEY,
+                                                                         SPEC_KEY)]:
             first = not sheets
             rows = wb.get_sheet_by_name(name).to_python(skip_empty_area=False)
             cells = {}
@@ -274,19 +283,33 @@ def parameter_values(source):
     return raw, warnings
 
 
-def law_values(source):
-    """The Crush law sheet's cells with their formulas evaluated (:func:`cell_value`, as the
-    parameter sheet's), for :func:`~airgun_xl.workbook.law_sheet.law_from_cells`; and the
-    warnings raised."""
+def sheet_values(source, key, title, label):
+    """A sheet's cells (Crush law, Specification) with their formulas evaluated
+    (:func:`cell_value`, as the parameter sheet's); and the warnings raised."""
     evaluator = Evaluator(source.view())
     cells, warnings = {}, []
-    for pos, cell in source.law_block.items():
-        where = f"'{LAW_SHEET}'!{get_column_letter(pos[1])}{pos[0]}"
-        value, warning = cell_value(evaluator, LAW_KEY, pos, cell, where, "crush law")
+    for pos, cell in source.other_sheets[key].items():
+        where = f"'{title}'!{get_column_letter(pos[1])}{pos[0]}"
+        value, warning = cell_value(evaluator, key, pos, cell, where, label)
         cells[pos] = (value, None)
         if warning:
             warnings.append(warning)
     return cells, warnings
+
+
+def law_values(source):
+    """The Crush law sheet's cells, evaluated (:func:`sheet_values`), for
+    :func:`~airgun_xl.workbook.law_sheet.law_from_cells`; and the warnings raised."""
+    return sheet_values(source, LAW_KEY, LAW_SHEET, "crush law")
+
+
+def read_spec(source):
+    """The Specification sheet's specification (None when the sheet is missing or empty), and
+    the warnings its formulas raised."""
+    if source is None or source.spec_block is None:
+        return None, []
+    cells, warnings = sheet_values(source, SPEC_KEY, SPEC_SHEET, "specification")
+    return spec_from_cells(cells), warnings
 
 
 def check_time_header(source):

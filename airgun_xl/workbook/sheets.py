@@ -238,6 +238,31 @@ def _summary_rows(result, summary, timings):
     return rows
 
 
+def write_predicted_verdict(wb, ws, verdict, row, style):
+    """The prediction judged by the shot's specification, from ``row``: the verdict, then a
+    row a criterion (value, unit, limits, margin, PASS/FAIL); the next free row."""
+    good = wb.add_format({"bold": True, "font_color": "#006100", "bg_color": "#C6EFCE"})
+    bad = wb.add_format({"bold": True, "font_color": "#9C0006", "bg_color": "#FFC7CE"})
+    number = wb.add_format({"num_format": "0.000", "align": "right"})
+    ws.write_string(row, 0, "Specification: predicted verdict", style.bold)
+    ws.write_string(row, 1, verdict.word, good if verdict.passed else bad)
+    ws.write_string(row, 3, f"from {verdict.spec.source or 'options'}; "
+                    + "; ".join(verdict.definitions[1:]))
+    row += 1
+    for c in verdict.criteria:
+        ws.write_string(row, 0, f"Specification: {c.name}")
+        if np.isfinite(c.value):
+            ws.write_number(row, 1, c.value, number)
+        ws.write_string(row, 2, c.unit)
+        lo = "-inf" if c.low is None else f"{c.low:.5g}"
+        hi = "+inf" if c.high is None else f"{c.high:.5g}"
+        ws.write_string(row, 3, f"{'PASS' if c.passed else 'FAIL'}: limits {lo} to {hi} "
+                        f"{c.unit}, margin {c.margin:+.2f} {c.margin_unit}"
+                        + (f"; {c.detail}" if c.detail else ""))
+        row += 1
+    return row
+
+
 def write_summary(wb, result, summary, timings, name="Summary"):
     """The Summary sheet: one labelled cell per figure (label A, value B in the unit of C, with
     a number format fit for it, definition D); printed as one landscape page."""
@@ -270,7 +295,10 @@ def write_summary(wb, result, summary, timings, name="Summary"):
             ws.write_string(row, 2, style.unit(code))
         if note:
             ws.write_string(row, 3, note)
-    last = write_warnings(wb, ws, len(rows) + 2, timings.get("warnings", []), 3)
+    row = len(rows) + 2
+    if timings.get("verdict") is not None:
+        row = write_predicted_verdict(wb, ws, timings["verdict"], row, style) + 1
+    last = write_warnings(wb, ws, row, timings.get("warnings", []), 3)
     one_page(ws, last, 3, shot=timings.get("shot"), title="Summary")
     ws.freeze_panes(1, 0)
     return ws

@@ -19,6 +19,7 @@ from ..outputs import SHEET_NAME as OUTPUTS_SHEET
 from ..outputs import block_cells
 from .formula_eval import Evaluator, SheetView
 from .report import report_workbook
+from .spec_sheet import write_spec_sheet
 
 SHEET = "Sheet1"
 
@@ -108,6 +109,7 @@ def write_template(path, force=False):
             else:
                 ws.write_number(address, content)
         write_outputs_sheet(wb)
+        write_spec_sheet(wb)
 
 
 def write_outputs_sheet(wb):

@@ -1,0 +1,61 @@
+"""Versioned JSON records in the archive's hidden folders (crush laws, verdicts): each record
+is ``vNNNN.json`` of its folder, written to a temp file and linked to its name, which fails if
+another writer took that version first (it then takes the next). So two writers can store at
+once and none is ever half-written."""
+import json
+import os
+import re
+import uuid
+from pathlib import Path
+
+from ..errors import ArchiveError
+from ..transaction import display
+
+_VERSION = re.compile(r"^v(\d{4,})\.json$")
+
+
+def versions(folder):
+    """``[(version, path)]`` of a record folder, oldest first."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    found = [(int(m.group(1)), p) for p in folder.iterdir()
+             if (m := _VERSION.match(p.name)) and p.is_file()]
+    return sorted(found)
+
+
+def store_record(folder, record, what):
+    """Write ``record`` as the next version in ``folder`` (created); return the version.
+
+    Raises
+    ------
+    ArchiveError
+        Naming the folder and ``what`` could not be written.
+    """
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ArchiveError(f"{display(folder)}: cannot be created ({exc.strerror})") from None
+    tmp = folder / f".{uuid.uuid4().hex}.tmp"
+    try:
+        with open(tmp, "x", encoding="utf-8") as fh:
+            json.dump(record, fh, indent=1)
+            fh.flush()
+            os.fsync(fh.fileno())
+        for _ in range(1000):  # a version another writer took first: the next one
+            found = versions(folder)
+            version = (found[-1][0] if found else 0) + 1
+            try:
+                os.link(tmp, folder / f"v{version:04d}.json")
+                break
+            except FileExistsError:
+                continue
+        else:
+            raise ArchiveError(f"{display(folder)}: no free version, expected fewer writers")
+    except OSError as exc:
+        raise ArchiveError(f"{display(folder)}: {what} cannot be written "
+                           f"({exc.strerror or exc})") from None
+    finally:
+        tmp.unlink(missing_ok=True)
+    return version

@@ -1,0 +1,70 @@
+"""Verdicts in the archive: each ``accept --archive DIR`` keeps its verdict (every criterion
+with its value, limits and margin, the tolerances used, the warnings, the recording, the
+report and the command) as ``.verdicts/<shot>/vNNNN.json`` (:mod:`.records`). ``archive
+verdicts`` lists them."""
+import dataclasses
+import datetime
+import hashlib
+import json
+from pathlib import Path
+
+from ..errors import ArchiveError
+from ..transaction import display
+from .entry import shot_name
+from .records import store_record, versions
+from .store import Archive, safe_name
+
+VERDICTS = ".verdicts"
+
+
+def _plain(value):
+    if isinstance(value, float) and value != value:
+        return None
+    if isinstance(value, float) and abs(value) == float("inf"):
+        return None
+    return value
+
+
+def verdict_record(verdict, shot, recording, report, command=()):
+    """The JSON record of a verdict."""
+    data = Path(str(recording).partition(":")[0])
+    try:
+        digest = hashlib.sha256(data.read_bytes()).hexdigest() if data.is_file() else None
+    except OSError:
+        digest = None
+    return {"shot": shot_name(shot), "verdict": verdict.word,
+            "criteria": [{k: _plain(v) for k, v in dataclasses.asdict(c).items()}
+                         for c in verdict.criteria],
+            "tolerances": verdict.tolerances(), "definitions": verdict.definitions,
+            "specification": verdict.spec.source, "notes": list(verdict.spec.notes),
+            "warnings": list(verdict.warnings), "recording": str(recording),
+            "recording_sha256": digest, "report": str(report),
+            "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+            "command": list(command)}
+
+
+def store_verdict(root, shot, verdict, recording, report, command=()):
+    """Keep the verdict in the archive at ``root``; return the file's path."""
+    Archive(root, create=True)
+    folder = Path(root) / VERDICTS / safe_name(shot_name(shot))
+    record = verdict_record(verdict, shot, recording, report, command)
+    version = store_record(folder, record, "the verdict")
+    return folder / f"v{version:04d}.json"
+
+
+def list_verdicts(root):
+    """Every stored verdict: ``[{"shot", "version", "verdict", "created", "recording"}]``."""
+    base = Path(root) / VERDICTS
+    out: list[dict] = []
+    if not base.is_dir():
+        return out
+    for folder in sorted(p for p in base.iterdir() if p.is_dir() and not p.is_symlink()):
+        for version, path in versions(folder):
+            try:
+                record = json.loads(path.read_text(encoding="utf-8"))
+            except (OSError, ValueError) as exc:
+                raise ArchiveError(f"{display(path)}: cannot be read ({exc})") from None
+            out.append({"shot": record.get("shot"), "version": version,
+                        "verdict": record.get("verdict"), "created": record.get("created"),
+                        "recording": record.get("recording")})
+    return out

@@ -1,0 +1,147 @@
+"""``airgun-xl accept SHOT.xlsx RECORDING``: did the fired shot meet its specification?
+
+Exit 0 on PASS, 3 on FAIL (:data:`FAIL_EXIT`), 2 for bad input."""
+from pathlib import Path
+
+from .recording_options import add_recording_options
+from .run_options import add_force, add_output
+from .spec_options import add_spec_options
+
+#: The exit status of a shot that fails its specification (2 stays for bad input).
+FAIL_EXIT = 3
+
+
+def add_parser(sub):
+    p = sub.add_parser("accept", help="judge a recording against the shot's specification: "
+                                      "PASS or FAIL, criterion by criterion",
+                       description="Read the recording (as compare-measured does), judge it "
+                                   "against the specification (the shot's Specification "
+                                   "sheet, a --profile, the options): peak, duration, velocity"
+                                   " change, the corridor round the ideal pulse and the SRS; "
+                                   "write the verdict workbook. Exit 0 on PASS, 3 on FAIL.")
+    p.add_argument("shot", metavar="SHOT.xlsx")
+    p.add_argument("recording", metavar="RECORDING",
+                   help="the recorded pulse: a CSV (time, acceleration, units in the header), "
+                        "a workbook's columns (trace.xlsx:Sheet1!A:B) or a LabVIEW TDMS file")
+    add_output(p, "verdict workbook", "SHOT.accept.xlsx")
+    add_force(p)
+    add_recording_options(p)
+    add_spec_options(p)
+    p.add_argument("--archive", metavar="DIR",
+                   help="record the verdict in the archive (the verdict file of the shot's "
+                        "next entry)")
+    p.set_defaults(run=run)
+
+
+def judged_cfc(args, spec):
+    """The record judged: --cfc, or the specification's; both, and different: refused."""
+    from ..errors import OptionError
+
+    if args.cfc is not None and spec.cfc is not None and args.cfc != spec.cfc:
+        raise OptionError(f"--cfc: found {args.cfc}, but the specification judges the record "
+                          f"at CFC {spec.cfc}; expected one of them (or --record)")
+    return args.cfc if args.cfc is not None else spec.cfc
+
+
+def run(args):
+    import dataclasses
+
+    from ..errors import OptionError
+    from ..shot import Shot
+    from ..studies.acceptance import judge
+    from ..studies.measured import prepare
+    from ..transaction import check_output
+    from ..workbook.trace import input_file, read_trace
+    from . import warn
+    from .spec_options import resolve_spec
+
+    shot_path = Path(args.shot)
+    output = Path(args.output) if args.output else shot_path.with_name(
+        shot_path.stem + ".accept.xlsx")
+    check_output(output, args.force, inputs=[args.shot, input_file(args.recording)])
+    shot = Shot.from_workbook(args.shot)
+    spec = resolve_spec(shot, args)
+    if spec is None:
+        raise OptionError(f"{args.shot}: its Specification sheet is empty and no option gives"
+                          " a criterion; expected --peak, --duration, --velocity-change, --srs"
+                          " or --profile")
+    cfc = judged_cfc(args, spec)
+    spec = dataclasses.replace(spec, cfc=cfc)
+    trace = read_trace(args.recording, args.time_unit, args.accel_unit, args.sign,
+                       args.channel)
+    rec = prepare(trace, cfc, anti_alias="none")
+    time, kg = rec.trace.time, rec.filtered
+    verdict = judge(time, kg, spec, warnings=shot.warnings + rec.warnings)
+    pulse, spectra = report_data(time, kg, spec, verdict)
+    about = [("Shot", str(args.shot)), ("Recording", trace.name),
+             ("Units read", f"time {trace.units[0]}, acceleration {trace.units[1]}"),
+             ("Record judged", f"CFC {cfc}" if cfc else "unfiltered (baseline removed)"),
+             ("Verdict", verdict.word)]
+    from ..workbook.acceptance import write_acceptance
+
+    write_acceptance(output, verdict, about, pulse, spectra, args.force,
+                     shot=Path(args.shot).name)
+    if args.archive:
+        record_verdict(args, shot, verdict, output)
+    print_verdict(verdict, f"{trace.name} against {args.shot}")
+    print(f"  wrote {output}")
+    eq = spectra["equivalent"]
+    print(f"  equivalent half-sine (its SRS envelops the record's): {eq[0]:.4f} kG, "
+          f"{eq[1] * 1e3:.4f} ms; pseudo-velocity up to {max(spectra['pv']):.3f} m/s")
+    warn(verdict.warnings)
+    return 0 if verdict.passed else FAIL_EXIT
+
+
+def print_verdict(verdict, what):
+    """The verdict, a line a criterion, with the tolerances used."""
+    print(f"{verdict.word}: {what}")
+    for c in verdict.criteria:
+        limits = (f"{'-inf' if c.low is None else f'{c.low:.5g}'} to "
+                  f"{'+inf' if c.high is None else f'{c.high:.5g}'} {c.unit}")
+        margin = f"{c.margin:+.2f} {c.margin_unit}"
+        print(f"  {'PASS' if c.passed else 'FAIL'}  {c.name}: {c.value:.5g} {c.unit} "
+              f"(limits {limits}; margin {margin})" + (f"; {c.detail}" if c.detail else ""))
+    for line in verdict.definitions:
+        print(f"  {line}")
+
+
+def report_data(time, kg, spec, verdict):
+    """The pulse with its corridor, and the spectra, for the verdict workbook."""
+    import numpy as np
+
+    from ..studies.acceptance import corridor_limits, equivalent_half_sine, ideal, pseudo_velocity
+    from ..studies.shock import default_frequencies, srs
+
+    pulse = {"time": time, "kg": kg}
+    if spec.corridor is not None and verdict.onset is not None:
+        tau = time - verdict.onset
+        upper, lower = corridor_limits(spec, tau)
+        lo, hi = verdict.window
+        inside = (time >= lo) & (time <= hi)
+        pulse["ideal"] = ideal(spec.shape, tau, spec.peak.nominal, spec.duration.nominal)
+        pulse["upper"] = np.where(inside, upper, np.nan)
+        pulse["lower"] = np.where(inside, lower, np.nan)
+    dt = time[1] - time[0]
+    q = spec.srs.q if spec.srs is not None else 10.0
+    if spec.srs is not None:
+        frequencies = np.array(spec.srs.frequencies)
+    else:
+        frequencies = default_frequencies(100.0, min(10_000.0, 0.1 / dt))
+    levels = srs(kg, dt, frequencies, q)
+    spectra = {"frequencies": frequencies, "srs": levels, "q": q,
+               "pv": pseudo_velocity(frequencies, levels),
+               "equivalent": equivalent_half_sine(time, kg, frequencies, q)}
+    if spec.srs is not None:
+        required = np.array(spec.srs.levels_kg)
+        spectra.update(required=required, lower=required * 10 ** (spec.srs.lower_db / 20),
+                       upper=required * 10 ** (spec.srs.upper_db / 20))
+    return pulse, spectra
+
+
+def record_verdict(args, shot, verdict, output):
+    """The verdict into the archive: a JSON file beside the shot's entries."""
+    from ..archive.verdicts import store_verdict
+
+    path = store_verdict(args.archive, shot, verdict, args.recording, output,
+                         tuple(args.argv))
+    print(f"  archived the verdict as {path}")

@@ -1,0 +1,173 @@
+"""The ``accept`` workbook: the verdict table, the pulse inside its corridor and the SRS
+between its tolerance lines, each on one printed page; the data sheets behind the charts."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..units import KG_MS2, G
+from .charts import line_series, log_axis, nice_range, titled
+from .columns_sheet import ColumnsWorksheet
+from .report import axis, chart_size, not_printed, one_page, report_workbook
+from .sheets import write_about, write_number_columns, write_warnings
+
+RECORD, IDEAL, LIMIT, REQUIRED = "#c00000", "#1f4e79", "#7f7f7f", "#000000"
+G_PER_KG = KG_MS2 / G
+
+#: Printed columns of the Verdict page, and a chart's width in columns.
+VERDICT_COLS, CHART_COLS = 8, 14
+
+
+def write_verdict_table(wb, ws, verdict, row, bold):
+    """The criteria (value, limits, margin, PASS/FAIL, detail) from ``row``; the next free
+    row."""
+    num = wb.add_format({"num_format": "0.000"})
+    pct = wb.add_format({"num_format": '0.00" %"'})
+    db = wb.add_format({"num_format": '+0.00" dB";-0.00" dB"'})
+    good = wb.add_format({"bold": True, "font_color": "#006100", "bg_color": "#C6EFCE"})
+    bad = wb.add_format({"bold": True, "font_color": "#9C0006", "bg_color": "#FFC7CE"})
+    wrap = wb.add_format({"text_wrap": True, "valign": "top"})
+    ws.write_row(row, 0, ["Criterion", "Value", "Unit", "Lower limit", "Upper limit",
+                          "Margin", "Verdict", "Detail"], bold)
+    row += 1
+    for c in verdict.criteria:
+        ws.write_string(row, 0, c.name)
+        if np.isfinite(c.value):
+            ws.write_number(row, 1, c.value, num)
+        else:
+            ws.write_string(row, 1, "not measured")
+        ws.write_string(row, 2, c.unit)
+        for col, limit in ((3, c.low), (4, c.high)):
+            if limit is None:
+                ws.write_string(row, col, "none")
+            else:
+                ws.write_number(row, col, limit, num)
+        if np.isfinite(c.margin):
+            ws.write_number(row, 5, c.margin, db if c.margin_unit == "dB" else pct)
+        else:
+            ws.write_string(row, 5, "none")
+        ws.write_string(row, 6, "PASS" if c.passed else "FAIL", good if c.passed else bad)
+        ws.write_string(row, 7, c.detail, wrap)
+        row += 1
+    ws.write_string(row, 0, "Overall")
+    ws.write_string(row, 6, verdict.word, good if verdict.passed else bad)
+    row += 2
+    ws.write_string(row, 0, "Tolerances used, and definitions", bold)
+    row += 1
+    for line in verdict.tolerances() + verdict.definitions + [
+            f"specification from: {verdict.spec.source or 'options'}"] + [
+            f"note: {n}" for n in verdict.spec.notes]:
+        ws.write_string(row, 0, line)
+        row += 1
+    return row
+
+
+def _pulse_chart(wb, n, t_ms, values, has_corridor):
+    chart = wb.add_chart({"type": "scatter", "subtype": "straight"})
+    line_series(chart, "Pulse data", "Record judged", 1, n, 0, 1, RECORD)
+    if has_corridor:
+        line_series(chart, "Pulse data", "Ideal pulse", 1, n, 0, 2, IDEAL, "dash")
+        line_series(chart, "Pulse data", "Corridor, upper", 1, n, 0, 3, LIMIT)
+        line_series(chart, "Pulse data", "Corridor, lower", 1, n, 0, 4, LIMIT)
+    lo, hi = nice_range(t_ms)
+    ylo, yhi = nice_range(values, include_zero=True)
+    chart = titled(chart, "The pulse and its corridor", axis("Time (ms)", lo, hi),
+                   axis("Acceleration (kG)", ylo, yhi))
+    chart.set_size(chart_size(CHART_COLS, 24))
+    return chart
+
+
+def _srs_chart(wb, n, frequencies, values, has_requirement):
+    chart = wb.add_chart({"type": "scatter", "subtype": "straight"})
+    line_series(chart, "SRS data", "SRS of the record", 1, n, 0, 1, RECORD)
+    if has_requirement:
+        line_series(chart, "SRS data", "Requirement", 1, n, 0, 2, REQUIRED)
+        line_series(chart, "SRS data", "Lower tolerance", 1, n, 0, 3, LIMIT, "dash")
+        line_series(chart, "SRS data", "Upper tolerance", 1, n, 0, 4, LIMIT, "dash")
+    x_axis = log_axis("Natural frequency (Hz)", frequencies, gridlines=True)
+    y_axis = log_axis("Peak response (g)", values, gridlines=True)
+    for a in (x_axis, y_axis):
+        a["num_format"] = "#,##0"
+    chart = titled(chart, "Shock response spectrum (maximax) and its tolerance", x_axis, y_axis)
+    chart.set_size(chart_size(CHART_COLS, 24))
+    return chart
+
+
+def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=None):
+    """Write the Verdict page, the Pulse page (chart), the SRS page (chart and the shaker's
+    figures) and their data sheets at ``path``.
+
+    Parameters
+    ----------
+    pulse : dict
+        ``time`` [s], ``kg`` the record judged, and with a corridor ``ideal``, ``upper``,
+        ``lower`` [kG] on the same samples (NaN outside the window).
+    spectra : dict
+        ``frequencies`` [Hz], ``srs`` [kG], ``pv`` [m/s], optional ``required``, ``lower``,
+        ``upper`` [kG]; ``equivalent`` (peak [kG], duration [s], governing [Hz]).
+    """
+    with report_workbook(path, force) as wb:
+        bold = wb.add_format({"bold": True})
+        ws = wb.add_worksheet("Verdict")
+        ws.set_column(0, 0, 34)
+        ws.set_column(1, 6, 12)
+        ws.set_column(7, 7, 60)
+        row = write_about(ws, about, bold) + 1
+        row = write_verdict_table(wb, ws, verdict, row, bold)
+        row = write_warnings(wb, ws, row + 1, verdict.warnings, VERDICT_COLS - 1,
+                             line_chars=160)
+        one_page(ws, row, VERDICT_COLS - 1, shot=shot, title="Verdict")
+
+        charts = wb.add_worksheet("Pulse")
+        data = wb.add_worksheet("Pulse data", worksheet_class=ColumnsWorksheet)
+        t_ms = np.asarray(pulse["time"]) * 1e3
+        has_corridor = "upper" in pulse
+        names = ["Time (ms)", "Record judged (kG)"]
+        columns = {0: t_ms, 1: np.asarray(pulse["kg"])}
+        if has_corridor:
+            names += ["Ideal pulse (kG)", "Corridor, upper (kG)", "Corridor, lower (kG)"]
+            for col, key in ((2, "ideal"), (3, "upper"), (4, "lower")):
+                columns[col] = np.asarray(pulse[key])
+        data.write_row(0, 0, names, bold)
+        write_number_columns(data, 1, columns)
+        not_printed(data)
+        shown = [v for v in columns.values()][1:]
+        values = np.concatenate([v[np.isfinite(v)] for v in shown])
+        charts.insert_chart(1, 0, _pulse_chart(wb, len(t_ms), t_ms, values, has_corridor))
+        charts.write_string(0, 0, f"Verdict: {verdict.word}", bold)
+        one_page(charts, 26, CHART_COLS - 1, shot=shot, title="Pulse")
+
+        srs_ws = wb.add_worksheet("SRS")
+        srs_data = wb.add_worksheet("SRS data", worksheet_class=ColumnsWorksheet)
+        f = np.asarray(spectra["frequencies"])
+        has_req = "required" in spectra
+        names = ["Frequency (Hz)", "SRS (g)"]
+        columns = {0: f, 1: np.asarray(spectra["srs"]) * G_PER_KG}
+        if has_req:
+            names += ["Requirement (g)", "Lower tolerance (g)", "Upper tolerance (g)"]
+            for col, key in ((2, "required"), (3, "lower"), (4, "upper")):
+                columns[col] = np.asarray(spectra[key]) * G_PER_KG
+        names.append("Pseudo-velocity (m/s)")
+        columns[len(names) - 1] = np.asarray(spectra["pv"])
+        srs_data.write_row(0, 0, names, bold)
+        write_number_columns(srs_data, 1, columns)
+        not_printed(srs_data)
+        plotted = np.concatenate([columns[k] for k in range(1, 5 if has_req else 2)])
+        srs_ws.insert_chart(1, 0, _srs_chart(wb, len(f), f, plotted, has_req))
+        row = 27
+        peak, duration, governing = spectra["equivalent"]
+        kg = wb.add_format({"num_format": '0.000" kG"'})
+        ms = wb.add_format({"num_format": '0.0000" ms"'})
+        hz = wb.add_format({"num_format": '#,##0" Hz"'})
+        mps = wb.add_format({"num_format": '0.000" m/s"'})
+        ws_rows = [("Equivalent half-sine (smallest whose SRS envelops), peak", peak, kg),
+                   ("Equivalent half-sine, duration", duration * 1e3, ms),
+                   ("Equivalent half-sine, governed at", governing, hz),
+                   ("Pseudo-velocity, largest", float(np.max(spectra["pv"])), mps)]
+        for label, value, form in ws_rows:
+            srs_ws.write_string(row, 0, label)
+            srs_ws.write_number(row, 8, value, form)
+            row += 1
+        srs_ws.write_string(0, 0, f"SRS at Q = {spectra['q']:g}; pseudo-velocity = SRS / "
+                                  "(2 pi f)", bold)
+        one_page(srs_ws, row, CHART_COLS - 1, shot=shot, title="SRS")
+
