@@ -34,6 +34,7 @@ class Options:
     force_word: str = "--force"  # how messages name `force`
     srs_requirement: tuple | None = None  # (frequencies [Hz], levels [kG], Q): SRS sheets
     spec: object = None  # a Specification to judge the prediction by (else the shot's sheet)
+    study_notes: tuple = ()  # what the study behind the shot found (design --confidence)
 
 
 @dataclasses.dataclass
@@ -231,7 +232,8 @@ def _provenance(shot, result, crit, compared, options, record, started):
     info = {"version": __version__, "command": " ".join(options.command), "warnings": record,
             "dt_crit": crit.dt_crit, "dt_compacted": crit.dt_compacted,
             "dt_unloading": crit.dt_unloading, "dt_ratio": crit.ratio, "compared": compared,
-            "srs_requirement": options.srs_requirement}
+            "srs_requirement": options.srs_requirement,
+            "study_notes": options.study_notes}
     if shot.source is not None:
         info.update(input=str(shot.source.path), sha256=shot.source.sha256)
     if not options.reproducible:

@@ -115,6 +115,8 @@ SLOW_TESTS = {
     "test_23_16_a_file_size_limit_is_one_line_with_no_zipfile_traceback",
     "test_an_error_cell_in_the_parameters_is_read",
     "test_template_at_half_a_microsecond_has_12002_rows", "test_libreoffice_reads_the_template",
+    "test_the_reported_probability_agrees_with_an_independent_monte_carlo_of_2000_fills",
+    "test_design_confidence_says_when_no_setting_reaches_it", "test_design_confidence_met_exits_0",
 }
 
 

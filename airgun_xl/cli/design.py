@@ -10,6 +10,7 @@ from ..units import parse_duration, parse_peak
 from .cluster_options import add_cluster_options, cluster_runner
 from .fill import print_summary
 from .run_options import add_force, add_output, add_run_options
+from .spec_options import add_spec_options
 
 
 def add_parser(sub):
@@ -19,7 +20,7 @@ def add_parser(sub):
                                    "acceleration of the test item, and write the designed "
                                    "shot as a filled workbook.")
     p.add_argument("shot", metavar="SHOT.xlsx")
-    target = p.add_mutually_exclusive_group(required=True)
+    target = p.add_mutually_exclusive_group()
     target.add_argument("--target-peak", metavar="PEAK",
                         help="requested peak: 12kG, 11750g or 1.2e5m/s2")
     target.add_argument("--target-srs", metavar="REQ.csv",
@@ -42,6 +43,17 @@ def add_parser(sub):
     add_output(p, "designed shot, filled", "SHOT.design.xlsx")
     add_force(p)
     add_cluster_options(p)
+    add_spec_options(p)
+    first = p.add_argument_group("first-shot success (with a specification, no --target-*)")
+    first.add_argument("--confidence", type=float, metavar="P",
+                       help="find the setting most likely to pass with the scatter of --sd, "
+                            "and say whether it reaches P (0.95): exit 3 if none does")
+    first.add_argument("--sd", action="append", metavar="CELL=SD",
+                       help="a cell's shot-to-shot scatter: A28=1.5%% (the gun), E40=5%% (the "
+                            "lot), E43=10%% (zeta); repeatable")
+    first.add_argument("--shots", type=int, default=10_000, metavar="N",
+                       help="Monte Carlo shots a setting (default 10,000)")
+    first.add_argument("--seed", type=int, default=1, help="of the draws (default 1)")
     p.set_defaults(run=run)
 
 
@@ -61,6 +73,11 @@ def run(args):
 
     if args.target_srs is not None:
         return run_srs(args)
+    if args.target_peak is None:
+        return run_spec(args)
+    if args.confidence is not None:
+        raise OptionError("--confidence: found with --target-peak, expected a design by the "
+                          "specification (its fields, with no --target-*)")
     target = parse_peak(args.target_peak)
     duration = parse_duration(args.target_duration) if args.target_duration else None
     names = args.vary or ["A28"]
@@ -126,7 +143,95 @@ def run_srs(args):
     return _write_design(args, shot, design, (frequencies, required, args.q))
 
 
-def _write_design(args, shot, design, requirement=None):
+def run_spec(args):
+    """Design by the specification: the middle of its tolerances, or with --confidence the
+    setting most likely to pass on the first shot."""
+    import math
+
+    from ..shot import Shot
+    from ..studies.design import Design, variable
+    from ..studies.first_shot import solve_confidence, solve_middle
+    from ..studies.sweep import parse_sd
+    from .spec_options import resolve_spec
+
+    names = args.vary or ["A28"]
+    if len(names) != 1:
+        raise OptionError("--vary: found two parameters, expected one for a design by the "
+                          "specification")
+    var = variable(names[0])
+    bounds = _range(args.range) if args.range else None
+    if args.confidence is not None and not 0 < args.confidence < 1:
+        raise OptionError(f"--confidence: found {args.confidence!r}, expected a probability "
+                          "between 0 and 1, such as 0.95")
+    if args.confidence is not None and not 100 <= args.shots <= 10**6:
+        raise OptionError(f"--shots: found {args.shots!r}, expected 100 to 1,000,000")
+    sds = [parse_sd(text) for text in args.sd or []]
+    if args.confidence is not None and not sds:
+        raise OptionError("--confidence: found no --sd, expected the scatter to design "
+                          "against (--sd A28=1.5%% --sd E40=5%%)".replace("%%", "%"))
+    if args.confidence is None and sds:
+        raise OptionError("--sd: found without --confidence, expected both")
+    shot = Shot.from_workbook(args.shot)
+    spec = resolve_spec(shot, args)
+    if spec is None:
+        raise OptionError("design: found no target and an empty specification, expected "
+                          "--target-peak, --target-srs, or the specification's fields (the "
+                          "Specification sheet, --profile, --peak 12kG:10%%...)".replace(
+                              "%%", "%"))
+    started = time.perf_counter()
+    label = f"{var.cell}{'..A30' if var.cell == 'A28' else ''}"
+    extra: list[str] = []  # warnings
+    notes: list[str] = []  # the study's figures, for the Summary
+    code = 0
+    with cluster_runner(args) as runner:
+        if args.confidence is None:
+            middle = solve_middle(shot.params, spec, var, bounds, args.integrator, args.model,
+                                  runner)
+            value, evaluations = middle.value, middle.evaluations
+            print(f"{label} = {value:.6g} {var.unit}: the prediction's smallest margin is "
+                  f"{middle.margin:+.2%} of its nominal (the middle of the tolerances)")
+            if middle.margin < 0:
+                extra.append(f"design: no {var.label} in range makes the prediction pass; the "
+                             f"best misses by {-middle.margin:.2%} of a nominal")
+                code = 3
+        else:
+            c = solve_confidence(shot.params, spec, var, sds, args.shots, args.seed, bounds,
+                                 args.integrator, args.model, runner)
+            value, evaluations = c.best.setting, sum(r.shots for r in c.tried)
+            lo, hi = c.best.interval
+            worst = c.best.most_failing()
+            print(f"{label} = {value:.6g} {var.unit}: P(PASS) = {c.best.probability:.4f} "
+                  f"(95 % interval {lo:.4f}-{hi:.4f}, {c.shots:,} shots)")
+            m_lo, m_hi = c.middle.interval
+            print(f"  the middle design, {label} = {c.middle.setting:.6g} {var.unit}: "
+                  f"P(PASS) = {c.middle.probability:.4f} ({m_lo:.4f}-{m_hi:.4f})")
+            if worst is not None:
+                print(f"  most likely to fail: {worst[0]} ({worst[1]:,} of {c.shots:,} shots)")
+            scatter = ", ".join(args.sd)
+            notes += [f"design --confidence {args.confidence:g}: P(PASS) = "
+                      f"{c.best.probability:.4f} (95 % interval {lo:.4f}-{hi:.4f}) at {label} "
+                      f"= {value:.6g} {var.unit}, over {c.shots:,} shots with {scatter}, "
+                      f"seed {args.seed}; most likely to fail: "
+                      f"{worst[0] if worst else 'none'}",
+                      f"the middle design, {label} = {c.middle.setting:.6g} {var.unit}: "
+                      f"P(PASS) = {c.middle.probability:.4f} ({m_lo:.4f}-{m_hi:.4f})"]
+            extra += c.warnings
+            if hi < args.confidence or c.best.probability < args.confidence:
+                extra.append(f"design --confidence: no {var.label} in range reaches "
+                             f"P(PASS) = {args.confidence:g}; the best found is "
+                             f"{c.best.probability:.4f} at {value:.6g} {var.unit}")
+                code = 3
+    solved = var.apply(shot.params, value)
+    design = Design([var], [value], solved, math.nan, math.nan, evaluations, extra)
+    print(f"  {evaluations:,} simulations in {time.perf_counter() - started:.2f} s")
+    if args.confidence is None:
+        notes.append(f"design by the specification: {label} = {value:.6g} {var.unit}, the "
+                     f"largest smallest margin ({middle.margin:+.2%} of a nominal)")
+    written = _write_design(args, shot, design, spec=spec, notes=tuple(notes))
+    return code or written
+
+
+def _write_design(args, shot, design, requirement=None, spec=None, notes=()):
     from ..pipeline import Options, fill_workbook
     from . import note, warn
     from .progress import Progress
@@ -134,11 +239,13 @@ def _write_design(args, shot, design, requirement=None):
     shot_path = Path(args.shot)
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".design.xlsx")
-    warn(design.warnings)
-    designed = with_cells(shot, design)
+    designed = with_cells(shot, design)  # its warnings go with the designed shot's figures
+    designed = dataclasses.replace(designed, warnings=list(designed.warnings)
+                                   + [w for w in design.warnings if w not in designed.warnings])
     outputs = from_sheet(shot.source.outputs_block)
     options = Options(args.integrator, "excel", args.model, False, args.force,
-                      command=tuple(args.argv), srs_requirement=requirement)
+                      command=tuple(args.argv), srs_requirement=requirement, spec=spec,
+                      study_notes=notes)
     progress = Progress.for_rows(designed.params.rows)
     try:
         filled = fill_workbook(designed, output, outputs, options, warn, None, note, progress)

@@ -33,6 +33,7 @@ class Batch:
     figures: np.ndarray
     diverged: np.ndarray
     stats: list | None = None  # each shot's KernelStats (None where it diverged)
+    extras: np.ndarray | None = None  # shots x extra.width: what ``extra`` computed
 
     def column(self, name):
         return self.figures[:, FIGURES.index(name)]
@@ -42,13 +43,19 @@ def _grid_key(p):
     return p.delta, p.max_time, p.filter_frequency, p.bird_masses
 
 
-def run_batch(params, integrator="legacy", host="excel", threads=2, progress=None):
+def run_batch(params, integrator="legacy", host="excel", threads=2, progress=None,
+              extra=None):
     """Headline figures of each of ``params`` (a list of :class:`ShotParams`).
 
     Parameters
     ----------
     progress : callable, optional
         Called with the number of shots finished after each block.
+    extra : callable, optional
+        ``extra(time, kg)`` of a block's pulses (the test item's acceleration [kG], a row a
+        shot, at ``time`` [s]) gives ``extra.width`` more values a shot, computed on the
+        worker threads while the block's pulses are in memory (the judge of a
+        specification: :class:`airgun_xl.studies.acceptance.BlockJudge`).
 
     Returns
     -------
@@ -56,6 +63,7 @@ def run_batch(params, integrator="legacy", host="excel", threads=2, progress=Non
     """
     n = len(params)
     figures = np.full((n, len(FIGURES)), np.nan)
+    extras = None if extra is None else np.full((n, extra.width), np.nan)
     diverged = np.zeros(n, dtype=bool)
     stats = [None] * n
     groups: dict = {}
@@ -68,9 +76,11 @@ def run_batch(params, integrator="legacy", host="excel", threads=2, progress=Non
             stencils = filter_stencils(first.rows, first.samplerate, host)
             for start in range(0, len(indices), BLOCK):
                 block = indices[start:start + BLOCK]
-                figs, bad, finals = _run_block([params[i] for i in block], integrator,
-                                               stencils, pool)
+                figs, bad, finals, more = _run_block([params[i] for i in block], integrator,
+                                                     stencils, pool, extra)
                 figures[block] = figs
+                if extras is not None:
+                    extras[block] = more
                 diverged[block] = bad
                 for i, row, stopped in zip(block, finals, bad, strict=True):
                     stats[i] = None if stopped else kernel_stats(
@@ -80,10 +90,10 @@ def run_batch(params, integrator="legacy", host="excel", threads=2, progress=Non
     finally:
         if pool is not None:
             pool.shutdown()
-    return Batch(figures, diverged, stats)
+    return Batch(figures, diverged, stats, extras)
 
 
-def _run_block(block, integrator, stencils, pool):
+def _run_block(block, integrator, stencils, pool, extra=None):
     p0 = block[0]
     rows, m = p0.rows, len(block)
     matrix = np.array([kernel_params(p) + [displacement_bound(p)] for p in block])
@@ -96,10 +106,17 @@ def _run_block(block, integrator, stencils, pool):
         t = np.empty(rows)
         batch_kernel(matrix[a:b], rows, _INTEGRATOR_ID[integrator], p0.bird_masses, t, y,
                      finals)
-        return (*_figures(y, t, finals, p0, stencils), finals)
+        out, bad = _figures(y, t, finals, p0, stencils)
+        more = np.full((b - a, extra.width if extra is not None else 0), np.nan)
+        if extra is not None and rows >= 3:
+            kg = ((1.0 / (p0.delta * p0.delta)) * (y[:, 2:] + y[:, :-2] - 2 * y[:, 1:-1])
+                  / KG_DIVISOR)  # as _figures: the single shot's accel_kg, a row a shot
+            more = np.asarray(extra(t[1:-1], kg), dtype=float)
+            more[bad] = np.nan
+        return out, bad, finals, more
 
     parts = list(pool.map(work, halves)) if len(halves) > 1 else [work(halves[0])]
-    return tuple(np.concatenate([part[j] for part in parts]) for j in range(3))
+    return tuple(np.concatenate([part[j] for part in parts]) for j in range(4))
 
 
 def _figures(y, t, finals, p0, stencils):

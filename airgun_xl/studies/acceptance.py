@@ -44,6 +44,9 @@ DURATION_LEVEL = 0.10
 #: The trapezoid's rise and fall, each a fraction of its base.
 TRAPEZOID_RAMP = 0.10
 
+#: Samples over the nominal duration on which the ideal pulse is placed by least squares.
+PLACEMENT_SAMPLES = 400
+
 #: Criteria in the order a verdict lists them.
 CRITERIA = ("peak", "duration", "velocity change", "corridor", "SRS")
 
@@ -167,10 +170,14 @@ def _placement(t: np.ndarray, kg: np.ndarray, spec: Specification, peak_index: n
         return t[peak_index] - peak_offset(spec.shape) * duration
     from scipy.signal import fftconvolve
 
-    template = ideal(spec.shape, np.arange(0.0, duration + dt / 2, dt), amplitude, duration)
+    # on every q-th sample, q keeping PLACEMENT_SAMPLES over the pulse (a prediction at 0.5 us
+    # has 10,000 over a 5 ms pulse); the parabola below places it to a fraction of q samples
+    q = max(1, int(duration / dt) // PLACEMENT_SAMPLES)
+    template = ideal(spec.shape, np.arange(0.0, duration + dt / 2, q * dt), amplitude,
+                     duration)
     # minimising sum (a - ideal(t - t0))^2 over t0 is maximising sum a ideal(t - t0) while
     # the ideal lies inside the record
-    corr = fftconvolve(kg, template[::-1][None, :], mode="valid", axes=1)
+    corr = fftconvolve(kg[:, ::q], template[::-1][None, :], mode="valid", axes=1)
     k = np.argmax(corr, axis=1)
     rows = np.arange(len(k))
     km, kp = np.maximum(k - 1, 0), np.minimum(k + 1, corr.shape[1] - 1)
@@ -178,7 +185,7 @@ def _placement(t: np.ndarray, kg: np.ndarray, spec: Specification, peak_index: n
     denom = cm - 2 * c0 + cp
     with np.errstate(invalid="ignore", divide="ignore"):
         frac = np.where((denom < 0) & (km < k) & (kp > k), 0.5 * (cm - cp) / denom, 0.0)
-    return t[0] + (k + np.clip(frac, -0.5, 0.5)) * dt
+    return t[0] + (k + np.clip(frac, -0.5, 0.5)) * q * dt
 
 
 def _nominals(spec: Specification) -> tuple[float, float]:
@@ -190,13 +197,21 @@ def _nominals(spec: Specification) -> tuple[float, float]:
 
 def corridor_limits(spec: Specification, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Upper and lower limits [kG] at times ``tau`` [s] from the ideal's start: its largest
-    and smallest values within ± the time slack, ± the half-width."""
+    and smallest values within ± the time slack, ± the half-width.
+
+    Every shape rises to its peak and then falls, so over a window [tau - s, tau + s] its
+    largest value is the peak where the window holds the peak's time, else the larger end,
+    and its smallest value is the smaller end: two evaluations, not a search.
+    """
     amplitude, duration = _nominals(spec)
     slack = spec.time_slack * duration
-    offsets = np.linspace(-slack, slack, 41) if slack > 0 else np.zeros(1)
-    shifted = ideal(spec.shape, tau[..., None] + offsets, amplitude, duration)
+    early = ideal(spec.shape, tau - slack, amplitude, duration)
+    late = ideal(spec.shape, tau + slack, amplitude, duration)
+    t_peak = peak_offset(spec.shape) * duration
+    holds_peak = (tau - slack <= t_peak) & (tau + slack >= t_peak)
     band = (spec.corridor or 0.0) * amplitude
-    return shifted.max(axis=-1) + band, shifted.min(axis=-1) - band
+    upper = np.where(holds_peak, amplitude, np.maximum(early, late))
+    return upper + band, np.minimum(early, late) - band
 
 
 def judge_rows(t: np.ndarray, kg: np.ndarray, spec: Specification) -> dict[str, np.ndarray]:
@@ -228,16 +243,20 @@ def judge_rows(t: np.ndarray, kg: np.ndarray, spec: Specification) -> dict[str, 
     lo, hi = onset - window, onset + length + window
     out["onset"] = onset
     out["span"] = np.stack([lo, hi], axis=1)
-    inside = (t[None, :] >= lo[:, None]) & (t[None, :] <= hi[:, None])
-    # the trapezoidal rule over the samples inside the span, row by row
-    pair = inside[:, 1:] & inside[:, :-1]
-    out["velocity change"] = np.sum(np.where(pair, 0.5 * (kg[:, 1:] + kg[:, :-1]), 0.0),
-                                    axis=1) * dt * KG_MS2
+    # the trapezoidal rule over the samples inside the span [lo, hi], row by row: partial
+    # sums of the intervals, differenced at the span's first and last sample
+    first = np.clip(np.searchsorted(t, lo, side="left"), 0, len(t) - 1)
+    last = np.clip(np.searchsorted(t, hi, side="right") - 1, 0, len(t) - 1)
+    sums = np.zeros((len(kg), len(t)))
+    np.cumsum(0.5 * (kg[:, 1:] + kg[:, :-1]), axis=1, out=sums[:, 1:])
+    rows = np.arange(len(kg))
+    out["velocity change"] = np.where(
+        last > first, sums[rows, last] - sums[rows, np.minimum(first, last)], 0.0) * dt * KG_MS2
     if spec.corridor is not None and placed:
+        inside = (t[None, :] >= lo[:, None]) & (t[None, :] <= hi[:, None])
         upper, lower = corridor_limits(spec, t[None, :] - onset[:, None])
         room = np.minimum(upper - kg, kg - lower)
         out["corridor"] = np.min(np.where(inside, room, np.inf), axis=1) / _nominals(spec)[0]
-        out["corridor_room"] = room  # for the report's chart (one row)
     return out
 
 
@@ -384,7 +403,6 @@ def predicted_verdict(result, spec: Specification) -> Verdict:
     """The verdict on a run's predicted pulse (the test item's acceleration, at rest before
     the impact, through the specification's CFC filter when it names one)."""
     from ..errors import OptionError
-    from .measured import filtered_from_rest
     from .shock import check_cfc
 
     ok = np.isfinite(result.accel_kg)
@@ -395,7 +413,53 @@ def predicted_verdict(result, spec: Specification) -> Verdict:
             warnings += check_cfc(spec.cfc, float(t[1] - t[0]))
         except OptionError as exc:
             raise OptionError(f"the specification's record (CFC {spec.cfc}): {exc}") from None
-    t, kg = filtered_from_rest(t, kg, spec.cfc or None)
+    t, kg = judged_record(t, kg, spec.cfc)
     verdict = judge(t, kg, spec, warnings)
     verdict.definitions.insert(0, "judged: the predicted pulse (the test item's acceleration)")
     return verdict
+
+
+def judged_record(t: np.ndarray, kg: np.ndarray, cfc: int | None):
+    """A predicted pulse (or a block of them, a row each) as the specification judges it:
+    through CFC ``cfc`` from rest (:data:`~airgun_xl.studies.measured.REST_BEFORE` of it
+    before the impact, for the phaseless filter's lead), or unchanged."""
+    from .measured import REST_BEFORE
+    from .shock import cfc_filter
+
+    kg = np.asarray(kg, dtype=float)
+    if not cfc:  # unfiltered: the record as it is (a run starts at rest)
+        return t, kg
+    dt = float(t[1] - t[0])
+    n = int(round(REST_BEFORE / dt))
+    t = np.concatenate([t[0] - dt * np.arange(n, 0, -1), t])
+    rest = np.zeros(kg.shape[:-1] + (n,))
+    kg = np.concatenate([rest, kg], axis=-1)
+    return t, (cfc_filter(kg, dt, cfc) if cfc else kg)
+
+
+#: The columns of :class:`BlockJudge`'s values.
+BLOCK_VALUES = ("peak", "duration", "velocity change", "corridor")
+
+
+@dataclass(frozen=True)
+class BlockJudge:
+    """``run_batch``'s ``extra``: each shot's :data:`BLOCK_VALUES`, judged as
+    :func:`predicted_verdict` judges one shot (picklable, for Dask workers)."""
+
+    spec: Specification
+    width: int = len(BLOCK_VALUES)
+
+    def __call__(self, t: np.ndarray, kg: np.ndarray) -> np.ndarray:
+        t, kg = judged_record(t, kg, self.spec.cfc)
+        values = judge_rows(t, kg, self.spec)
+        return np.column_stack([values.get(name, np.full(len(kg), np.nan))
+                                for name in BLOCK_VALUES])
+
+
+def flags_of(values: np.ndarray, spec: Specification) -> dict[str, np.ndarray]:
+    """:func:`pass_flags` of a :class:`BlockJudge`'s columns; a diverged shot (NaN) fails
+    every criterion."""
+    named = {name: values[:, k] for k, name in enumerate(BLOCK_VALUES)}
+    if spec.corridor is None or spec.shape == "none":
+        named.pop("corridor")
+    return pass_flags(named, spec)

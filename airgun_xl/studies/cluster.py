@@ -24,13 +24,13 @@ DEFAULT_CHUNK = 512
 CONNECT_TIMEOUT = "5s"
 
 
-def run_chunk(params, integrator, host):
+def run_chunk(params, integrator, host, extra=None):
     """One chunk on a worker: the batch kernel on one thread (the worker's threads run other
-    chunks); returns (figures, diverged, kernel statistics) only."""
+    chunks); returns (figures, diverged, kernel statistics, extras) only."""
     from ..engine.batch import run_batch
 
-    batch = run_batch(params, integrator, host, threads=1)
-    return batch.figures, batch.diverged, batch.stats
+    batch = run_batch(params, integrator, host, threads=1, extra=extra)
+    return batch.figures, batch.diverged, batch.stats, batch.extras
 
 
 class ClusterRunner:
@@ -48,17 +48,18 @@ class ClusterRunner:
             raise OptionError(f"chunk: found {chunk!r}, expected a positive number of shots")
         self.client, self.chunk = client, int(chunk)
 
-    def __call__(self, params, integrator="legacy", host="excel", progress=None):
+    def __call__(self, params, integrator="legacy", host="excel", progress=None, extra=None):
         from distributed import as_completed
 
         from ..engine.batch import FIGURES, Batch
 
         params = list(params)
         if not params:
-            return Batch(np.zeros((0, len(FIGURES))), np.zeros(0, dtype=bool), [])
+            return Batch(np.zeros((0, len(FIGURES))), np.zeros(0, dtype=bool), [],
+                         None if extra is None else np.zeros((0, extra.width)))
         starts = range(0, len(params), self.chunk)
         futures = [self.client.submit(run_chunk, params[i:i + self.chunk], integrator, host,
-                                      pure=False) for i in starts]
+                                      extra, pure=False) for i in starts]
         index = {f.key: n for n, f in enumerate(futures)}
         parts: list = [None] * len(futures)
         for future in as_completed(futures):
@@ -67,9 +68,10 @@ class ClusterRunner:
             future.release()
             if progress is not None:
                 progress(min(self.chunk, len(params) - starts[n]))
-        return Batch(np.concatenate([f for f, _, _ in parts]),
-                     np.concatenate([d for _, d, _ in parts]),
-                     [s for _, _, stats in parts for s in stats])
+        return Batch(np.concatenate([f for f, _, _, _ in parts]),
+                     np.concatenate([d for _, d, _, _ in parts]),
+                     [s for _, _, stats, _ in parts for s in stats],
+                     None if extra is None else np.concatenate([e for *_, e in parts]))
 
 
 def max_workers():

@@ -298,6 +298,10 @@ def write_summary(wb, result, summary, timings, name="Summary"):
     row = len(rows) + 2
     if timings.get("verdict") is not None:
         row = write_predicted_verdict(wb, ws, timings["verdict"], row, style) + 1
+    for note in timings.get("study_notes") or ():
+        ws.write_string(row, 0, "Design", style.bold)
+        ws.write_string(row, 3, note)
+        row += 1
     last = write_warnings(wb, ws, row, timings.get("warnings", []), 3)
     one_page(ws, last, 3, shot=timings.get("shot"), title="Summary")
     ws.freeze_panes(1, 0)

@@ -1,0 +1,231 @@
+"""Designs that meet a specification, and the chance that they pass on the first shot
+(issue 25).
+
+- :func:`solve_middle`: the setting of one parameter whose predicted pulse sits in the middle
+  of the tolerances: the largest smallest margin over the criteria (each margin a fraction of
+  its nominal, as :mod:`airgun_xl.studies.acceptance` gives it).
+- :func:`pass_probability`: a Monte Carlo of the shot with the scattered cells (``--sd``)
+  drawn from normal distributions, every shot run on the batch lanes (or a Dask runner) and
+  judged on the worker threads by :class:`~airgun_xl.studies.acceptance.BlockJudge`: the
+  fraction that passes, with its Wilson 95 % interval, and how often each criterion fails.
+- :func:`solve_confidence`: the setting with the highest probability: the middle design and
+  :data:`CANDIDATES` settings across the span where the prediction passes are tried with a
+  twentieth of the shots, then the best of them and the middle design with all of them, each
+  round on one set of draws (common random numbers: settings compared on equal luck).
+
+The SRS criterion is judged on single pulses only: a probability says when it leaves it out.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..engine.batch import run_batch
+from ..errors import AirgunXlError, DesignError
+from ..models import apply_model
+from ..specification import Specification
+from .acceptance import BLOCK_VALUES, BlockJudge, flags_of, wilson_interval
+
+#: Points of the scan over the parameter's range.
+SCAN_POINTS = 25
+
+#: The first round of :func:`solve_confidence` runs this fraction of the shots a setting.
+FIRST_ROUND = 0.05
+
+#: Settings tried in the first round, across the span where the prediction passes (the scan's
+#: passing points, one scan step wider each side).
+CANDIDATES = 7
+
+#: Settings of the first round that go on to the second with every shot (beside the middle
+#: design, which always does).
+FINALISTS = 1
+
+
+def margins(values: np.ndarray, spec: Specification) -> np.ndarray:
+    """Each shot's smallest margin over the criteria (a fraction of the nominal; negative:
+    outside), from a :class:`BlockJudge`'s columns; NaN (diverged) is -inf."""
+    cols = []
+    for k, name in enumerate(BLOCK_VALUES):
+        v = values[:, k]
+        if name == "corridor":
+            if spec.corridor is not None and spec.shape != "none":
+                cols.append(v)
+            continue
+        tol = {"peak": spec.peak, "duration": spec.duration,
+               "velocity change": spec.velocity_change}[name]
+        if tol is not None:
+            lo, hi = tol.limits
+            cols.append(np.minimum(v - lo, hi - v) / tol.nominal)
+    if not cols:
+        raise DesignError("the specification gives no criterion a design can aim at (peak, "
+                          "duration, velocity change or corridor)")
+    least = np.min(np.column_stack(cols), axis=1)
+    return np.where(np.isfinite(least), least, -np.inf)
+
+
+@dataclass
+class MiddleDesign:
+    """The setting whose prediction sits deepest inside the tolerances."""
+
+    value: float
+    margin: float  # smallest margin there, a fraction of the nominal
+    passing: tuple[float, float] | None  # scan's span of settings whose prediction passes
+    evaluations: int
+    scan: tuple[np.ndarray, np.ndarray] = field(repr=False, default=(np.zeros(0),
+                                                                     np.zeros(0)))
+
+
+def _run(p, var, xs, spec, integrator, model, runner):
+    params = [apply_model(var.apply(p, x), model) for x in xs]
+    batch = (runner or run_batch)(params, integrator, extra=BlockJudge(spec))
+    return batch.extras
+
+
+def solve_middle(p, spec, var, bounds=None, integrator="legacy", model="4-mass", runner=None):
+    """The value of ``var`` with the largest smallest margin: a scan of :data:`SCAN_POINTS`,
+    then a bounded search (scipy) between the best point's neighbours.
+
+    Raises
+    ------
+    DesignError
+        When no setting in the range has a finite margin (every shot diverged).
+    """
+    from scipy.optimize import minimize_scalar
+
+    lo, hi = bounds or var.bounds(p)
+    xs = np.linspace(lo, hi, SCAN_POINTS)
+    ys = margins(_run(p, var, xs, spec, integrator, model, runner), spec)
+    if not np.isfinite(ys).any():
+        raise DesignError(f"no {var.label} in {lo:.4g}-{hi:.4g} {var.unit} gives a pulse that "
+                          "can be judged (every shot diverged)")
+    best = int(np.argmax(ys))
+    a, b = xs[max(best - 1, 0)], xs[min(best + 1, len(xs) - 1)]
+    count = [len(xs)]
+
+    def negative(x):
+        count[0] += 1
+        return -float(margins(_run(p, var, [x], spec, integrator, model, runner), spec)[0])
+
+    found = minimize_scalar(negative, bounds=(a, b), method="bounded",
+                            options={"xatol": 1e-6 * max(abs(a), abs(b), 1e-12)})
+    x, y = (float(found.x), -float(found.fun)) if -found.fun >= ys[best] else (
+        float(xs[best]), float(ys[best]))
+    passing = xs[ys >= 0]
+    span = (float(passing.min()), float(passing.max())) if len(passing) else None
+    return MiddleDesign(x, y, span, count[0], (xs, ys))
+
+
+@dataclass
+class PassProbability:
+    """A Monte Carlo's pass rate at one setting."""
+
+    setting: float
+    passes: int
+    shots: int
+    failures: dict[str, int]  # criterion -> shots failing it (a shot may fail several)
+    diverged: int
+    invalid: int  # draws that are not a shot (a negative mass): counted as failures
+
+    @property
+    def probability(self) -> float:
+        return self.passes / self.shots if self.shots else math.nan
+
+    @property
+    def interval(self) -> tuple[float, float]:
+        return wilson_interval(self.passes, self.shots)
+
+    def most_failing(self) -> tuple[str, int] | None:
+        if not self.failures or max(self.failures.values()) == 0:
+            return None
+        name = max(self.failures, key=lambda k: self.failures[k])
+        return name, self.failures[name]
+
+
+def draws(p, sds, n, seed):
+    """``n`` draws of the scattered cells: a (n, cells) array of values, and the cells'
+    fields (as :func:`airgun_xl.studies.sweep.monte_carlo` draws them)."""
+    from .sweep import check_spreads
+
+    check_spreads(p, sds)
+    rng = np.random.default_rng(seed)
+    columns = [rng.normal(getattr(p, fields[0]),
+                          sd * abs(getattr(p, fields[0])) if relative else sd, n)
+               for _cell, fields, sd, relative in sds]
+    return (np.column_stack(columns) if columns else np.zeros((n, 0)),
+            [fields for _cell, fields, _sd, _rel in sds])
+
+
+def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator="legacy",
+                     model="4-mass", runner=None, progress=None, drawn=None):
+    """The fraction of ``n`` shots that pass ``spec``, with ``var`` at ``setting`` (None: the
+    sheet's) and the ``sds`` cells scattered (:func:`airgun_xl.studies.sweep.parse_sd`).
+
+    A setting moves a scattered cell's mean: a drawn value is its draw's offset from the
+    sheet's value, added to the setting (so the gun's scatter follows the velocity set).
+    """
+    values, fields_list = drawn if drawn is not None else draws(p, sds, n, seed)
+    base = var.apply(p, setting) if var is not None and setting is not None else p
+    params, invalid = [], np.zeros(n, dtype=bool)
+    offsets = [(fields, getattr(base, fields[0]) - getattr(p, fields[0]))
+               for fields in fields_list]
+    for i in range(n):
+        try:
+            q = base.replace(**{f: float(value + shift) for (fields, shift), value
+                                in zip(offsets, values[i], strict=True) for f in fields})
+            params.append(apply_model(q, model))
+        except AirgunXlError:
+            invalid[i] = True
+    batch = (runner or run_batch)(params, integrator, progress=progress,
+                                  extra=BlockJudge(spec))
+    flags = flags_of(batch.extras, spec)
+    ok = np.ones(len(params), dtype=bool)
+    for f in flags.values():
+        ok &= f
+    failures = {name: int((~f).sum()) + int(invalid.sum()) for name, f in flags.items()}
+    return PassProbability(float(setting) if setting is not None else math.nan,
+                           int(ok.sum()), n, failures, int(batch.diverged.sum()),
+                           int(invalid.sum()))
+
+
+@dataclass
+class ConfidenceDesign:
+    """The setting with the highest pass probability, and the middle design's."""
+
+    best: PassProbability
+    middle: PassProbability
+    middle_design: MiddleDesign
+    tried: list[PassProbability]
+    shots: int
+    warnings: list[str] = field(default_factory=list)
+
+
+def solve_confidence(p, spec, var, sds, n, seed=1, bounds=None, integrator="legacy",
+                     model="4-mass", runner=None, progress=None):
+    """The setting of ``var`` most likely to pass (see the module's notes)."""
+    middle = solve_middle(p, spec, var, bounds, integrator, model, runner)
+    xs, ys = middle.scan
+    step = xs[1] - xs[0] if len(xs) > 1 else 0.0
+    if middle.passing is not None:
+        lo, hi = middle.passing
+        span = np.linspace(max(lo - step, xs[0]), min(hi + step, xs[-1]), CANDIDATES)
+    else:  # nothing passes nominally: round the middle design
+        span = np.clip(middle.value + step * np.linspace(-1, 1, CANDIDATES), xs[0], xs[-1])
+    candidates = sorted({float(x) for x in span} | {middle.value})
+    first_n = max(200, int(round(n * FIRST_ROUND)))
+    drawn_first = draws(p, sds, first_n, seed)
+    first = [pass_probability(p, spec, sds, first_n, seed, var, x, integrator, model, runner,
+                              progress, drawn_first) for x in candidates]
+    ranked = sorted(first, key=lambda r: -r.probability)
+    finalists = sorted({r.setting for r in ranked[:FINALISTS]} | {middle.value})
+    drawn = draws(p, sds, n, seed + 1)  # fresh draws: the first round's luck does not carry
+    final = [pass_probability(p, spec, sds, n, seed + 1, var, x, integrator, model, runner,
+                              progress, drawn) for x in finalists]
+    best = max(final, key=lambda r: r.probability)
+    mid = next(r for r in final if r.setting == middle.value)
+    warnings = []
+    if spec.srs is not None:
+        warnings.append("the SRS criterion is not in the probability: it is judged on the "
+                        "designed shot's prediction only")
+    return ConfidenceDesign(best, mid, middle, first + final, n, warnings)
