@@ -45,12 +45,19 @@ def fill_cmd(shot, out, *flags):
             *flags]
 
 
-def timed(cmd, repeat):
-    subprocess.run(cmd, check=True, capture_output=True)  # warm-up (OS file cache)
+def timed(cmd, repeat, ok_codes=(0,)):
+    """(median, min) wall time [s] of ``cmd`` as a process, after a warm-up run; an exit code
+    outside ``ok_codes`` stops the benchmark."""
+    def run():
+        done = subprocess.run(cmd, capture_output=True)
+        if done.returncode not in ok_codes:
+            raise subprocess.CalledProcessError(done.returncode, cmd, done.stdout, done.stderr)
+
+    run()  # warm-up (OS file cache)
     times = []
     for _ in range(repeat):
         started = time.perf_counter()
-        subprocess.run(cmd, check=True, capture_output=True)
+        run()
         times.append(time.perf_counter() - started)
     return statistics.median(times), min(times)
 

@@ -98,6 +98,7 @@ SLOW_MODULES = {
     "test_recorder", "test_design", "test_design_srs", "test_calibrate", "test_cluster",
     "test_writer_fallback", "test_hostile_faults", "test_hostile_inputs",
     "test_hostile_outputs", "test_hostile_properties", "test_hostile_measured_properties",
+    "test_hostile_spec_properties",
     "test_hostile_archive", "test_pure_python", "test_typing", "test_sensitivity",
 }
 

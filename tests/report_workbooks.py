@@ -29,7 +29,8 @@ def make_all(folder):
     requirement.write_text("frequency [Hz],srs [g]\n200,150\n1000,1500\n4000,6000\n")
     out = {name: folder / f"{name}.xlsx" for name in (
         "fill", "diff", "grid", "montecarlo", "sobol", "convergence", "srs", "design_srs",
-        "compare", "calibrate_law", "calibrate_fit", "campaign", "history")}
+        "compare", "calibrate_law", "calibrate_fit", "campaign", "history", "accept",
+        "accept_corridor", "design_confidence")}
     day = folder / "day"
     day.mkdir()
     for name in ("shot_1", "shot_2"):
@@ -60,6 +61,22 @@ def make_all(folder):
         "campaign": ["fill", str(day), "--jobs", "1", "--summary", str(out["campaign"]),
                      "--archive", str(folder / "archive")],
         "history": ["history", str(folder / "archive"), "-o", str(out["history"])],
+        "accept": ["accept", str(shot), str(measured), "--sign", "-1", "--cfc", "1000",
+                   "--peak", "9.5kG:15%", "--duration", "5ms:15%", "--velocity-change",
+                   "240m/s:10%", "--srs", str(requirement), "--srs-tol", "-40dB,+40dB",
+                   "-o", str(out["accept"])],
+        "accept_corridor": ["accept", str(shot), str(measured), "--sign", "-1", "--cfc",
+                            "1000", "--profile", "mil-std-810h-half-sine", "--peak", "9.5kG",
+                            "--duration", "5ms", "--velocity-change", "240m/s", "-o",
+                            str(out["accept_corridor"])],
+        "design_confidence": ["design", str(shot), "--peak", "12kG:10%", "--duration",
+                              "5ms:10%", "--velocity-change", "240m/s:10%", "--confidence",
+                              "0.5", "--sd", "A28=1.5%", "--shots", "200", "-o",
+                              str(out["design_confidence"])],
     }
     codes = {name: main(argv) for name, argv in commands.items()}
     return out, codes
+
+
+#: The exit codes make_all's commands give: 0, but a shot that fails its specification (3).
+EXPECTED_CODES = {"accept_corridor": 3}

@@ -261,3 +261,31 @@ def test_a_spec_without_a_tolerance_is_refused():
 
     with pytest.raises(OptionError, match="without a tolerance"):
         check(Specification(peak=Tolerance(12.0, math.nan, math.nan)), "options")
+
+
+# -- the spectra a lab uses to move a test to a shaker ----------------------------------------
+
+def test_the_equivalent_half_sine_of_a_half_sine_is_itself():
+    """The smallest half-sine whose SRS envelops an ideal half-sine's is that half-sine: peak
+    and duration to 0.1 % (the duration search stops at 1e-4 of the grid step; the SRS's
+    recursive filter is exact for a ramp-invariant pulse only to O((f dt)^2))."""
+    from airgun_xl.studies.acceptance import equivalent_half_sine
+
+    dt = T / 400
+    t = np.arange(0, 6 * T, dt)
+    pulse = ideal("half-sine", t - T, A, T)
+    peak, duration, _ = equivalent_half_sine(t, pulse, np.geomspace(100, 0.1 / dt, 40), 10.0)
+    assert peak == pytest.approx(A, rel=1e-3) and duration == pytest.approx(T, rel=1e-3)
+
+
+def test_the_pseudo_velocity_tends_to_the_velocity_change_at_low_frequency():
+    """Far below 1/T an oscillator sees an impulse of the velocity change dV, and its
+    pseudo-velocity is dV times the damping's loss over a quarter period, exp(-zeta pi/2)
+    (0.9992 at Q = 1000); the pulse's length (omega T = 0.019 rad) moves it by under 1e-4."""
+    from airgun_xl.studies.acceptance import pseudo_velocity
+
+    dt = T / 400
+    pulse = ideal("half-sine", np.arange(0, 6 * T, dt) - T, A, T)
+    f = np.array([10.0])
+    pv = pseudo_velocity(f, srs(pulse, dt, f, 1000.0))[0]
+    assert pv == pytest.approx(DV * math.exp(-0.0005 * math.pi / 2), rel=2e-4)

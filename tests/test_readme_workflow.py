@@ -22,7 +22,8 @@ NOT_RUN = ("pip install", "python -m pytest", "apt-get ", "../shared/legacy/run-
 #: README, then the documents it links, in the order their sections had in README (later
 #: blocks use files that earlier ones made).
 DOCUMENTS = ("README.md", "docs/cell-map.md", "docs/output.md", "docs/trust.md",
-             "docs/studies.md", "docs/legacy.md", "docs/security.md", "docs/speed.md",
+             "docs/studies.md", "docs/acceptance.md", "docs/legacy.md", "docs/security.md",
+             "docs/speed.md",
              "docs/layout.md", "docs/dependencies.md")
 
 

@@ -123,16 +123,21 @@ def report_data(time, kg, spec, verdict):
         pulse["lower"] = np.where(inside, lower, np.nan)
     dt = time[1] - time[0]
     q = spec.srs.q if spec.srs is not None else 10.0
-    if spec.srs is not None:
-        frequencies = np.array(spec.srs.frequencies)
+    top = 0.1 / dt  # the SRS's highest frequency at this rate
+    if spec.srs is not None:  # the requirement's band on a 1/12-octave grid, and its rows
+        required_f = np.array(spec.srs.frequencies)
+        lo, hi = required_f.min(), min(required_f.max(), top)
+        grid = default_frequencies(lo, hi) if hi > lo else np.array([lo])
+        frequencies = np.unique(np.concatenate([grid, required_f[required_f <= top]]))
     else:
-        frequencies = default_frequencies(100.0, min(10_000.0, 0.1 / dt))
+        frequencies = default_frequencies(100.0, min(10_000.0, top))
     levels = srs(kg, dt, frequencies, q)
     spectra = {"frequencies": frequencies, "srs": levels, "q": q,
                "pv": pseudo_velocity(frequencies, levels),
                "equivalent": equivalent_half_sine(time, kg, frequencies, q)}
-    if spec.srs is not None:
-        required = np.array(spec.srs.levels_kg)
+    if spec.srs is not None:  # log-log between the requirement's rows
+        required = np.exp(np.interp(np.log(frequencies), np.log(required_f),
+                                    np.log(np.array(spec.srs.levels_kg))))
         spectra.update(required=required, lower=required * 10 ** (spec.srs.lower_db / 20),
                        upper=required * 10 ** (spec.srs.upper_db / 20))
     return pulse, spectra

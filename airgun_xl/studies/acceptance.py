@@ -315,7 +315,7 @@ def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
     definitions.append(f"velocity change: integrated from {lo * 1e3:.4f} to {hi * 1e3:.4f} ms")
     if "corridor" in row:
         margin = float(row["corridor"])
-        criteria.append(Criterion("corridor", 100 * margin, "% of peak", 0.0, None,
+        criteria.append(Criterion("corridor", 100 * margin, "%", 0.0, None,
                                   100 * margin, "%", margin >= 0,
                                   f"±{spec.corridor:.0%} of {_nominals(spec)[0]:.4g} kG, time "
                                   f"slack ±{spec.time_slack:.0%}, placed by {spec.placement}"))
@@ -380,23 +380,37 @@ def equivalent_half_sine(t: np.ndarray, kg: np.ndarray, frequencies: np.ndarray,
     -------
     (peak [kG], duration [s], governing frequency [Hz])
     """
+    from scipy.optimize import minimize_scalar
+
     from .shock import srs
 
     dt = t[1] - t[0]
     target = srs(np.asarray(kg, dtype=float), dt, frequencies, q)
-    if durations is None:
-        above = np.flatnonzero(np.asarray(kg) >= 0.1 * np.max(kg))
-        base = (above[-1] - above[0] + 1) * dt if len(above) else 1e-3
-        durations = base * np.geomspace(0.25, 4.0, 33)
-    best = None
-    for duration in durations:
+
+    def least_peak(duration):
         n = int(math.ceil(duration / dt)) + 1
         unit = ideal("half-sine", np.arange(n) * dt, 1.0, duration)
         ratio = target / srs(unit, dt, frequencies, q)
         k = int(np.argmax(ratio))
-        if best is None or ratio[k] < best[0]:
-            best = (float(ratio[k]), float(duration), float(frequencies[k]))
-    return best
+        return float(ratio[k]), float(frequencies[k])
+
+    if durations is None:
+        above = np.flatnonzero(np.asarray(kg) >= DURATION_LEVEL * np.max(kg))
+        base = ((above[-1] - above[0] + 1) * dt / width_fraction("half-sine") if len(above)
+                else 1e-3)
+        durations = base * np.geomspace(0.25, 4.0, 33)
+    durations = np.asarray(durations, dtype=float)
+    peaks = [least_peak(d)[0] for d in durations]
+    k = int(np.argmin(peaks))
+    lo, hi = durations[max(k - 1, 0)], durations[min(k + 1, len(durations) - 1)]
+    if hi > lo:  # refined between the grid's neighbours
+        found = minimize_scalar(lambda d: least_peak(d)[0], bounds=(lo, hi), method="bounded",
+                                options={"xatol": 1e-4 * lo})
+        if found.fun < peaks[k]:
+            peak, governing = least_peak(float(found.x))
+            return peak, float(found.x), governing
+    peak, governing = least_peak(float(durations[k]))
+    return peak, float(durations[k]), governing
 
 
 def predicted_verdict(result, spec: Specification) -> Verdict:

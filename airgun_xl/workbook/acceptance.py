@@ -87,8 +87,20 @@ def _srs_chart(wb, n, frequencies, values, has_requirement):
     y_axis = log_axis("Peak response (g)", values, gridlines=True)
     for a in (x_axis, y_axis):
         a["num_format"] = "#,##0"
-    chart = titled(chart, "Shock response spectrum (maximax) and its tolerance", x_axis, y_axis)
-    chart.set_size(chart_size(CHART_COLS, 24))
+    chart = titled(chart, "SRS (maximax) and its tolerance", x_axis, y_axis)
+    chart.set_size(chart_size(CHART_COLS // 2, 24))
+    return chart
+
+
+def _pv_chart(wb, n, frequencies, pv, col):
+    chart = wb.add_chart({"type": "scatter", "subtype": "straight"})
+    line_series(chart, "SRS data", "Pseudo-velocity", 1, n, 0, col, IDEAL)
+    x_axis = log_axis("Natural frequency (Hz)", frequencies, gridlines=True)
+    y_axis = log_axis("Pseudo-velocity (m/s)", pv, gridlines=True)
+    x_axis["num_format"] = "#,##0"
+    y_axis["num_format"] = "General"
+    chart = titled(chart, "Pseudo-velocity shock spectrum", x_axis, y_axis)
+    chart.set_size(chart_size(CHART_COLS - CHART_COLS // 2, 24))
     return chart
 
 
@@ -153,6 +165,9 @@ def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=Non
         not_printed(srs_data)
         plotted = np.concatenate([columns[k] for k in range(1, 5 if has_req else 2)])
         srs_ws.insert_chart(1, 0, _srs_chart(wb, len(f), f, plotted, has_req))
+        srs_ws.insert_chart(1, CHART_COLS // 2, _pv_chart(wb, len(f), f, columns[len(names) - 1],
+                                                         len(names) - 1))
+        srs_ws.set_column(8, 8, 16)
         row = 27
         peak, duration, governing = spectra["equivalent"]
         kg = wb.add_format({"num_format": '0.000" kG"'})

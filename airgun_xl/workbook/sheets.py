@@ -4,6 +4,7 @@ Each writer returns the :class:`Ref` of the series it holds, so charts can point
 are already written instead of copying them.
 """
 import datetime
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -246,8 +247,7 @@ def write_predicted_verdict(wb, ws, verdict, row, style):
     number = wb.add_format({"num_format": "0.000", "align": "right"})
     ws.write_string(row, 0, "Specification: predicted verdict", style.bold)
     ws.write_string(row, 1, verdict.word, good if verdict.passed else bad)
-    ws.write_string(row, 3, f"from {verdict.spec.source or 'options'}; "
-                    + "; ".join(verdict.definitions[1:]))
+    ws.write_string(row, 3, f"the specification from {verdict.spec.source or 'options'}")
     row += 1
     for c in verdict.criteria:
         ws.write_string(row, 0, f"Specification: {c.name}")
@@ -259,6 +259,12 @@ def write_predicted_verdict(wb, ws, verdict, row, style):
         ws.write_string(row, 3, f"{'PASS' if c.passed else 'FAIL'}: limits {lo} to {hi} "
                         f"{c.unit}, margin {c.margin:+.2f} {c.margin_unit}"
                         + (f"; {c.detail}" if c.detail else ""))
+        row += 1
+    wrap = wb.add_format({"text_wrap": True, "valign": "top"})
+    for line in verdict.definitions[1:] + [f"note: {n}" for n in verdict.spec.notes]:
+        ws.write_string(row, 3, line, wrap)
+        if len(line) > 110:  # the Definition column's width, in characters
+            ws.set_row(row, 15 * math.ceil(len(line) / 110))
         row += 1
     return row
 
