@@ -22,7 +22,6 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 from .errors import OptionError
-from .units import parse_duration, parse_peak
 
 #: The pulse shapes a specification can name; "none" judges the limits only (no corridor).
 SHAPES = ("half-sine", "sawtooth", "trapezoid", "none")
@@ -389,42 +388,6 @@ def load_profile(name: str) -> Specification:
         raise OptionError(f"{shown}: found notes that are not text, expected a list of text")
     spec = from_fields(data, f"profile {path.stem}")
     return replace(spec, notes=tuple(notes))
-
-
-def from_options(args, record: int | None = None) -> Specification:
-    """The fields given on the command line (``--peak 12kG:10%``...), as a specification to
-    merge over the sheet's or the profile's."""
-    from .workbook.trace import read_spectrum
-
-    srs = None
-    if getattr(args, "srs", None):
-        freqs, levels = read_spectrum(args.srs, getattr(args, "accel_unit", None))
-        lower, upper = parse_db_pair(args.srs_tol) if args.srs_tol else (-3.0, 6.0)
-        srs = SrsRequirement(tuple(map(float, freqs)), tuple(map(float, levels)),
-                             args.srs_q, lower, upper, args.srs_outside / 100)
-        check(Specification(srs=srs), "--srs")
-    elif getattr(args, "srs_tol", None):
-        raise OptionError("--srs-tol: found without --srs, expected the requirement it "
-                          "applies to")
-    return Specification(
-        shape=args.shape or "none",
-        peak=parse_tolerance(args.peak, "--peak", parse_peak) if args.peak else None,
-        duration=(parse_tolerance(args.duration, "--duration", parse_duration)
-                  if args.duration else None),
-        velocity_change=(parse_tolerance(args.velocity_change, "--velocity-change",
-                                         lambda t, o: parse_velocity(t, o))
-                         if args.velocity_change else None),
-        corridor=None if args.corridor is None else _percent_option(args.corridor,
-                                                                    "--corridor"),
-        time_slack=(0.0 if args.time_slack is None else
-                    _percent_option(args.time_slack, "--time-slack")),
-        window=(None if args.window is None else parse_duration(args.window, "--window")),
-        srs=srs, cfc=record, placement=args.placement or "least-squares",
-        source="options")
-
-
-def _percent_option(text: str, option: str) -> float:
-    return _fraction(str(text), option, str(text))[1]
 
 
 def combine(profile: str | None, sheet: Specification | None,

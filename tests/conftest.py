@@ -118,6 +118,8 @@ SLOW_TESTS = {
     "test_template_at_half_a_microsecond_has_12002_rows", "test_libreoffice_reads_the_template",
     "test_the_reported_probability_agrees_with_an_independent_monte_carlo_of_2000_fills",
     "test_design_confidence_says_when_no_setting_reaches_it", "test_design_confidence_met_exits_0",
+    "test_the_closed_form_critical_step_agrees_with_the_bisection",
+    "test_the_short_version_agrees_with_formulas",
 }
 
 

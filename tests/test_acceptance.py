@@ -289,3 +289,26 @@ def test_the_pseudo_velocity_tends_to_the_velocity_change_at_low_frequency():
     f = np.array([10.0])
     pv = pseudo_velocity(f, srs(pulse, dt, f, 1000.0))[0]
     assert pv == pytest.approx(DV * math.exp(-0.0005 * math.pi / 2), rel=2e-4)
+
+
+def test_the_verdict_goes_into_the_archive(tmp_path, recording, capsys):
+    """accept --archive keeps the verdict (criteria, tolerances, warnings, the recording's
+    hash); history lists it; the archive still verifies clean."""
+    import hashlib
+    import json
+
+    archive = tmp_path / "lab"
+    assert main(["accept", str(TEMPLATE), str(recording), "--sign", "-1", "--cfc", "1000",
+                 "--peak", "9.5kG:10%", "--duration", "5ms:15%", "-o",
+                 str(tmp_path / "v.xlsx"), "--archive", str(archive)]) == 0
+    stored = sorted((archive / ".verdicts").rglob("v*.json"))
+    assert len(stored) == 1
+    record = json.loads(stored[0].read_text())
+    assert record["verdict"] == "PASS" and [c["name"] for c in record["criteria"]] == [
+        "peak", "duration"]
+    assert record["recording_sha256"] == hashlib.sha256(recording.read_bytes()).hexdigest()
+    assert record["tolerances"][0].startswith("peak: 8.55 to 10.45 kG")
+    capsys.readouterr()
+    assert main(["history", str(archive)]) == 0
+    assert "verdicts (accept --archive):" in capsys.readouterr().out
+    assert main(["archive", "verify", str(archive)]) == 0

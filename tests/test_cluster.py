@@ -106,3 +106,21 @@ def test_cluster_options_are_checked(tmp_path, capsys):
     assert errors[2].startswith("airgun-xl: error: --scheduler: found 'tcp://127.0.0.1:9', "
                                 "which did not answer")
     assert len(errors) == 3 and not out.exists()
+
+
+def test_a_pass_probability_on_the_cluster_equals_the_batch_lanes(client):
+    """Issue 25: design --confidence's Monte Carlo on Dask workers (the judge pickled to them)
+    passes and fails the same shots as on this machine's lanes."""
+    from airgun_xl.specification import Specification, Tolerance
+    from airgun_xl.studies.design import variable
+    from airgun_xl.studies.first_shot import pass_probability
+    from airgun_xl.studies.sweep import parse_sd
+
+    p = airgun_xl.load(TEMPLATE).params
+    spec = Specification(peak=Tolerance(12.0, 0.1, 0.1), duration=Tolerance(5e-3, 0.1, 0.1))
+    sds = [parse_sd("A28=1.5%"), parse_sd("E40=5%")]
+    local = pass_probability(p, spec, sds, 300, 3, variable("A28"), 242.0)
+    remote = pass_probability(p, spec, sds, 300, 3, variable("A28"), 242.0,
+                              runner=ClusterRunner(client, chunk=64))
+    assert (remote.passes, remote.failures) == (local.passes, local.failures)
+    assert 0 < local.passes < 300

@@ -145,6 +145,30 @@ def _read_manifest(folder):
     return manifest if ok else None
 
 
+#: How long a writer waits for another's lock on the index [s].
+LOCK_WAIT = 120
+
+
+def _prepare(conn):
+    """WAL mode, full sync and the schema on a new connection. Two processes creating the index
+    at once may see "database is locked" from the journal-mode switch, which SQLite does not
+    retry through the busy timeout: it is retried here, up to :data:`LOCK_WAIT`."""
+    import time
+
+    deadline = time.monotonic() + LOCK_WAIT
+    while True:
+        try:
+            if str(conn.execute("PRAGMA journal_mode").fetchone()[0]).lower() != "wal":
+                conn.execute("PRAGMA journal_mode=WAL")
+            conn.execute("PRAGMA synchronous=FULL")
+            conn.execute(SCHEMA)
+            return
+        except sqlite3.OperationalError as exc:
+            if "locked" not in str(exc) or time.monotonic() > deadline:
+                raise
+            time.sleep(0.02)
+
+
 def _is_index(path):
     """Whether ``path`` is an SQLite file with this tool's ``entries`` table."""
     if not path.is_file():
@@ -258,11 +282,9 @@ class Archive:
     # -- the index ------------------------------------------------------------------------
     def _connect(self):
         try:
-            conn = sqlite3.connect(self.root / INDEX, timeout=120, isolation_level=None)
+            conn = sqlite3.connect(self.root / INDEX, timeout=LOCK_WAIT, isolation_level=None)
             conn.row_factory = sqlite3.Row
-            conn.execute("PRAGMA journal_mode=WAL")
-            conn.execute("PRAGMA synchronous=FULL")
-            conn.execute(SCHEMA)
+            _prepare(conn)
         except sqlite3.Error as exc:
             raise ArchiveError(f"{display(self.root / INDEX)}: cannot be used ({exc}), expected "
                                "the archive's SQLite index") from None

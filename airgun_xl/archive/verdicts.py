@@ -1,7 +1,7 @@
 """Verdicts in the archive: each ``accept --archive DIR`` keeps its verdict (every criterion
 with its value, limits and margin, the tolerances used, the warnings, the recording, the
-report and the command) as ``.verdicts/<shot>/vNNNN.json`` (:mod:`.records`). ``archive
-verdicts`` lists them."""
+report and the command) as ``.verdicts/<shot>/vNNNN.json`` (:mod:`.records`). ``history``
+lists them."""
 import dataclasses
 import datetime
 import hashlib

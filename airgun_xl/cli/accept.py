@@ -59,6 +59,10 @@ def run(args):
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".accept.xlsx")
     check_output(output, args.force, inputs=[args.shot, input_file(args.recording)])
+    if args.archive:  # a folder that is not an archive: refused before any work
+        from ..archive import Archive
+
+        Archive(args.archive, create=True, dry_run=True)
     shot = Shot.from_workbook(args.shot)
     spec = resolve_spec(shot, args)
     if spec is None:

@@ -143,6 +143,9 @@ def run_history(args):
     from ..archive.laws import list_laws
 
     laws = list_laws(archive.root)
+    from ..archive.verdicts import list_verdicts
+
+    verdicts = list_verdicts(archive.root)
     if args.json:  # the index row of each entry, with its figures and its law
         print(json.dumps(rows, indent=1))
     else:
@@ -166,6 +169,11 @@ def run_history(args):
                         f"{law['v_range'][0]:.4g} to {law['v_range'][1]:.4g} m/s")
                 print(f"  {law['ref']:<30} {span}, fitted on {law['shots']} shot"
                       f"{'s' * (law['shots'] != 1)}, {law['created']}")
+        if verdicts:
+            print("verdicts (accept --archive):")
+            for v in verdicts:
+                print(f"  {v['shot']}@{v['version']:<6} {v['verdict']:<5} {v['created']}  "
+                      f"{v['recording']}")
     if args.output:
         from ..campaign import HISTORY_TABLE
         from ..workbook.campaign import write_campaign

@@ -10,8 +10,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from airgun_xl.cli import main
+from airgun_xl.cli.spec_options import from_options
 from airgun_xl.errors import AirgunXlError
-from airgun_xl.specification import check, from_options, load_profile
+from airgun_xl.specification import check, load_profile
 from airgun_xl.workbook.spec_sheet import ROWS, spec_from_cells
 
 TEXT = st.one_of(st.text(max_size=12), st.sampled_from([
