@@ -312,3 +312,37 @@ def test_the_verdict_goes_into_the_archive(tmp_path, recording, capsys):
     assert main(["history", str(archive)]) == 0
     assert "verdicts (accept --archive):" in capsys.readouterr().out
     assert main(["archive", "verify", str(archive)]) == 0
+
+
+@pytest.mark.parametrize("shape", ["half-sine", "sawtooth", "trapezoid"])
+def test_every_shapes_ideal_pulse_measures_its_own_duration_and_fills_its_corridor(shape):
+    """Each shape's ideal pulse passes its own specification with the duration measured as T
+    (the width at 10 % over the shape's width fraction) to one sample: the sawtooth's drop is
+    instantaneous, so its sampled crossing falls up to a sample late (the smooth shapes'
+    interpolation error is O((dt/T)^2)); and the corridor's margin equals its half-width (the
+    envelope holds the ideal itself)."""
+    pulse = ideal(shape, TIME - START, A, T)
+    spec = mil_spec(shape=shape, velocity_change=None)
+    c = by_name(judge(TIME, pulse, spec))
+    assert all(x.passed for x in c.values())
+    assert c["duration"].value == pytest.approx(T * 1e3, abs=DT * 1e3)
+    assert c["corridor"].margin == pytest.approx(20.0, abs=1e-6)
+    assert c["peak"].margin == pytest.approx(20.0, abs=1e-9)
+
+
+def test_fill_judges_the_prediction_by_the_sheet_and_options_override_it(tmp_path, capsys):
+    shot = tmp_path / "spec.xlsx"
+    wb = openpyxl.load_workbook(TEMPLATE)
+    ws = wb["Specification"]
+    ws["B3"], ws["B4"], ws["B5"], ws["B6"] = 12, 10, 5, 10  # 12 kG ±10 %, 5 ms ±10 %
+    wb.save(shot)
+    assert main(["fill", str(shot), "-o", str(tmp_path / "a.xlsx")]) == 0
+    line = [t for t in capsys.readouterr().out.splitlines() if "predicted" in t][0]
+    assert "the 'Specification' sheet), predicted: PASS" in line and "peak 11.994 kG" in line
+    assert main(["fill", str(shot), "-o", str(tmp_path / "b.xlsx"), "--peak", "15kG"]) == 0
+    line = [t for t in capsys.readouterr().out.splitlines() if "predicted" in t][0]
+    assert "predicted: FAIL" in line and "peak 11.994 kG -10.04 % FAIL" in line
+    summary = openpyxl.load_workbook(tmp_path / "b.xlsx", read_only=True)["Summary"]
+    texts = [str(c) for row in summary.iter_rows(values_only=True) for c in row if c]
+    assert "Specification: predicted verdict" in texts and "FAIL" in texts
+    assert any(t.startswith("FAIL: limits 13.5 to 16.5 kG") for t in texts)
