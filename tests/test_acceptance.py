@@ -346,3 +346,15 @@ def test_fill_judges_the_prediction_by_the_sheet_and_options_override_it(tmp_pat
     texts = [str(c) for row in summary.iter_rows(values_only=True) for c in row if c]
     assert "Specification: predicted verdict" in texts and "FAIL" in texts
     assert any(t.startswith("FAIL: limits 13.5 to 16.5 kG") for t in texts)
+
+
+def test_an_archived_fill_keeps_its_predicted_verdict(tmp_path):
+    import json
+
+    archive = tmp_path / "lab"
+    assert main(["fill", str(TEMPLATE), "-o", str(tmp_path / "f.xlsx"), "--peak", "12kG:10%",
+                 "--archive", str(archive)]) == 0
+    summary = json.loads(next(archive.rglob("summary.json")).read_text())
+    verdict = summary["predicted_verdict"]
+    assert verdict["verdict"] == "PASS" and verdict["criteria"][0]["name"] == "peak"
+    assert verdict["tolerances"] == ["peak: 10.8 to 13.2 kG"]

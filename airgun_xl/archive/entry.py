@@ -78,6 +78,13 @@ def prepare_entry(archive, request, shot, workbook, filled, options, seconds):
         summary["dominant_frequencies_hz"] = list(s.spectrum.peaks)
     summary.update(rows=result.rows, peak_kg=_plain(result.peak_kg),
                    time_of_peak=_plain(result.time_of_peak), warnings=list(filled.warnings))
+    if filled.verdict is not None:  # the prediction judged by the shot's specification
+        v = filled.verdict
+        summary["predicted_verdict"] = {
+            "verdict": v.word, "specification": v.spec.source,
+            "criteria": [{k: _plain(x) for k, x in dataclasses.asdict(c).items()}
+                         for c in v.criteria],
+            "tolerances": v.tolerances(), "definitions": v.definitions}
     provenance = {"engine": __version__, "versions": _versions(),
                   "input": display(shot.source.path) if shot.source else None,
                   "input_sha256": shot.source.sha256 if shot.source else None,

@@ -226,8 +226,17 @@ def run_show(args):
     print("figures:")
     summary = dict(doc["summary"])
     warnings = summary.pop("warnings", None)
+    verdict = summary.pop("predicted_verdict", None)
     for k, v in summary.items():
         print(f"  {k:<24} {shown_figure(k, v)}")
+    if isinstance(verdict, dict):
+        print(f"predicted verdict: {verdict.get('verdict')} (specification from "
+              f"{verdict.get('specification')})")
+        for c in verdict.get("criteria") or []:
+            value = "not measured" if c["value"] is None else f"{c['value']:.6g} {c['unit']}"
+            margin = "none" if c["margin"] is None else f"{c['margin']:+.2f} {c['margin_unit']}"
+            print(f"  {c['name']:<24} {value}, margin {margin}, "
+                  f"{'PASS' if c['passed'] else 'FAIL'}")
     if warnings is None:
         print("warnings: not recorded (an entry from before they were kept)")
     else:
