@@ -358,3 +358,19 @@ def test_an_archived_fill_keeps_its_predicted_verdict(tmp_path):
     verdict = summary["predicted_verdict"]
     assert verdict["verdict"] == "PASS" and verdict["criteria"][0]["name"] == "peak"
     assert verdict["tolerances"] == ["peak: 10.8 to 13.2 kG"]
+
+
+def test_a_verdict_on_doubted_figures_is_flagged_where_it_is_shown(tmp_path, capsys):
+    """E40 in the wrong unit: the warning names E40, the pulse's figures are doubted, and so
+    is the predicted verdict, on the terminal and on the Summary."""
+    shot = tmp_path / "psi.xlsx"
+    wb = openpyxl.load_workbook(TEMPLATE)
+    wb["Sheet1"]["E40"] = 2.7e9
+    wb.save(shot)
+    out = tmp_path / "psi.out.xlsx"
+    assert main(["fill", str(shot), "-o", str(out), "--peak", "12kG:10%"]) == 0
+    line = [t for t in capsys.readouterr().out.splitlines() if "predicted" in t][0]
+    assert "predicted: FAIL (DOUBTED: see the warnings on E40)" in line
+    texts = [str(c) for row in openpyxl.load_workbook(out, read_only=True)["Summary"]
+             .iter_rows(values_only=True) for c in row if c]
+    assert "DOUBTED: see the warnings on E40; the specification from options" in texts

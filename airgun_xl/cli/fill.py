@@ -107,7 +107,12 @@ def print_summary(output, filled):
         lines.append(f"  full history in {sidecar}")
     v = filled.verdict
     if v is not None:
-        lines.append(f"  specification ({v.spec.source or 'options'}), predicted: {v.word}: "
+        from ..workbook.sheets import flagged_figures
+
+        doubted = flagged_figures(filled.warnings).get("Peak acceleration (raw)")
+        lines.append(f"  specification ({v.spec.source or 'options'}), predicted: {v.word}"
+                     + (f" (DOUBTED: see the warnings on {', '.join(doubted)})" if doubted
+                        else "") + ": "
                      + "; ".join(f"{c.name} {c.value:.5g} {c.unit} {c.margin:+.2f} "
                                  f"{c.margin_unit} {'PASS' if c.passed else 'FAIL'}"
                                  for c in v.criteria))

@@ -239,15 +239,17 @@ def _summary_rows(result, summary, timings):
     return rows
 
 
-def write_predicted_verdict(wb, ws, verdict, row, style):
+def write_predicted_verdict(wb, ws, verdict, row, style, doubted=()):
     """The prediction judged by the shot's specification, from ``row``: the verdict, then a
-    row a criterion (value, unit, limits, margin, PASS/FAIL); the next free row."""
+    row a criterion (value, unit, limits, margin, PASS/FAIL); the next free row. ``doubted``:
+    the cells whose warnings put the pulse's figures in doubt, and so the verdict."""
     good = wb.add_format({"bold": True, "font_color": "#006100", "bg_color": "#C6EFCE"})
     bad = wb.add_format({"bold": True, "font_color": "#9C0006", "bg_color": "#FFC7CE"})
     number = wb.add_format({"num_format": "0.000", "align": "right"})
     ws.write_string(row, 0, "Specification: predicted verdict", style.bold)
     ws.write_string(row, 1, verdict.word, good if verdict.passed else bad)
-    ws.write_string(row, 3, f"the specification from {verdict.spec.source or 'options'}")
+    doubt = f"DOUBTED: see the warnings on {', '.join(doubted)}; " if doubted else ""
+    ws.write_string(row, 3, f"{doubt}the specification from {verdict.spec.source or 'options'}")
     row += 1
     for c in verdict.criteria:
         ws.write_string(row, 0, f"Specification: {c.name}")
@@ -303,7 +305,8 @@ def write_summary(wb, result, summary, timings, name="Summary"):
             ws.write_string(row, 3, note)
     row = len(rows) + 2
     if timings.get("verdict") is not None:
-        row = write_predicted_verdict(wb, ws, timings["verdict"], row, style) + 1
+        row = write_predicted_verdict(wb, ws, timings["verdict"], row, style,
+                                      flags.get("Peak acceleration (raw)", [])) + 1
     for note in timings.get("study_notes") or ():
         ws.write_string(row, 0, "Design", style.bold)
         ws.write_string(row, 3, note)
