@@ -98,7 +98,9 @@ def run(args):
 
 def print_verdict(verdict, what):
     """The verdict, a line a criterion, with the tolerances used."""
-    print(f"{verdict.word}: {what}")
+    n = len(verdict.warnings)
+    print(f"{verdict.word}: {what}"
+          + (f" (with {n} warning{'s' * (n != 1)}: read them before relying on it)" if n else ""))
     for c in verdict.criteria:
         limits = (f"{'-inf' if c.low is None else f'{c.low:.5g}'} to "
                   f"{'+inf' if c.high is None else f'{c.high:.5g}'} {c.unit}")

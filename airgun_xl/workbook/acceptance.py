@@ -50,6 +50,10 @@ def write_verdict_table(wb, ws, verdict, row, bold):
         row += 1
     ws.write_string(row, 0, "Overall")
     ws.write_string(row, 6, verdict.word, good if verdict.passed else bad)
+    if verdict.warnings:  # the verdict is only as good as what the warnings below question
+        n = len(verdict.warnings)
+        ws.write_string(row, 7, f"with {n} warning{'s' * (n != 1)} below: read them before "
+                                "relying on it", wrap)
     row += 2
     ws.write_string(row, 0, "Tolerances used, and definitions", bold)
     row += 1
