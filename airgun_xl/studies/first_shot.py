@@ -28,6 +28,10 @@ from ..models import apply_model
 from ..specification import Specification
 from .acceptance import BLOCK_VALUES, BlockJudge, flags_of, wilson_interval
 
+#: Memory a Monte Carlo shot holds until its batch is judged [bytes]: its ShotParams (350
+#: measured), its figures and judged values, with room.
+SHOT_BYTES = 600
+
 #: Points of the scan over the parameter's range.
 SCAN_POINTS = 25
 
@@ -165,6 +169,13 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
     A setting moves a scattered cell's mean: a drawn value is its draw's offset from the
     sheet's value, added to the setting (so the gun's scatter follows the velocity set).
     """
+    from ..engine.batch import BLOCK
+    from ..limits import check_memory
+
+    # a checked ShotParams a shot (350 bytes measured) and its figures and values, then a
+    # block's pulses and the judge's arrays (about 8 rows-long doubles a shot of the block)
+    check_memory(n * SHOT_BYTES + BLOCK * p.rows * 8 * 8,
+                 f"a Monte Carlo of {n:,} shots of {p.rows:,} rows", "fewer --shots")
     values, fields_list = drawn if drawn is not None else draws(p, sds, n, seed)
     base = var.apply(p, setting) if var is not None and setting is not None else p
     params, invalid = [], np.zeros(n, dtype=bool)
