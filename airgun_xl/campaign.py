@@ -165,7 +165,8 @@ TABLE = (
     ("Filtered peak (kG)", "filtered_peak_kg", "kG"), ("Time of peak (ms)", "time_of_peak", "s"),
     ("Pulse (ms)", "pulse_duration", "s"), ("Max crush (m)", "max_crush", "m"),
     ("Final length (m)", "final_length", "m"), ("Warnings", "warning_count", "count"),
-    ("Status", "status", None), ("Output", "output", None),
+    ("Predicted verdict", "verdict", None), ("Status", "status", None),
+    ("Output", "output", None),
 )
 
 
@@ -187,7 +188,8 @@ def row_of(path, output, filled, entry=None):
            "v0": result.params.v31, "peak_kg": result.peak_kg,
            "time_of_peak": result.time_of_peak, "warnings": list(filled.warnings),
            "warning_count": len(filled.warnings), "entry": entry,
-           "crush_law": law_name(result.params.crush_law)}
+           "crush_law": law_name(result.params.crush_law),
+           "verdict": filled.verdict.word if filled.verdict is not None else ""}
     if s is not None:
         row.update(filtered_peak_kg=s.filtered_peak_kg, pulse_duration=s.pulse_duration,
                    max_crush=s.max_crush, final_length=s.final_length)

@@ -12,6 +12,7 @@ import pytest
 from conftest import TEMPLATE, template_with, write_trace_csv
 
 from airgun_xl.archive import Archive
+from airgun_xl.campaign import TABLE
 from airgun_xl.cli import main
 
 SPEEDS = {"a": 243.53532, "b": 200.0, "c": 150.0}
@@ -37,7 +38,8 @@ def test_three_shots_one_bad(tmp_path, capsys):
     and a summary of three rows whose figures are the fills' own."""
     day = _day(tmp_path / "day", {"a": 243.53532, "b": 200.0}, bad=["bad"])
     summary = tmp_path / "day.xlsx"
-    code = main(["fill", str(day), "--jobs", "2", "--summary", str(summary)])
+    code = main(["fill", str(day), "--jobs", "2", "--summary", str(summary), "--peak",
+                 "12kG:10%"])  # each shot's prediction judged (issue 25)
     err = capsys.readouterr().err
     assert code == 2
     assert f"{day / 'bad.xlsx'}: E2 (Timestep): found 'abc'" in err
@@ -46,11 +48,14 @@ def test_three_shots_one_bad(tmp_path, capsys):
     ws = openpyxl.load_workbook(summary)["Shots"]
     rows = [r for r in ws.iter_rows(min_row=4, values_only=True) if r[0] and r[0].endswith(
         ".xlsx")][:3]
-    assert [r[9] for r in rows] == ["filled", "filled", "failed"]
+    col = {key: k for k, (_, key, _) in enumerate(TABLE)}
+    assert [r[col["status"]] for r in rows] == ["filled", "filled", "failed"]
+    # v0 243.5 m/s peaks at 11.99 kG, inside 12 kG ±10 %; v0 200 m/s falls short
+    assert [r[col["verdict"]] for r in rows] == ["PASS", "FAIL", None]
     for row in rows[:2]:  # the summary's peak is the filled workbook's (kG, same double)
-        filled = openpyxl.load_workbook(row[10])["Summary"]
+        filled = openpyxl.load_workbook(row[col["output"]])["Summary"]
         assert row[2] == filled["B2"].value and row[1] in (243.53532, 200.0)
-    assert rows[2][2] is None and rows[2][10] is None  # nothing of the bad shot
+    assert rows[2][2] is None and rows[2][col["output"]] is None  # nothing of the bad shot
     # the chart of the peak against v0, and the failure listed on the printed page
     texts = [c for r in ws.iter_rows(values_only=True) for c in r if isinstance(c, str)]
     assert any("E2 (Timestep)" in t for t in texts)
