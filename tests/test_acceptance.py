@@ -374,3 +374,17 @@ def test_a_verdict_on_doubted_figures_is_flagged_where_it_is_shown(tmp_path, cap
     texts = [str(c) for row in openpyxl.load_workbook(out, read_only=True)["Summary"]
              .iter_rows(values_only=True) for c in row if c]
     assert "DOUBTED: see the warnings on E40; the specification from options" in texts
+
+
+def test_an_srs_requirement_past_the_records_band_is_one_line_naming_it(tmp_path, recording,
+                                                                        capsys):
+    """The recorder samples at 50 kHz: a requirement row at 10 kHz is past the SRS's tenth of
+    the rate, refused naming the row and the highest row it could judge."""
+    req = tmp_path / "req.csv"
+    req.write_text("frequency [Hz],srs [g]\n1000,2000\n10000,8000\n")
+    out = tmp_path / "x.xlsx"
+    code = main(["accept", str(TEMPLATE), str(recording), "--sign", "-1", "--srs", str(req),
+                 "-o", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and "found a row at 10,000 Hz" in err and "up to 5,000 Hz" in err
+    assert len(err.strip().splitlines()) == 1 and not out.exists()

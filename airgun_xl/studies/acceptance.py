@@ -276,7 +276,16 @@ def srs_criterion(t: np.ndarray, kg: np.ndarray, spec: Specification) -> tuple[C
     r = spec.srs
     if r is None:
         raise ValueError("the specification has no SRS requirement")
-    levels = srs(np.asarray(kg, dtype=float), t[1] - t[0], np.array(r.frequencies), r.q)
+    dt = float(t[1] - t[0])
+    top = max(r.frequencies)
+    if top > 0.1 / dt:
+        from ..errors import OptionError
+
+        raise OptionError(f"the SRS requirement ({spec.source or 'options'}): found a row at "
+                          f"{top:,.0f} Hz, above a tenth of the record's {1 / dt:,.0f} "
+                          f"samples a second, where the SRS is not computed; expected "
+                          f"requirement rows up to {0.1 / dt:,.0f} Hz, or a faster record")
+    levels = srs(np.asarray(kg, dtype=float), dt, np.array(r.frequencies), r.q)
     with np.errstate(divide="ignore"):
         margins = 20 * np.log10(levels / np.array(r.levels_kg))
     outside = (margins < r.lower_db) | (margins > r.upper_db)
