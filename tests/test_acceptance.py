@@ -388,3 +388,23 @@ def test_an_srs_requirement_past_the_records_band_is_one_line_naming_it(tmp_path
     err = capsys.readouterr().err
     assert code == 2 and "found a row at 10,000 Hz" in err and "up to 5,000 Hz" in err
     assert len(err.strip().splitlines()) == 1 and not out.exists()
+
+
+def test_a_verdict_whose_workbook_fails_is_not_archived(tmp_path, recording, monkeypatch,
+                                                       capsys):
+    """The workbook's writing fails (here, made to): the verdict record stored just before is
+    taken back, with the archive folder this command created; the command is one line, exit
+    2."""
+    from airgun_xl.errors import OutputError
+    from airgun_xl.workbook import acceptance as writer
+
+    def fail(*args, **kwargs):
+        raise OutputError("v.xlsx: cannot be written (made to fail)")
+
+    monkeypatch.setattr(writer, "write_acceptance", fail)
+    archive = tmp_path / "lab"
+    assert main(["accept", str(TEMPLATE), str(recording), "--sign", "-1", "--peak",
+                 "9.5kG:10%", "-o", str(tmp_path / "v.xlsx"), "--archive",
+                 str(archive)]) == 2
+    assert "made to fail" in capsys.readouterr().err
+    assert not archive.exists() and not (tmp_path / "v.xlsx").exists()

@@ -44,12 +44,30 @@ def verdict_record(verdict, shot, recording, report, command=()):
 
 
 def store_verdict(root, shot, verdict, recording, report, command=()):
-    """Keep the verdict in the archive at ``root``; return the file's path."""
-    Archive(root, create=True)
+    """Keep the verdict in the archive at ``root``; return a :class:`StoredVerdict`, which
+    :meth:`StoredVerdict.take_back` undoes."""
+    archive = Archive(root, create=True)
     folder = Path(root) / VERDICTS / safe_name(shot_name(shot))
     record = verdict_record(verdict, shot, recording, report, command)
     version = store_record(folder, record, "the verdict")
-    return folder / f"v{version:04d}.json"
+    return StoredVerdict(folder / f"v{version:04d}.json", archive)
+
+
+@dataclasses.dataclass
+class StoredVerdict:
+    path: Path
+    archive: Archive
+
+    def take_back(self):
+        """Remove the record, the folders it made that are left empty, and the archive
+        folder itself if this command created it and nothing else is in it."""
+        self.path.unlink(missing_ok=True)
+        for folder in (self.path.parent, self.path.parent.parent):
+            try:
+                folder.rmdir()  # only if empty: another verdict stays
+            except OSError:
+                break
+        self.archive.remove_if_unused()
 
 
 def list_verdicts(root):

@@ -83,10 +83,18 @@ def run(args):
              ("Verdict", verdict.word)]
     from ..workbook.acceptance import write_acceptance
 
-    write_acceptance(output, verdict, about, pulse, spectra, args.force,
-                     shot=Path(args.shot).name)
-    if args.archive:
-        record_verdict(args, shot, verdict, output)
+    # the verdict's record first, taken back if the workbook is not published: a failure or
+    # a signal leaves neither
+    stored = record_verdict(args, shot, verdict, output) if args.archive else None
+    try:
+        write_acceptance(output, verdict, about, pulse, spectra, args.force,
+                         shot=Path(args.shot).name)
+    except BaseException:
+        if stored is not None:
+            stored.take_back()
+        raise
+    if stored is not None:
+        print(f"  archived the verdict as {stored.path}")
     print_verdict(verdict, f"{trace.name} against {args.shot}")
     print(f"  wrote {output}")
     eq = spectra["equivalent"]
@@ -150,9 +158,9 @@ def report_data(time, kg, spec, verdict):
 
 
 def record_verdict(args, shot, verdict, output):
-    """The verdict into the archive: a JSON file beside the shot's entries."""
+    """The verdict into the archive (a JSON file beside the shot's entries): a
+    :class:`~airgun_xl.archive.verdicts.StoredVerdict`."""
     from ..archive.verdicts import store_verdict
 
-    path = store_verdict(args.archive, shot, verdict, args.recording, output,
+    return store_verdict(args.archive, shot, verdict, args.recording, output,
                          tuple(args.argv))
-    print(f"  archived the verdict as {path}")
