@@ -203,7 +203,8 @@ def _run_watched(shot, model_shot, crit, track, options, record):
         raise StabilityError(f"{diverged}; {UNLOADING_WAY_OUT}")
     if diverged is not None:
         record.append(str(diverged))
-    record.extend(str(w) for w in result.warnings[len(shot.warnings):])
+    # the run's own warnings, but for one the checks before it said in the same words
+    record.extend(w for w in map(str, result.warnings[len(shot.warnings):]) if w not in record)
     record.extend(str(f) for f in after_run(result))
     return result
 

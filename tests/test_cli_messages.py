@@ -111,3 +111,19 @@ def test_the_shared_run_options_have_one_help_text():
     assert {flag: len(texts) for flag, texts in helps.items()} == {"--integrator": 1,
                                                                    "--model": 1}
     assert None not in helps["--integrator"] | helps["--model"]
+
+
+def test_a_fractional_filter_step_is_said_once(tmp_path, capsys):
+    """1/(E2*E34) = 333.3 rows: the check before the run and the run's filter say it in the
+    same words, and the fill records it once (it said it twice before)."""
+    import openpyxl
+    from conftest import TEMPLATE
+
+    shot = tmp_path / "fr.xlsx"
+    wb = openpyxl.load_workbook(TEMPLATE)
+    wb["Sheet1"]["E34"] = 6000
+    wb.save(shot)
+    assert main(["fill", str(shot), "-o", str(tmp_path / "o.xlsx")]) == 0
+    err = capsys.readouterr().err
+    assert err.count("is not a whole number of rows") == 1
+    assert "E34 (Filter Frequency): 1/(E2*E34) = 333.333 is not a whole number" in err

@@ -58,11 +58,12 @@ def run(args):
     _, findings = before_run(model_params, args.integrator)
     result = dataclasses.replace(shot, params=model_params).run(integrator=args.integrator,
                                                                 track=())
-    # the warnings a fill of the shot gives, with the spectrum of its run (Summary-like)
-    warnings = ([str(w) for w in shot.warnings] + [str(f) for f in findings
-                                                    if f.level != "note"]
-                + [str(w) for w in result.warnings[len(shot.warnings):]]
-                + [str(f) for f in after_run(result)])
+    # the warnings a fill of the shot gives, with the spectrum of its run (Summary-like),
+    # each once (the checks and the run say a fractional 1/(E2*E34) in the same words)
+    warnings = list(dict.fromkeys(
+        [str(w) for w in shot.warnings] + [str(f) for f in findings if f.level != "note"]
+        + [str(w) for w in result.warnings[len(shot.warnings):]]
+        + [str(f) for f in after_run(result)]))
     pulse = result.accel_kg[np.isfinite(result.accel_kg)]
     dt = shot.params.delta
     if args.cfc is not None:

@@ -64,6 +64,15 @@ class Stencils:
     warnings: list
 
 
+def fractional_rows(samplerate):
+    """What a fractional 1/(E2*E34) does, in one sentence: the run's warning (this module's)
+    and the check before it (:mod:`airgun_xl.studies.check`) say it in the same words, so a
+    fill records it once."""
+    return (f"1/(E2*E34) = {samplerate:.6g} is not a whole number of rows: the legacy "
+            "filtered column is ill-defined (Excel rounds the offsets and drifts a row per "
+            "sample, LibreOffice writes zeros; --host chooses which is reproduced)")
+
+
 def filter_stencils(n, samplerate, host="excel"):
     """Follow the macro's cursor over ``n`` rows; see the module docstring.
 
@@ -77,10 +86,7 @@ def filter_stencils(n, samplerate, host="excel"):
     if samplerate < 1:  # every visited row writes; Offset(-sr) is fractional in both hosts
         warnings.append(sub_row_warning(samplerate, host))
     elif not float(samplerate).is_integer():
-        warnings.append(
-            f"samplerate 1/(E2*E34) = {samplerate:.6g} is not a whole number of rows: the legacy "
-            f"filtered column is ill-defined (Excel rounds the offsets and drifts a row per "
-            f"sample; LibreOffice writes zeros); reproducing {host}")
+        warnings.append(f"E34 (Filter Frequency): {fractional_rows(samplerate)}")
     # The loop visits `iterations` rows from index 0 (sheet row 2).
     last = n - (2 * samplerate)  # `introwcount - (2 * samplerate)`, a double
     iterations = max(0, math.floor(last) - 3 + 1)

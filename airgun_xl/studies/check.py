@@ -4,6 +4,7 @@ import math
 from dataclasses import dataclass
 
 from ..cells import BY_ADDRESS, CELLS
+from ..engine.filtered import fractional_rows
 from ..engine.stability import WARN_RATIO, critical_time_step, full_length
 
 #: Bird masses differing by this factor or more make a stiff, badly scaled system.
@@ -124,9 +125,7 @@ def before_run(p, integrator="legacy"):
                              f"2 x that within the run's {p.rows:,} rows, so there is no "
                              "filtered column"))
     elif 1 <= s and not float(s).is_integer():
-        found.append(Finding("warning", "E34", f"1/(E2*E34) = {s:.6g} is not a whole number "
-                             "of rows: the legacy filtered column is ill-defined (Excel "
-                             "drifts a row per sample, LibreOffice writes zeros)"))
+        found.append(Finding("warning", "E34", fractional_rows(s)))
     masses = {c: m for c, m in (("B2", p.m31), ("C2", p.m32), ("D2", p.m33)) if m > 0}
     light = min(masses, key=lambda cell: masses[cell])
     heavy = max(list(masses.values()) + [p.m1 + p.mmitigator])
