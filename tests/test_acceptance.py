@@ -408,3 +408,11 @@ def test_a_verdict_whose_workbook_fails_is_not_archived(tmp_path, recording, mon
                  str(archive)]) == 2
     assert "made to fail" in capsys.readouterr().err
     assert not archive.exists() and not (tmp_path / "v.xlsx").exists()
+
+
+def test_the_peak_rule_places_the_ideal_pulse_on_the_records_peak():
+    """placement = peak: the ideal half-sine's peak sits on the record's largest sample (here
+    exactly at START + T/2), and the verdict is the least-squares one."""
+    v = judge(TIME, half_sine(), mil_spec(placement="peak"))
+    assert v.onset == pytest.approx(START, abs=1e-15)
+    assert by_name(v)["corridor"].margin == pytest.approx(20.0, abs=1e-6) and v.passed
