@@ -15,7 +15,7 @@ from pathlib import Path
 from ..crush_law import DEGREE, CrushLaw
 from ..errors import ArchiveError, OptionError
 from ..transaction import display
-from .records import store_record, versions
+from .records import all_versions, store_record, versions
 from .store import Archive, safe_name
 
 LAWS = ".laws"
@@ -24,9 +24,6 @@ _REF = re.compile(r"^(?P<name>[^@]+?)(?:@(?P<version>\d+))?$")
 
 def _folder(root, name):
     return Path(root) / LAWS / safe_name(name)
-
-
-_versions = versions
 
 
 def store_law(root, name, law, shots, scores, command=()):
@@ -71,15 +68,15 @@ def load_law(root, ref):
     :class:`CrushLaw` whose ``source`` is its reference; and its record."""
     m = _REF.match(str(ref).strip())
     folder = _folder(root, m.group("name")) if m else None
-    versions = _versions(folder) if folder is not None else []
+    found = versions(folder) if folder is not None else []
     if m and m.group("version"):
-        versions = [v for v in versions if v[0] == int(m.group("version"))]
-    if not versions:
+        found = [v for v in found if v[0] == int(m.group("version"))]
+    if not found:
         known = ", ".join(r["ref"] for r in list_laws(root)) or "none yet"
         raise OptionError(f"--crush-law: found {ref!r}, expected workbook, legacy or a law in "
                           f"{display(root)} (stored by calibrate --archive --name; there: "
                           f"{known})")
-    version, path = versions[-1]
+    version, path = found[-1]
     try:
         record = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError) as exc:
@@ -90,19 +87,15 @@ def load_law(root, ref):
 
 def list_laws(root):
     """Every stored law version: ``[{"ref", "v_range", "shots", "created"}]``, by name."""
-    base = Path(root) / LAWS
     out: list = []
-    if not base.is_dir():
-        return out
-    for folder in sorted(p for p in base.iterdir() if p.is_dir() and not p.is_symlink()):
-        for version, path in _versions(folder):
-            try:
-                record = json.loads(path.read_text(encoding="utf-8"))
-                lo, hi = record["v_range"]
-                out.append({"ref": f"{folder.name}@{version}", "v_range": [lo, hi],
-                            "shots": len(record.get("shots", [])),
-                            "created": record.get("created", "")})
-            except (OSError, ValueError, KeyError, TypeError):
-                out.append({"ref": f"{folder.name}@{version}", "v_range": None, "shots": 0,
-                            "created": "unreadable"})
+    for folder, version, path in all_versions(Path(root) / LAWS):
+        try:
+            record = json.loads(path.read_text(encoding="utf-8"))
+            lo, hi = record["v_range"]
+            out.append({"ref": f"{folder.name}@{version}", "v_range": [lo, hi],
+                        "shots": len(record.get("shots", [])),
+                        "created": record.get("created", "")})
+        except (OSError, ValueError, KeyError, TypeError):
+            out.append({"ref": f"{folder.name}@{version}", "v_range": None, "shots": 0,
+                        "created": "unreadable"})
     return out

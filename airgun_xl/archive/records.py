@@ -24,6 +24,17 @@ def versions(folder):
     return sorted(found)
 
 
+def all_versions(base):
+    """``(folder, version, path)`` of every record under ``base`` (one of the archive's hidden
+    folders: ``.laws``, ``.verdicts``), folders by name, versions in order."""
+    base = Path(base)
+    if not base.is_dir():
+        return
+    for folder in sorted(p for p in base.iterdir() if p.is_dir() and not p.is_symlink()):
+        for version, path in versions(folder):
+            yield folder, version, path
+
+
 def store_record(folder, record, what):
     """Write ``record`` as the next version in ``folder`` (created); return the version.
 

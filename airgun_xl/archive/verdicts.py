@@ -8,10 +8,9 @@ import hashlib
 import json
 from pathlib import Path
 
-from ..errors import ArchiveError
 from ..transaction import display
 from .entry import shot_name
-from .records import store_record, versions
+from .records import all_versions, store_record
 from .store import Archive, safe_name
 
 VERDICTS = ".verdicts"
@@ -72,17 +71,14 @@ class StoredVerdict:
 
 def list_verdicts(root):
     """Every stored verdict: ``[{"shot", "version", "verdict", "created", "recording"}]``."""
-    base = Path(root) / VERDICTS
     out: list[dict] = []
-    if not base.is_dir():
-        return out
-    for folder in sorted(p for p in base.iterdir() if p.is_dir() and not p.is_symlink()):
-        for version, path in versions(folder):
-            try:
-                record = json.loads(path.read_text(encoding="utf-8"))
-            except (OSError, ValueError) as exc:
-                raise ArchiveError(f"{display(path)}: cannot be read ({exc})") from None
+    for folder, version, path in all_versions(Path(root) / VERDICTS):
+        try:
+            record = json.loads(path.read_text(encoding="utf-8"))
             out.append({"shot": record.get("shot"), "version": version,
                         "verdict": record.get("verdict"), "created": record.get("created"),
                         "recording": record.get("recording")})
+        except (OSError, ValueError, AttributeError):  # listed, not fatal (as a law)
+            out.append({"shot": folder.name, "version": version, "verdict": "?",
+                        "created": "unreadable", "recording": display(path)})
     return out

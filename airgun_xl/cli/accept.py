@@ -3,7 +3,7 @@
 Exit 0 on PASS, 3 on FAIL (:data:`FAIL_EXIT`), 2 for bad input."""
 from pathlib import Path
 
-from .recording_options import add_recording_options
+from .recording_options import RECORDING_HELP, add_recording_options
 from .run_options import add_force, add_output
 from .spec_options import add_spec_options
 
@@ -20,9 +20,7 @@ def add_parser(sub):
                                    " change, the corridor round the ideal pulse and the SRS; "
                                    "write the verdict workbook. Exit 0 on PASS, 3 on FAIL.")
     p.add_argument("shot", metavar="SHOT.xlsx")
-    p.add_argument("recording", metavar="RECORDING",
-                   help="the recorded pulse: a CSV (time, acceleration, units in the header), "
-                        "a workbook's columns (trace.xlsx:Sheet1!A:B) or a LabVIEW TDMS file")
+    p.add_argument("recording", metavar="RECORDING", help="the recorded pulse: " + RECORDING_HELP)
     add_output(p, "verdict workbook", "SHOT.accept.xlsx")
     add_force(p)
     add_recording_options(p)

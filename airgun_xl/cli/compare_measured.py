@@ -1,7 +1,7 @@
 """``airgun-xl compare-measured SHOT.xlsx MEASURED.csv``: the prediction against the test."""
 from pathlib import Path
 
-from .recording_options import add_recording_options
+from .recording_options import RECORDING_HELP, add_recording_options
 from .run_options import add_force, add_output, add_run_options
 
 
@@ -15,9 +15,7 @@ def add_parser(sub):
                                    "and score the peak, its time, the pulse, the velocity "
                                    "change and their correlation.")
     p.add_argument("shot", metavar="SHOT.xlsx")
-    p.add_argument("measured", metavar="MEASURED",
-                   help="the measured pulse: a CSV (time, acceleration, units in the header), "
-                        "a workbook's columns (trace.xlsx:Sheet1!A:B) or a LabVIEW TDMS file")
+    p.add_argument("measured", metavar="MEASURED", help="the measured pulse: " + RECORDING_HELP)
     add_output(p, "scores and traces", "SHOT.measured.xlsx")
     add_force(p)
     add_recording_options(p)

@@ -15,6 +15,11 @@ def anti_alias_value(text):
         return text  # refused by check_anti_alias, naming the option
 
 
+#: The help of a command's recording argument (compare-measured, accept).
+RECORDING_HELP = ("a CSV (time, acceleration, units in the header), a workbook's columns "
+                  "(trace.xlsx:Sheet1!A:B) or a LabVIEW TDMS file")
+
+
 def add_recording_options(p, channel_help="TDMS only: the channel (default: the first "
                                           "waveform channel)"):
     p.add_argument("--channel", metavar="GROUP/CHANNEL", help=channel_help)
