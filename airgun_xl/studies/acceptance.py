@@ -47,9 +47,6 @@ TRAPEZOID_RAMP = 0.10
 #: Samples over the nominal duration on which the ideal pulse is placed by least squares.
 PLACEMENT_SAMPLES = 400
 
-#: Criteria in the order a verdict lists them.
-CRITERIA = ("peak", "duration", "velocity change", "corridor", "SRS")
-
 
 def ideal(shape: str, t: np.ndarray, amplitude: float, duration: float) -> np.ndarray:
     """The ideal pulse [kG] at times ``t`` [s] from its start."""
@@ -120,12 +117,6 @@ class Verdict:
     @property
     def word(self) -> str:
         return "PASS" if self.passed else "FAIL"
-
-    def worst(self) -> Criterion | None:
-        """The criterion with the least margin (a failed one first)."""
-        if not self.criteria:
-            return None
-        return min(self.criteria, key=lambda c: (c.passed, c.margin))
 
     def tolerances(self) -> list[str]:
         """The tolerances used, one line each, as every verdict prints them."""
