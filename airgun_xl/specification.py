@@ -1,27 +1,40 @@
 """A client's test specification: the pulse's shape, its figures with their tolerances, the
-corridor, an SRS requirement and the record judged (issue 25).
+corridor, an SRS requirement and the record judged (issues 25 and 30).
 
-It is declared once here, as :class:`Specification`; it comes from three places, which all
-build one through :func:`from_fields`:
+It is declared once here, as :class:`Specification`; it comes from three sources:
 
-- the shot workbook's ``Specification`` sheet (:mod:`airgun_xl.workbook.spec_sheet`), which the
-  template writes empty;
 - a tolerance profile, a JSON file the lab names and edits (:func:`load_profile`; the
   package's ``profiles/`` folder holds the examples);
-- command-line options (``--peak 12kG:10%``...), which override the other two field by field.
+- the shot workbook's ``Specification`` sheet (:mod:`airgun_xl.workbook.spec_sheet`), which the
+  template writes empty;
+- command-line options (``--peak 12kG:10%``...).
 
-Units: peaks in kG (the macro's, 9800 m/s^2), times in s, velocities in m/s, tolerances as
-fractions. The judging itself is :mod:`airgun_xl.studies.acceptance`.
+**The merge** (:func:`combine`): every field is None until a source gives it; each source
+overrides the one before it field by field (options over sheet over profile), so a value equal
+to a default still overrides; the defaults (:data:`DEFAULTS`) are applied once, after the
+merge, and each field remembers where it came from (:meth:`Specification.provenance`).
+
+**The grammar** (:data:`KEYS`): one parser per field for every source. An option's value is
+text; a profile key or a sheet cell holds the same text, or a bare number in the key's declared
+unit. Units are case-exact (``kg`` is refused: did you mean kG?), a quantity in text needs its
+unit, a sign where none is meaningful is refused, and empty values, infinities and values past
+the caps (:data:`CAPS`) are refused, each in one line naming the option, cell or key.
+
+Units inside: peaks in kG (the macro's, 9800 m/s^2), times in s, velocities in m/s, tolerances
+and percentages as fractions. The judging itself is :mod:`airgun_xl.studies.acceptance`.
 """
 from __future__ import annotations
 
-import json
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field, fields, replace
+from decimal import Decimal, InvalidOperation, localcontext
 from pathlib import Path
+from typing import Any
 
 from .errors import OptionError
+from .units import G, KG_MS2
 
 #: The pulse shapes a specification can name; "none" judges the limits only (no corridor).
 SHAPES = ("half-sine", "sawtooth", "trapezoid", "none")
@@ -30,17 +43,42 @@ SHAPES = ("half-sine", "sawtooth", "trapezoid", "none")
 #: standard gives no rule), or with its peak on the record's peak.
 PLACEMENTS = ("least-squares", "peak")
 
+#: The J211 channel frequency classes a record may be judged through (0: unfiltered).
+CFC_CLASSES = (60, 180, 600, 1000)
+
 #: The largest SRS requirement read (rows): a spectrum is at most a few hundred.
 MAX_SRS_ROWS = 2_000
 
 #: Profiles shipped with the package (examples; the lab keeps its own beside them).
 PROFILES = Path(__file__).with_name("profiles")
 
+#: The largest value each quantity may take: past it a value is a typing slip (and 1e308 kG
+#: overflows the judge's arithmetic).
+CAPS = {
+    "peak": 1e4,  # [kG]: about 10^5 g, past any pyroshock
+    "duration": 10.0,  # [s]
+    "velocity_change": 1e4,  # [m/s]
+    "window": 10.0,  # [s]
+    "srs_q": 1000.0,  # quality factor
+    "db": 60.0,  # |SRS tolerance| [dB]
+}
+
+#: The defaults by :data:`KEYS` name, applied once after the merge
+#: (:meth:`Specification.resolved`); the window's default is a rule (half the nominal
+#: duration), so it stays None.
+DEFAULTS: dict[str, Any] = {
+    "shape": "none", "time_slack": 0.0, "placement": "least-squares", "record": 0,
+    "srs_q": 10.0, "srs_lower_db": -3.0, "srs_upper_db": 6.0, "srs_outside": 0.0,
+}
+
+#: Marks the fields of :class:`Specification` that say where it came from, not what it asks.
+META = {"meta": True}
+
 
 @dataclass(frozen=True)
 class Tolerance:
     """A nominal value with its tolerance: ``nominal * (1 - minus)`` to ``nominal * (1 +
-    plus)``. NaN marks a part not given yet: a profile gives tolerances, the test its nominal
+    plus)``. NaN marks a part not given: a profile gives tolerances, the test its nominal
     values (:meth:`Specification.merged` joins them)."""
 
     nominal: float
@@ -63,26 +101,22 @@ class Tolerance:
 
 @dataclass(frozen=True)
 class SrsRequirement:
-    """Required SRS levels at their frequencies, with the tolerance in dB either side and the
-    fraction of frequencies that may fall outside it."""
+    """Required SRS levels at their frequencies (the rows of ``--srs`` or of the sheet); its
+    Q and tolerance are fields of the :class:`Specification`."""
 
     frequencies: tuple[float, ...]  # [Hz]
     levels_kg: tuple[float, ...]  # [kG]
-    q: float = 10.0
-    lower_db: float = -3.0
-    upper_db: float = 6.0
-    outside_fraction: float = 0.0
 
 
 @dataclass(frozen=True)
 class Specification:
-    """What a shot must meet. Every field may be left out (None); a criterion is judged only
-    when its fields are given.
+    """What a shot must meet. Every field is None until a source gives it; a criterion is
+    judged only when its fields are given. :meth:`resolved` applies :data:`DEFAULTS`.
 
     Attributes
     ----------
-    shape : str
-        One of :data:`SHAPES`.
+    shape : str or None
+        One of :data:`SHAPES` (default none).
     peak : Tolerance or None
         Peak acceleration [kG].
     duration : Tolerance or None
@@ -92,32 +126,50 @@ class Specification:
         Velocity change [m/s], integrated over the pulse and its windows.
     corridor : float or None
         Half-width of the corridor round the ideal pulse, a fraction of the nominal peak.
-    time_slack : float
-        Time slack of the corridor, a fraction of the nominal duration.
+    time_slack : float or None
+        Time slack of the corridor, a fraction of the nominal duration (default 0).
     window : float or None
         Monitoring window before and after the pulse [s] (None: half the duration).
-    srs : SrsRequirement or None
     cfc : int or None
-        The record judged: unfiltered (None, or 0 where an option says so over a sheet's
-        class) or through SAE J211 CFC ``cfc``.
-    placement : str
-        One of :data:`PLACEMENTS`.
+        The record judged: 0 unfiltered (the default), or through SAE J211 CFC ``cfc``.
+    placement : str or None
+        One of :data:`PLACEMENTS` (default least-squares).
+    srs : SrsRequirement or None
+        The required SRS's rows.
+    srs_q, srs_lower_db, srs_upper_db, srs_outside : float or None
+        Its quality factor (default 10), tolerance [dB] (default -3 and +6) and the fraction
+        of its frequencies allowed outside (default 0).
     source : str
-        Where the specification came from (profile, sheet, options), as verdicts print it.
+        The sources that gave it (profile, sheet, options), as verdicts print it.
+    notes : tuple of str
+        A profile's notes, printed with every verdict.
+    origins : tuple of (str, str)
+        Each key's source (:data:`KEYS` names; "default" for a default applied).
+    places : tuple of (str, str)
+        Each key's option, cell or profile key, as a refusal names it.
+    set_aside : tuple of str
+        What a source gave that a later one made moot, in words (a verdict prints it).
     """
 
-    shape: str = "none"
+    shape: str | None = None
     peak: Tolerance | None = None
     duration: Tolerance | None = None
     velocity_change: Tolerance | None = None
     corridor: float | None = None
-    time_slack: float = 0.0
+    time_slack: float | None = None
     window: float | None = None
-    srs: SrsRequirement | None = None
     cfc: int | None = None
-    placement: str = "least-squares"
-    source: str = ""
-    notes: tuple[str, ...] = field(default_factory=tuple)
+    placement: str | None = None
+    srs: SrsRequirement | None = None
+    srs_q: float | None = None
+    srs_lower_db: float | None = None
+    srs_upper_db: float | None = None
+    srs_outside: float | None = None
+    source: str = field(default="", metadata=META)
+    notes: tuple[str, ...] = field(default=(), metadata=META)
+    origins: tuple[tuple[str, str], ...] = field(default=(), metadata=META)
+    places: tuple[tuple[str, str], ...] = field(default=(), metadata=META)
+    set_aside: tuple[str, ...] = field(default=(), metadata=META)
 
     @property
     def empty(self) -> bool:
@@ -126,225 +178,448 @@ class Specification:
                 and self.srs is None)
 
     def merged(self, other: Specification) -> Specification:
-        """This specification with every field ``other`` gives (not None) taken from it."""
-        changes = {f.name: getattr(other, f.name) for f in fields(self)
-                   if f.name not in ("source", "notes")
-                   and getattr(other, f.name) != getattr(Specification(), f.name)}
-        for name in ("peak", "duration", "velocity_change"):
-            if name in changes:
-                changes[name] = changes[name].over(getattr(self, name))
+        """This specification with every field ``other`` gives (not None) taken from it; a
+        tolerance's nominal and tolerance separately."""
+        changes: dict[str, Any] = {}
+        for name in judged_fields():
+            value = getattr(other, name)
+            if value is not None:
+                changes[name] = value.over(getattr(self, name)) if isinstance(
+                    value, Tolerance) else value
         sources = " + ".join(s for s in (self.source, other.source) if s)
-        return replace(self, **changes, source=sources, notes=self.notes + other.notes)
+        return replace(self, **changes, source=sources, notes=self.notes + other.notes,
+                       origins=tuple({**dict(self.origins), **dict(other.origins)}.items()),
+                       places=tuple({**dict(self.places), **dict(other.places)}.items()),
+                       set_aside=self.set_aside + other.set_aside)
+
+    def resolved(self) -> Specification:
+        """This specification with :data:`DEFAULTS` in the fields no source gave (the SRS's
+        only with an SRS requirement); each default's origin is "default"."""
+        changes: dict[str, Any] = {}
+        origins = dict(self.origins)
+        for key, value in DEFAULTS.items():
+            name = KEYS[key].field
+            if getattr(self, name) is None and (self.srs is not None or
+                                                not key.startswith("srs_")):
+                changes[name] = value
+                origins[key] = "default"
+        if not changes:
+            return self
+        return replace(self, **changes, origins=tuple(origins.items()))
+
+    def origin(self, key: str) -> str | None:
+        """Where a field (a :data:`KEYS` name) came from, or None if no source gave it."""
+        return dict(self.origins).get(key)
+
+    def provenance(self) -> list[str]:
+        """Where each field came from, a line a source, the defaults last: what a verdict
+        prints under its criteria."""
+        by_source: dict[str, list[str]] = {}
+        for key, where in self.origins:
+            if key in KEYS:
+                by_source.setdefault(where, []).append(f"{key_label(key)} {show(self, key)}")
+            elif key == "srs" and self.srs is not None:
+                by_source.setdefault(where, []).append(
+                    f"SRS requirement ({len(self.srs.frequencies)} rows)")
+        lines = [f"from {where}: {', '.join(items)}" for where, items in by_source.items()
+                 if where != "default"]
+        defaults = by_source.get("default", [])
+        if self.window is None and self.origin("window") is None:
+            defaults.append("window half the nominal duration")
+        if defaults:
+            lines.append(f"defaults (the tool's, no source gave them): {', '.join(defaults)}")
+        return lines
 
 
-_TOLERANCE = re.compile(r"^(?P<value>[^:]+)(?::(?P<tol>.+))?$")
-_PERCENT = re.compile(r"^\s*([-+]?)\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*%\s*$")
+def judged_fields() -> tuple[str, ...]:
+    """The names of :class:`Specification`'s fields that ask something (not its meta)."""
+    return tuple(f.name for f in fields(Specification) if not f.metadata.get("meta"))
 
 
-def _fraction(text: str, option: str, whole: str) -> tuple[str, float]:
-    match = _PERCENT.match(text)
+# -- the grammar -------------------------------------------------------------------------------
+
+#: A number as the grammar reads it: digits, a point, an exponent; its sign is read apart.
+_NUMBER = r"(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
+_SIGNED = re.compile(r"^\s*(?P<sign>[-+±]?)\s*" + _NUMBER + r"\s*(?P<unit>.*?)\s*$")
+
+#: Units of each quantity: name -> the factor to the inside unit, exactly as typed.
+PEAK_UNITS = {"kG": 1.0, "g": G / KG_MS2, "m/s^2": 1 / KG_MS2, "m/s2": 1 / KG_MS2,
+              "m/s²": 1 / KG_MS2}
+#: The units a message names (the others are spellings of these).
+_SHOWN_UNITS = ("kG", "g", "m/s^2", "s", "ms", "us", "ns", "m/s")
+TIME_UNITS = {"s": "1", "ms": "1e-3", "us": "1e-6", "µs": "1e-6", "ns": "1e-9"}
+VELOCITY_UNITS = {"m/s": 1.0}
+
+
+def _refuse(where: str, text: object, expected: str) -> OptionError:
+    shown = repr(text) if not isinstance(text, str) or len(text) <= 60 else \
+        repr(text[:57] + "...")
+    return OptionError(f"{where}: found {shown}, expected {expected}")
+
+
+def _split(text: str, where: str, expected: str) -> tuple[str, Decimal, str]:
+    """(sign, magnitude, unit text) of a number with an optional sign and unit."""
+    if not text.strip():
+        raise OptionError(f"{where}: found an empty value, expected {expected}")
+    match = _SIGNED.match(text)
     if not match:
-        raise OptionError(f"{option}: found {whole!r}, expected a tolerance in %, such as "
-                          "10% or -10%,+20%")
-    value = float(match.group(2)) / 100
-    if not (math.isfinite(value) and 0 <= value < 1):
-        raise OptionError(f"{option}: found {whole!r}, expected a tolerance from 0% to below "
-                          "100%")
-    return match.group(1), value
+        raise _refuse(where, text, expected)
+    try:
+        magnitude = Decimal(match.group("num"))
+    except InvalidOperation:
+        raise _refuse(where, text, expected) from None
+    return match.group("sign"), magnitude, match.group("unit")
 
 
-def parse_tolerance(text: str, option: str, parse_value) -> Tolerance:
-    """``12kG:10%`` (either side), ``12kG:-10%,+20%``: a :class:`Tolerance`."""
-    match = _TOLERANCE.match(str(text).strip())
-    if not match:
-        raise OptionError(f"{option}: found {text!r}, expected VALUE:TOLERANCE such as "
-                          "12kG:10%")
-    nominal = parse_value(match.group("value"), option)
-    if match.group("tol") is None:  # the tolerance from the profile or the sheet
-        return Tolerance(nominal, math.nan, math.nan)
-    parts = [p for p in match.group("tol").split(",")]
-    if len(parts) == 1:
-        _, tol = _fraction(parts[0], option, text)
-        return Tolerance(nominal, tol, tol)
-    if len(parts) != 2:
-        raise OptionError(f"{option}: found {text!r}, expected one tolerance or two "
-                          "(-10%,+20%)")
-    signs = [_fraction(p, option, text) for p in parts]
-    minus = next((v for s, v in signs if s == "-"), None)
-    plus = next((v for s, v in signs if s == "+"), None)
-    if minus is None or plus is None:
-        raise OptionError(f"{option}: found {text!r}, expected the lower tolerance with - and "
-                          "the upper with + (-10%,+20%)")
-    return Tolerance(nominal, minus, plus)
+def _unit(unit: str, units: dict, text: str, where: str, expected: str) -> Any:
+    if unit in units:
+        return units[unit]
+    if not unit:
+        raise OptionError(f"{where}: found {text!r} without a unit, expected {expected}")
+    near = [u for u in units if u.lower() == unit.lower()]
+    hint = f" (did you mean {near[0]}?)" if near else ""
+    raise OptionError(f"{where}: found the unit {unit!r} in {text!r}{hint}, expected "
+                      f"{expected}")
 
 
-def parse_velocity(text: str, option: str = "--velocity-change") -> float:
-    """``35m/s`` -> 35.0 [m/s]."""
-    match = re.fullmatch(r"\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(m/s)?\s*", str(text))
-    value = float(match.group(1)) if match else math.nan
-    if not (value > 0 and math.isfinite(value)):
-        raise OptionError(f"{option}: found {text!r}, expected a positive velocity such as "
-                          "35m/s")
+def _quantity(text: str, where: str, what: str, units: dict, example: str, cap: float,
+              cap_text: str, zero: bool = False) -> float:
+    """A positive (or, with ``zero``, non-negative) quantity with its unit, at most ``cap``
+    in the inside unit; times scaled exactly in decimal, then rounded once."""
+    expected = (f"{what} such as {example} (units "
+                f"{', '.join(u for u in units if u in _SHOWN_UNITS)}), "
+                f"{'from 0' if zero else 'above 0'} and at most {cap_text}")
+    sign, magnitude, unit_text = _split(text, where, expected)
+    factor = _unit(unit_text, units, text, where, expected)
+    if sign:
+        raise OptionError(f"{where}: found the sign {sign!r} in {text!r}, where none is "
+                          f"meaningful; expected {expected}")
+    if isinstance(factor, str):  # a time: "5e0us" and "5us" give float("5e-6")
+        value = _scaled(magnitude, factor)
+    else:
+        value = float(magnitude) * factor
+    if not (math.isfinite(value) and (value >= 0 if zero else value > 0) and value <= cap):
+        raise _refuse(where, text, expected)
     return value
 
 
-def parse_db_pair(text: str, option: str = "--srs-tol") -> tuple[float, float]:
+def _percent(text: str, where: str, what: str, low_open: bool, allow_sign: bool = False
+             ) -> tuple[str, float]:
+    """(sign, fraction) of ``N%``; the fraction from 0 (above 0 with ``low_open``) to
+    below 1."""
+    expected = f"{what} {'above' if low_open else 'from'} 0% to below 100%, such as 10%"
+    sign, magnitude, unit_text = _split(text, where, expected)
+    _unit(unit_text, {"%": 1}, text, where, expected)
+    if sign and not allow_sign:
+        raise OptionError(f"{where}: found the sign {sign!r} in {text!r}, where none is "
+                          f"meaningful; expected {expected}")
+    value = _scaled(magnitude, "0.01")
+    if not (math.isfinite(value) and (value > 0 if low_open else value >= 0) and value < 1):
+        raise _refuse(where, text, expected)
+    return sign, value
+
+
+TOLERANCE_EXPECTED = ("a tolerance in %: 10% (either side) or -10%,+20% (below and above), "
+                      "each from 0% to below 100%")
+
+
+def parse_tolerance_text(text: str, where: str) -> tuple[float, float]:
+    """``10%`` or ``±10%`` -> (0.1, 0.1); ``-10%,+20%`` (either order) -> (0.1, 0.2). A
+    single signed tolerance is ambiguous, and refused."""
+    parts = str(text).split(",")
+    if len(parts) == 1:
+        sign, value = _percent(parts[0], where, "a tolerance", False, allow_sign=True)
+        if sign in ("-", "+"):
+            raise OptionError(f"{where}: found {text!r}, a single signed tolerance, which is "
+                              f"ambiguous; expected {TOLERANCE_EXPECTED}")
+        return value, value
+    if len(parts) != 2:
+        raise _refuse(where, text, TOLERANCE_EXPECTED)
+    signed = [_percent(p, where, "a tolerance", False, allow_sign=True) for p in parts]
+    minus = [v for s, v in signed if s == "-"]
+    plus = [v for s, v in signed if s == "+"]
+    if len(minus) != 1 or len(plus) != 1:
+        raise OptionError(f"{where}: found {text!r}, expected the lower tolerance with - and "
+                          "the upper with + (-10%,+20%)")
+    return minus[0], plus[0]
+
+
+def _db(text: str, where: str, side: str) -> float:
+    """A tolerance in dB: the lower 0 or below (``-3dB``), the upper 0 or above (``+6dB``)."""
+    expected = (f"the {side} SRS tolerance in dB, such as {'-3dB' if side == 'lower' else '+6dB'}"
+                f", {'from -' if side == 'lower' else 'from 0 to '}"
+                f"{CAPS['db']:g}{' to 0' if side == 'lower' else ''} dB")
+    sign, magnitude, unit_text = _split(text, where, expected)
+    _unit(unit_text, {"dB": 1}, text, where, expected)
+    value = float(-magnitude if sign == "-" else magnitude)
+    if sign == "±" or not math.isfinite(value) or abs(value) > CAPS["db"] or (
+            value > 0 if side == "lower" else value < 0):
+        raise _refuse(where, text, expected)
+    return value
+
+
+def parse_db_pair(text: str, where: str = "--srs-tol") -> tuple[float, float]:
     """``-3dB,+6dB`` -> (-3.0, 6.0)."""
-    parts = [p.strip() for p in str(text).split(",")]
-    values = []
-    for part in parts:
-        match = re.fullmatch(r"([-+]?[0-9]*\.?[0-9]+)\s*(dB)?", part, re.IGNORECASE)
-        values.append(float(match.group(1)) if match else math.nan)
-    if len(values) != 2 or not all(math.isfinite(v) for v in values) or not (
-            values[0] <= 0 <= values[1]):
-        raise OptionError(f"{option}: found {text!r}, expected a lower and an upper tolerance"
-                          " in dB, such as -3dB,+6dB")
-    return values[0], values[1]
+    parts = str(text).split(",")
+    if len(parts) != 2:
+        raise _refuse(where, text, "a lower and an upper tolerance in dB, such as -3dB,+6dB")
+    return _db(parts[0], where, "lower"), _db(parts[1], where, "upper")
 
 
-def check(spec: Specification, where: str) -> Specification:
-    """Refuse a specification that cannot be judged, naming ``where`` it came from.
+def _name(text: str, where: str, names: tuple, what: str) -> str:
+    value = str(text).strip().lower()
+    if value not in names:
+        raise _refuse(where, text, f"{what}: one of {', '.join(names)}")
+    return value
 
-    Raises
-    ------
-    OptionError
+
+def parse_record(text: str, where: str = "--record") -> int:
+    """``unfiltered`` -> 0; ``cfc600`` or ``CFC 600`` -> 600."""
+    value = str(text).strip().lower()
+    match = re.fullmatch(r"cfc\s*(\d{1,5})", value)
+    if value == "unfiltered":
+        return 0
+    if match and int(match.group(1)) in CFC_CLASSES:
+        return int(match.group(1))
+    raise _refuse(where, text, "unfiltered or one of 60, 180, 600, 1000 (cfc600)")
+
+
+def parse_q(text: str, where: str = "--srs-q") -> float:
+    """The SRS's quality factor: a number without a unit, above 0.5."""
+    expected = f"a quality factor without a unit or sign, above 0.5 and at most " \
+               f"{CAPS['srs_q']:g}, such as 10"
+    sign, magnitude, unit_text = _split(text, where, expected)
+    if sign or unit_text:
+        raise _refuse(where, text, expected)
+    value = float(magnitude)
+    if not (0.5 < value <= CAPS["srs_q"]):
+        raise _refuse(where, text, expected)
+    return value
+
+
+@dataclass(frozen=True)
+class Key:
+    """One key of the grammar: a profile key, a Specification sheet row, and (for most) an
+    option.
+
+    Attributes
+    ----------
+    field : str
+        The :class:`Specification` field it gives (a tolerance gives a part of one).
+    unit : str
+        The unit of a bare number in a profile or a cell ("" for text only): the number is
+        read as its text followed by the unit.
+    parse : callable
+        ``(text, where) -> value``: the text grammar, shared by the three sources.
+    show : callable
+        ``value -> text`` that parses back to the same value.
     """
-    if spec.shape not in SHAPES:
-        raise OptionError(f"{where}: found the shape {spec.shape!r}, expected one of "
-                          f"{', '.join(SHAPES)}")
-    if spec.placement not in PLACEMENTS:
-        raise OptionError(f"{where}: found the placement {spec.placement!r}, expected one of "
-                          f"{', '.join(PLACEMENTS)}")
-    for name in ("peak", "duration", "velocity_change"):
-        tol = getattr(spec, name)
-        words = name.replace("_", " ")
-        if tol is not None and not math.isfinite(tol.nominal):
-            raise OptionError(f"{where}: found a {words} tolerance without its nominal value, "
-                              f"expected one (--{words.replace(' ', '-')} VALUE)")
-        if tol is not None and not tol.nominal > 0:
-            raise OptionError(f"{where}: found a {words} of {tol.nominal!r}, expected a "
-                              "positive number")
-        if tol is not None and not (math.isfinite(tol.minus) and math.isfinite(tol.plus)):
-            raise OptionError(f"{where}: found a {words} of {tol.nominal:g} without a "
-                              f"tolerance, expected one (VALUE:10%, a profile or the sheet)")
-    if spec.corridor is not None:
-        if spec.shape == "none":
-            raise OptionError(f"{where}: found a corridor with the shape none, expected a "
-                              f"shape ({', '.join(SHAPES[:3])}) to draw it round")
-        if spec.peak is None or spec.duration is None:
-            raise OptionError(f"{where}: found a corridor without a nominal peak and "
-                              "duration, expected both (the ideal pulse is drawn from them)")
-        if not (0 < spec.corridor < 1):
-            raise OptionError(f"{where}: found a corridor of {spec.corridor!r}, expected a "
-                              "fraction of the peak from 0 to 1 (0.2 for ±20 %)")
-    if not (0 <= spec.time_slack < 1):
-        raise OptionError(f"{where}: found a time slack of {spec.time_slack!r}, expected a "
-                          "fraction of the duration from 0 to below 1")
-    if spec.window is not None and not (math.isfinite(spec.window) and spec.window >= 0):
-        raise OptionError(f"{where}: found a window of {spec.window!r} s, expected 0 or more")
-    if spec.cfc not in (None, 0, 60, 180, 600, 1000):  # 0: unfiltered, said explicitly
-        raise OptionError(f"{where}: found the record CFC {spec.cfc!r}, expected unfiltered "
-                          "or one of 60, 180, 600, 1000")
-    if spec.srs is not None:
-        r = spec.srs
-        if not (0 < len(r.frequencies) <= MAX_SRS_ROWS):
-            raise OptionError(f"{where}: found {len(r.frequencies)} SRS rows, expected 1 to "
-                              f"{MAX_SRS_ROWS:,}")
-        if not (r.q > 0.5 and r.lower_db <= 0 <= r.upper_db and 0 <= r.outside_fraction < 1):
-            raise OptionError(f"{where}: found the SRS Q {r.q!r}, tolerance {r.lower_db!r} / "
-                              f"{r.upper_db!r} dB and outside fraction {r.outside_fraction!r},"
-                              " expected Q above 0.5, a lower tolerance <= 0 <= the upper, "
-                              "and a fraction from 0 to below 1")
-    return spec
+
+    field: str
+    unit: str
+    parse: Callable[[str, str], Any]
+    show: Callable[[Any], str]
 
 
-#: The fields of a profile file and of the Specification sheet, by name: (kind, unit).
-FIELDS = {
-    "shape": ("text", ""),
-    "peak": ("number", "kG"),
-    "peak_tolerance": ("percent", "%"),
-    "duration": ("number", "ms"),
-    "duration_tolerance": ("percent", "%"),
-    "velocity_change": ("number", "m/s"),
-    "velocity_change_tolerance": ("percent", "%"),
-    "corridor": ("percent", "% of peak"),
-    "time_slack": ("percent", "% of duration"),
-    "window": ("number", "ms"),
-    "record": ("text", ""),
-    "placement": ("text", ""),
-    "srs_q": ("number", ""),
-    "srs_lower_db": ("number", "dB"),
-    "srs_upper_db": ("number", "dB"),
-    "srs_outside": ("percent", "%"),
+def _scaled(magnitude: Decimal, scale: str) -> float:
+    """A decimal times a power of ten (``"1e-3"``), rounded once to a float: how the grammar
+    reads a time in ms or a percentage, and how :func:`_shortest` checks what it prints."""
+    return float(magnitude * Decimal(scale))
+
+
+def _shortest(value: float, scale: str, unit: str) -> str:
+    """The shortest decimal text N + ``unit`` that the grammar reads back as ``value``
+    exactly (N x ``scale`` rounded once); 17 significant digits always do."""
+    if value == 0:
+        return f"0{unit}"
+    with localcontext() as ctx:
+        ctx.prec = 1_200  # a double's exact decimal expansion, shifted by a power of ten
+        exact = Decimal(value) / Decimal(scale)
+    for digits in range(1, 18):
+        text = _plain_decimal(format(exact, f".{digits - 1}e"))
+        if _scaled(Decimal(text), scale) == value:
+            return text + unit
+    raise AssertionError(f"no 17-digit text for {value!r}")  # a double always has one
+
+
+def _plain_decimal(text: str) -> str:
+    """``1.50e+1`` -> ``15``; ``5.0e-7`` -> ``5e-7`` (no trailing zeros)."""
+    number = Decimal(text).normalize()
+    exponent = number.as_tuple().exponent
+    assert isinstance(exponent, int)
+    return f"{number:f}" if -7 <= exponent <= 6 and len(f"{number:f}") <= 20 else \
+        str(number).replace("E", "e")
+
+
+def _show_peak(kg: float) -> str:
+    return f"{kg!r}kG"
+
+
+def _show_time(seconds: float) -> str:
+    return _shortest(seconds, TIME_UNITS["ms"], "ms")
+
+
+def _show_fraction(fraction: float) -> str:
+    return _shortest(fraction, "0.01", "%")
+
+
+def _show_tolerance(pair: tuple[float, float]) -> str:
+    minus, plus = pair
+    if minus == plus:
+        return _show_fraction(minus)
+    return f"-{_show_fraction(minus)},+{_show_fraction(plus)}"
+
+
+def _show_db(db: float) -> str:
+    return f"{'+' if db > 0 else ''}{db!r}dB".replace(".0dB", "dB")
+
+
+def _peak(text: str, where: str) -> float:
+    return _quantity(text, where, "a peak", PEAK_UNITS, "12kG, 11750g or 1.2e5m/s^2",
+                     CAPS["peak"], f"{CAPS['peak']:g} kG")
+
+
+def _time(name: str, zero: bool = False) -> Callable[[str, str], float]:
+    def parse(text: str, where: str) -> float:
+        return _quantity(text, where, f"a {name}", TIME_UNITS, "5ms or 500us", CAPS[name],
+                         f"{CAPS[name]:g} s", zero)
+    return parse
+
+
+def _velocity(text: str, where: str) -> float:
+    return _quantity(text, where, "a velocity change", VELOCITY_UNITS, "35m/s",
+                     CAPS["velocity_change"], f"{CAPS['velocity_change']:g} m/s")
+
+
+#: The grammar's keys, by name: the profile's keys, the sheet's rows and the options'.
+KEYS: dict[str, Key] = {
+    "shape": Key("shape", "", lambda t, w: _name(t, w, SHAPES, "a shape"), str),
+    "peak": Key("peak", "kG", _peak, _show_peak),
+    "peak_tolerance": Key("peak", "%", parse_tolerance_text, _show_tolerance),
+    "duration": Key("duration", "ms", _time("duration"), _show_time),
+    "duration_tolerance": Key("duration", "%", parse_tolerance_text, _show_tolerance),
+    "velocity_change": Key("velocity_change", "m/s", _velocity, lambda v: f"{v!r}m/s"),
+    "velocity_change_tolerance": Key("velocity_change", "%", parse_tolerance_text,
+                                     _show_tolerance),
+    "corridor": Key("corridor", "%", lambda t, w: _percent(t, w, "a corridor", True)[1],
+                    _show_fraction),
+    "time_slack": Key("time_slack", "%", lambda t, w: _percent(t, w, "a time slack",
+                                                               False)[1], _show_fraction),
+    "window": Key("window", "ms", _time("window", zero=True), _show_time),
+    "record": Key("cfc", "", parse_record, lambda c: f"cfc{c}" if c else "unfiltered"),
+    "placement": Key("placement", "", lambda t, w: _name(t, w, PLACEMENTS, "a placement"),
+                     str),
+    "srs_q": Key("srs_q", "", parse_q, lambda q: f"{q!r}"),
+    "srs_lower_db": Key("srs_lower_db", "dB", lambda t, w: _db(t, w, "lower"), _show_db),
+    "srs_upper_db": Key("srs_upper_db", "dB", lambda t, w: _db(t, w, "upper"), _show_db),
+    "srs_outside": Key("srs_outside", "%", lambda t, w: _percent(
+        t, w, "a fraction of the frequencies", False)[1], _show_fraction),
 }
 
-
-def _tol(values: dict, name: str, scale: float, where: str) -> Tolerance | None:
-    nominal = values.get(name)
-    tol = values.get(f"{name}_tolerance")
-    if nominal is None and tol is None:
-        return None
-    if tol is not None and not 0 <= tol < 100:
-        raise OptionError(f"{where}: found {name}_tolerance = {tol!r} %, expected 0 to below 100")
-    return Tolerance(math.nan if nominal is None else nominal * scale,
-                     math.nan if tol is None else tol / 100,
-                     math.nan if tol is None else tol / 100)
+#: The option of each key (the tolerances and the dB pair are given with their quantity).
+OPTIONS = {"shape": "--shape", "peak": "--peak", "peak_tolerance": "--peak",
+           "duration": "--duration", "duration_tolerance": "--duration",
+           "velocity_change": "--velocity-change",
+           "velocity_change_tolerance": "--velocity-change", "corridor": "--corridor",
+           "time_slack": "--time-slack", "window": "--window", "record": "--record",
+           "placement": "--placement", "srs_q": "--srs-q", "srs_lower_db": "--srs-tol",
+           "srs_upper_db": "--srs-tol", "srs_outside": "--srs-outside"}
 
 
-def from_fields(values: dict, where: str, srs_rows=None) -> Specification:
-    """A specification from named fields in the units of :data:`FIELDS` (percentages in %),
-    e.g. a profile's or the sheet's; ``srs_rows`` are (frequency [Hz], level [kG]) pairs.
+def key_label(key: str) -> str:
+    return key.replace("_", " ").replace("srs ", "SRS ").replace("db", "dB")
+
+
+def value_of(spec: Specification, key: str) -> Any:
+    """A key's value in a specification (a tolerance's part as the pair (minus, plus)), or
+    None when not given."""
+    value = getattr(spec, KEYS[key].field)
+    if isinstance(value, Tolerance):
+        if key.endswith("_tolerance"):
+            return (value.minus, value.plus) if math.isfinite(value.minus) else None
+        return value.nominal if math.isfinite(value.nominal) else None
+    return value
+
+
+def show(spec: Specification, key: str) -> str:
+    """A key's value in the grammar's own text (it parses back to itself)."""
+    value = value_of(spec, key)
+    return "not given" if value is None else KEYS[key].show(value)
+
+
+def parse_key(key: str, value: object, where: str) -> Any:
+    """A profile key's or a sheet cell's value: text in the grammar, or a bare number in the
+    key's unit (a record's number is its CFC class).
 
     Raises
     ------
     OptionError
-        Naming ``where`` and the field.
+        Naming ``where``.
     """
-    unknown = sorted(set(values) - set(FIELDS))
+    k = KEYS[key]
+    if isinstance(value, str):
+        return k.parse(value, where)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise _refuse(where, value, f"text or a number in {k.unit}" if k.unit else "text")
+    if isinstance(value, int) and not -10**18 <= value <= 10**18:  # past a float's integers
+        raise OptionError(f"{where}: found an integer of more than 18 digits, expected "
+                          f"{'a number in ' + k.unit if k.unit else 'text'}")
+    number = float(value)
+    if not math.isfinite(number):
+        raise _refuse(where, value, f"a finite number{' in ' + k.unit if k.unit else ''}")
+    if key == "record":
+        return k.parse(f"cfc{int(number)}" if number.is_integer() and number else
+                       ("unfiltered" if number == 0 else repr(number)), where)
+    if not k.unit:
+        if key == "srs_q":
+            return k.parse(_plain(number), where)
+        raise _refuse(where, value, "text")
+    sign = "-" if number < 0 else ""
+    if key.endswith("_tolerance") and sign:
+        raise OptionError(f"{where}: found {value!r}, a single signed tolerance, which is "
+                          f"ambiguous; expected {TOLERANCE_EXPECTED}")
+    if key == "srs_upper_db" and number > 0:
+        sign = "+"
+    return k.parse(f"{sign}{_plain(abs(number))}{k.unit}", where)
+
+
+def _plain(number: float) -> str:
+    return repr(float(number)).replace("inf", "1e999")
+
+
+# -- the sources ---------------------------------------------------------------------------------
+
+def from_keys(values: dict[str, Any], where: str, key_where: Callable[[str], str],
+              srs: SrsRequirement | None = None) -> Specification:
+    """A specification from :data:`KEYS` values (a profile's or a sheet's), each read by
+    :func:`parse_key`; ``key_where(key)`` names a key in messages. Blank values give
+    nothing."""
+    unknown = sorted(k for k in values if k not in KEYS)
     if unknown:
-        raise OptionError(f"{where}: found the field {unknown[0]!r}, expected fields from "
-                          f"{', '.join(FIELDS)}")
-    clean: dict = {}
-    for name, value in values.items():
-        kind, unit = FIELDS[name]
-        if value is None or value == "":
-            continue
-        if kind == "text":
-            if not isinstance(value, str):
-                raise OptionError(f"{where}: found {name} = {value!r}, expected text")
-            clean[name] = value.strip().lower()
-        else:
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not \
-                    math.isfinite(value):
-                raise OptionError(f"{where}: found {name} = {value!r}, expected a number"
-                                  + (f" in {unit}" if unit else ""))
-            clean[name] = float(value)
-    record = clean.get("record", "unfiltered")
-    cfc = None
-    if record != "unfiltered":
-        match = re.fullmatch(r"(?:cfc\s*)?(\d+)", record)
-        if not match:
-            raise OptionError(f"{where}: found record = {record!r}, expected unfiltered or "
-                              "CFC 60, 180, 600 or 1000")
-        cfc = int(match.group(1))
-    srs = None
-    if srs_rows:
-        freqs, levels = zip(*srs_rows, strict=True)
-        srs = SrsRequirement(tuple(float(f) for f in freqs), tuple(float(v) for v in levels),
-                             clean.get("srs_q", 10.0), clean.get("srs_lower_db", -3.0),
-                             clean.get("srs_upper_db", 6.0),
-                             clean.get("srs_outside", 0.0) / 100)
-    corridor = clean.get("corridor")
-    window = clean.get("window")
-    spec = Specification(
-        shape=clean.get("shape", "none"), peak=_tol(clean, "peak", 1.0, where),
-        duration=_tol(clean, "duration", 1e-3, where),
-        velocity_change=_tol(clean, "velocity_change", 1.0, where),
-        corridor=None if corridor is None else corridor / 100,
-        time_slack=clean.get("time_slack", 0.0) / 100,
-        window=None if window is None else window * 1e-3, srs=srs, cfc=cfc,
-        placement=clean.get("placement", "least-squares"), source=where)
-    return spec
+        raise OptionError(f"{key_where(unknown[0])}: is not a specification field, expected "
+                          f"fields from {', '.join(KEYS)}")
+    parsed = {key: parse_key(key, value, key_where(key)) for key, value in values.items()
+              if value is not None and not (isinstance(value, str) and not value.strip())}
+    return spec_of_keys(parsed, where, srs, {key: key_where(key) for key in parsed})
+
+
+def spec_of_keys(parsed: dict[str, Any], source: str, srs: SrsRequirement | None = None,
+                 places: dict[str, str] | None = None) -> Specification:
+    """A specification from parsed key values (:func:`parse_key`'s or an option's), from
+    ``source``; ``places`` names each key's option, cell or profile key."""
+    kwargs: dict[str, Any] = {}
+    for name in ("peak", "duration", "velocity_change"):
+        nominal, tol = parsed.get(name), parsed.get(f"{name}_tolerance")
+        if nominal is not None or tol is not None:
+            minus, plus = tol if tol is not None else (math.nan, math.nan)
+            kwargs[name] = Tolerance(math.nan if nominal is None else nominal, minus, plus)
+    for key, value in parsed.items():
+        if KEYS[key].field not in ("peak", "duration", "velocity_change"):
+            kwargs[KEYS[key].field] = value
+    given = list(parsed) + (["srs"] if srs is not None else [])
+    return Specification(**kwargs, srs=srs, source=source,
+                         origins=tuple((key, source) for key in given),
+                         places=tuple((key, (places or {}).get(key, source)) for key in given))
 
 
 #: A profile file is read only up to this size: it is a few hundred bytes of JSON.
@@ -352,30 +627,42 @@ MAX_PROFILE_BYTES = 65_536
 
 
 def load_profile(name: str) -> Specification:
-    """A tolerance profile: a JSON file of :data:`FIELDS` (and ``notes``), by path or by the
+    """A tolerance profile: a JSON object of :data:`KEYS` (and ``notes``), by path or by the
     name of one in :data:`PROFILES`.
 
     Raises
     ------
     OptionError
-        For a missing, oversized or malformed profile, naming it.
+        For a missing, oversized or malformed profile, naming it and the key at fault.
     """
+    import json
+    import stat
+
     path = Path(name)
     if not path.suffix and not path.exists():
         path = PROFILES / f"{name}.json"
     shown = f"--profile {name}"
     try:
-        size = path.stat().st_size
-    except OSError:
+        info = path.stat()
+    except (OSError, ValueError):
         known = ", ".join(sorted(p.stem for p in PROFILES.glob("*.json")))
         raise OptionError(f"{shown}: no such profile file, expected a JSON file or one of "
                           f"{known}") from None
-    if size > MAX_PROFILE_BYTES:
-        raise OptionError(f"{shown}: found {size:,} bytes, expected a profile of at most "
-                          f"{MAX_PROFILE_BYTES:,}")
+    if not stat.S_ISREG(info.st_mode):
+        raise OptionError(f"{shown}: is not a regular file, expected a JSON profile")
+    if info.st_size > MAX_PROFILE_BYTES:
+        raise OptionError(f"{shown}: found {info.st_size:,} bytes, expected a profile of at "
+                          f"most {MAX_PROFILE_BYTES:,}")
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        with open(path, "rb") as handle:
+            raw = handle.read(MAX_PROFILE_BYTES + 1)
+        if len(raw) > MAX_PROFILE_BYTES:
+            raise OptionError(f"{shown}: found over {MAX_PROFILE_BYTES:,} bytes, expected a "
+                              "profile of at most that")
+        data = json.loads(raw.decode("utf-8"), parse_constant=_no_constant)
+    except OptionError:
+        raise
+    except (OSError, UnicodeDecodeError, ValueError, RecursionError) as exc:
         raise OptionError(f"{shown}: is not readable JSON ({type(exc).__name__}), expected "
                           "an object of specification fields") from None
     if not isinstance(data, dict):
@@ -385,19 +672,94 @@ def load_profile(name: str) -> Specification:
     if isinstance(notes, str):
         notes = [notes]
     if not isinstance(notes, list) or not all(isinstance(n, str) for n in notes):
-        raise OptionError(f"{shown}: found notes that are not text, expected a list of text")
-    spec = from_fields(data, f"profile {path.stem}")
+        raise OptionError(f"{shown}: notes: found notes that are not text, expected a list "
+                          "of text")
+    spec = from_keys(data, f"profile {path.stem}", lambda key: f"{shown}: {key}")
     return replace(spec, notes=tuple(notes))
 
 
-def combine(profile: str | None, sheet: Specification | None,
+def _no_constant(name: str) -> None:
+    raise ValueError(f"{name} is not JSON")
+
+
+def check(spec: Specification, where: str) -> Specification:
+    """Refuse a specification that cannot be judged (fields that do not go together),
+    naming ``where`` it came from. Each field's own value was checked by the grammar.
+
+    Raises
+    ------
+    OptionError
+    """
+    for name in ("peak", "duration", "velocity_change"):
+        tol = getattr(spec, name)
+        words = name.replace("_", " ")
+        if tol is not None and not math.isfinite(tol.nominal):
+            raise OptionError(f"{where}: found a {words} tolerance without its nominal value, "
+                              f"expected one (--{words.replace(' ', '-')} VALUE)")
+        if tol is not None and not (math.isfinite(tol.minus) and math.isfinite(tol.plus)):
+            raise OptionError(f"{where}: found a {words} of {tol.nominal:g} without a "
+                              f"tolerance, expected one (VALUE:10%, a profile or the sheet)")
+    if spec.corridor is not None:
+        if spec.shape in (None, "none"):
+            raise OptionError(f"{where}: found a corridor with the shape none, expected a "
+                              f"shape ({', '.join(SHAPES[:3])}) to draw it round")
+        if spec.peak is None or spec.duration is None:
+            raise OptionError(f"{where}: found a corridor without a nominal peak and "
+                              "duration, expected both (the ideal pulse is drawn from them)")
+    if spec.srs is None:
+        given = [k for k in ("srs_q", "srs_lower_db", "srs_upper_db", "srs_outside")
+                 if spec.origin(k) not in (None, "default")
+                 and not str(spec.origin(k)).startswith("profile")]
+        if given:
+            named = dict(spec.places).get(given[0], str(spec.origin(given[0])))
+            raise OptionError(f"{named}: found {show(spec, given[0])} with no SRS requirement"
+                              ", expected the requirement it applies to (--srs, or rows in "
+                              "the Specification sheet's F and G)")
+    elif not 0 < len(spec.srs.frequencies) <= MAX_SRS_ROWS:
+        raise OptionError(f"{where}: found {len(spec.srs.frequencies)} SRS rows, expected 1 "
+                          f"to {MAX_SRS_ROWS:,}")
+    return spec
+
+
+def combine(profile: str | Specification | None, sheet: Specification | None,
             options: Specification | None) -> Specification | None:
-    """The specification a shot is judged by: the profile (a name or file), then the shot's
-    sheet, then the command's options, each overriding the one before field by field; checked.
-    None when nothing is specified."""
-    spec = load_profile(profile) if profile else Specification()
-    for part in (sheet, options):
-        if part is not None:
-            spec = spec.merged(part)
+    """The specification a shot is judged by: the profile (a name, a file or one already
+    loaded), then the shot's sheet, then the command's options, each overriding the one
+    before field by field; checked, and its defaults applied. None when nothing is specified.
+    """
+    spec = Specification()
+    loaded = load_profile(profile) if isinstance(profile, str) else profile
+    parts = [part for part in (loaded, sheet, options) if part is not None]
+    for part in parts:
+        spec = spec.merged(part)
+    spec = _shape_none_over_a_corridor(spec, [part.source for part in parts])
     spec = check(spec, "the specification")
-    return None if spec.empty else spec
+    if spec.empty:
+        return None
+    return spec.resolved()
+
+
+def _shape_none_over_a_corridor(spec: Specification, order: list[str]) -> Specification:
+    """``--shape none`` (or the sheet's) over a profile's corridor: the later source asks for
+    limits only, so the corridor is set aside, and the verdict says so; from one source, the
+    two are refused together by :func:`check`."""
+    shape_from, corridor_from = spec.origin("shape"), spec.origin("corridor")
+    if spec.shape != "none" or spec.corridor is None or shape_from is None or \
+            corridor_from is None or order.index(shape_from) <= order.index(corridor_from):
+        return spec
+    said = (f"not judged: the corridor {show(spec, 'corridor')} from {corridor_from} (the "
+            f"shape is none, from {shape_from}: limits only)")
+    origins = tuple((k, w) for k, w in spec.origins if k != "corridor")
+    return replace(spec, corridor=None, origins=origins, set_aside=spec.set_aside + (said,))
+
+
+def unjudged(spec: Specification) -> list[str]:
+    """What a source gave that no criterion judges, in words: a verdict says it (a profile's
+    SRS tolerance with no SRS requirement)."""
+    keys = [k for k in ("srs_q", "srs_lower_db", "srs_upper_db", "srs_outside")
+            if spec.srs is None and spec.origin(k) not in (None, "default")]
+    said = list(spec.set_aside)
+    if keys:
+        said.append(f"not judged: {', '.join(key_label(k) for k in keys)} from "
+                    f"{spec.origin(keys[0])} (no SRS requirement was given)")
+    return said

@@ -16,7 +16,7 @@ from conftest import TEMPLATE
 
 import airgun_xl
 from airgun_xl.cli import main
-from airgun_xl.errors import CellError, OptionError
+from airgun_xl.errors import AirgunXlError, OptionError
 from airgun_xl.specification import Specification, SrsRequirement, Tolerance, load_profile
 from airgun_xl.studies.acceptance import ideal, judge, judge_rows, pass_flags
 from airgun_xl.studies.recorder import Recorder
@@ -82,7 +82,7 @@ def test_15_percent_longer_it_fails_on_duration():
 def requirement_of(pulse, raise_db=0.0):
     frequencies = np.geomspace(200.0, 20_000.0, 25)
     levels = srs(pulse, DT, frequencies, 10.0) * 10 ** (raise_db / 20)
-    return SrsRequirement(tuple(frequencies), tuple(levels), 10.0, -3.0, 6.0, 0.0)
+    return SrsRequirement(tuple(frequencies), tuple(levels))  # Q 10, -3/+6 dB: the defaults
 
 
 def test_an_srs_requirement_equal_to_the_shots_own_passes_at_0_dB():
@@ -187,8 +187,8 @@ def test_a_specification_sheet_is_read_and_a_bad_cell_is_named(tmp_path):
     assert spec.cfc == 600 and spec.srs.frequencies == (100.0, 1000.0)
     ws["B3"] = "twelve"
     wb.save(shot)
-    with pytest.raises(CellError, match=r"'Specification'!B3 \(Peak\): found 'twelve', "
-                                        r"expected a number in kG"):
+    with pytest.raises(AirgunXlError, match=r"'Specification'!B3 \(Peak\): found 'twelve', "
+                                            r"expected a peak such as 12kG"):
         airgun_xl.load(shot)
 
 

@@ -23,7 +23,7 @@ def add_parser(sub):
     p.add_argument("recording", metavar="RECORDING", help="the recorded pulse: " + RECORDING_HELP)
     add_output(p, "verdict workbook", "SHOT.accept.xlsx")
     add_force(p)
-    add_recording_options(p)
+    add_recording_options(p, anti_alias=False)
     add_spec_options(p)
     p.add_argument("--archive", metavar="DIR",
                    help="record the verdict in the archive (the verdict file of the shot's "
@@ -35,9 +35,11 @@ def judged_cfc(args, spec):
     """The record judged: --cfc, or the specification's; both, and different: refused."""
     from ..errors import OptionError
 
-    if args.cfc is not None and spec.cfc is not None and args.cfc != spec.cfc:
-        raise OptionError(f"--cfc: found {args.cfc}, but the specification judges the record "
-                          f"at CFC {spec.cfc}; expected one of them (or --record)")
+    given = spec.origin("record") not in (None, "default")
+    if args.cfc is not None and given and args.cfc != spec.cfc:
+        judged = f"CFC {spec.cfc}" if spec.cfc else "unfiltered"
+        raise OptionError(f"--cfc: found {args.cfc}, but the specification ({spec.origin('record')}) "
+                          f"judges the record {judged}; expected one of them (or --record)")
     return args.cfc if args.cfc is not None else spec.cfc
 
 
@@ -134,7 +136,7 @@ def report_data(time, kg, spec, verdict):
         pulse["upper"] = np.where(inside, upper, np.nan)
         pulse["lower"] = np.where(inside, lower, np.nan)
     dt = time[1] - time[0]
-    q = spec.srs.q if spec.srs is not None else 10.0
+    q = spec.srs_q if spec.srs is not None and spec.srs_q is not None else 10.0
     top = 0.1 / dt  # the SRS's highest frequency at this rate
     if spec.srs is not None:  # the requirement's band on a 1/12-octave grid, and its rows
         required_f = np.array(spec.srs.frequencies)
@@ -150,8 +152,8 @@ def report_data(time, kg, spec, verdict):
     if spec.srs is not None:  # log-log between the requirement's rows
         required = np.exp(np.interp(np.log(frequencies), np.log(required_f),
                                     np.log(np.array(spec.srs.levels_kg))))
-        spectra.update(required=required, lower=required * 10 ** (spec.srs.lower_db / 20),
-                       upper=required * 10 ** (spec.srs.upper_db / 20))
+        spectra.update(required=required, lower=required * 10 ** (spec.srs_lower_db / 20),
+                       upper=required * 10 ** (spec.srs_upper_db / 20))
     return pulse, spectra
 
 

@@ -1,5 +1,6 @@
 """The argument parser: one subparser per subcommand module, each of which hands off."""
 import argparse
+import re
 
 from .. import __version__
 from ..errors import OptionError
@@ -17,6 +18,7 @@ from . import (
     sweep,
     template,
 )
+from .spec_options import PLAIN_OPTIONS, QUANTITY_OPTIONS
 
 COMMANDS = (fill, diff, archive, check, convergence, design, sweep, srs, compare_measured,
             calibrate, accept, template)
@@ -30,17 +32,19 @@ class _Parser(argparse.ArgumentParser):
         raise OptionError(f"{command}: {message}" if command else message)
 
 
-#: Options whose value starts with a minus sign as typed (``--srs-tol -3dB,+6dB``), which
-#: argparse would take for an option.
-DASHED_VALUES = ("--srs-tol",)
+#: Options whose value may start with a minus sign as typed (``--srs-tol -3dB,+6dB``, and
+#: ``--time-slack -1%``, refused by the grammar with its reason), which argparse would take
+#: for an option.
+DASHED_VALUES = ("--srs-tol", *(option for _, option in QUANTITY_OPTIONS + PLAIN_OPTIONS))
 
 
 def joined_values(argv):
-    """``argv`` with ``--srs-tol -3dB,+6dB`` joined as ``--srs-tol=-3dB,+6dB``."""
+    """``argv`` with ``--srs-tol -3dB,+6dB`` joined as ``--srs-tol=-3dB,+6dB``: a value
+    that starts with a minus and a digit or a point."""
     out, k = [], 0
     while k < len(argv):
-        if argv[k] in DASHED_VALUES and k + 1 < len(argv) and argv[k + 1].startswith("-") \
-                and not argv[k + 1].startswith("--"):
+        if argv[k] in DASHED_VALUES and k + 1 < len(argv) and re.match(r"-[\d.]",
+                                                                         argv[k + 1]):
             out.append(f"{argv[k]}={argv[k + 1]}")
             k += 2
         else:

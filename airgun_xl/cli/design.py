@@ -151,7 +151,7 @@ def run_spec(args):
     from ..shot import Shot
     from ..studies.design import Design, variable
     from ..studies.first_shot import solve_confidence, solve_middle
-    from ..studies.sweep import parse_sd
+    from ..studies.sweep import parse_sds
     from .spec_options import resolve_spec
 
     names = args.vary or ["A28"]
@@ -165,7 +165,7 @@ def run_spec(args):
                           "between 0 and 1, such as 0.95")
     if args.confidence is not None and not 100 <= args.shots <= 10**6:
         raise OptionError(f"--shots: found {args.shots!r}, expected 100 to 1,000,000")
-    sds = [parse_sd(text) for text in args.sd or []]
+    sds = parse_sds(args.sd or [])
     if args.confidence is not None and not sds:
         raise OptionError("--confidence: found no --sd, expected the scatter to design "
                           "against (--sd A28=1.5%% --sd E40=5%%)".replace("%%", "%"))

@@ -21,7 +21,9 @@ RECORDING_HELP = ("a CSV (time, acceleration, units in the header), a workbook's
 
 
 def add_recording_options(p, channel_help="TDMS only: the channel (default: the first "
-                                          "waveform channel)"):
+                                          "waveform channel)", anti_alias=True):
+    """The recording's options; ``anti_alias`` False for a command with no prediction to put
+    through the recorder's filter (accept: the option would be accepted and ignored)."""
     p.add_argument("--channel", metavar="GROUP/CHANNEL", help=channel_help)
     p.add_argument("--cfc", type=int, default=None,
                    help="filter both pulses: SAE J211 class 60, 180, 600 or 1000 (refused "
@@ -32,6 +34,8 @@ def add_recording_options(p, channel_help="TDMS only: the channel (default: the 
     p.add_argument("--time-unit", help="s, ms or us (default: from the header)")
     p.add_argument("--accel-unit", help="g, kG or m/s^2 (default: from the header); g is "
                                         "standard gravity, 9.80665 m/s^2")
+    if not anti_alias:
+        return
     p.add_argument("--anti-alias", type=anti_alias_value, default="auto", metavar="HZ",
                    help="the recorder's anti-alias filter, modelled on the prediction as a "
                         "4-pole Butterworth at HZ: auto (a fifth of the record's rate, the "

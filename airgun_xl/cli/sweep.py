@@ -46,12 +46,12 @@ def _progress_bar(total):
 def run(args):
     from ..shot import Shot
     from ..studies.sensitivity import sobol
-    from ..studies.sweep import grid, monte_carlo, parse_sd, parse_vary, spread
+    from ..studies.sweep import grid, monte_carlo, parse_sds, parse_vary, spread
     from ..workbook.sweep import write_sweep
 
     shot = Shot.from_workbook(args.shot)
     varies = [parse_vary(v) for v in args.vary]
-    sds = [parse_sd(s) for s in args.sd]
+    sds = parse_sds(args.sd)
     if args.mc is not None and args.sobol is not None:
         raise OptionError("--sobol: found it with --mc, expected one or the other")
     random = "--mc" if args.mc is not None else "--sobol" if args.sobol is not None else None

@@ -48,7 +48,7 @@ TRAPEZOID_RAMP = 0.10
 PLACEMENT_SAMPLES = 400
 
 
-def ideal(shape: str, t: np.ndarray, amplitude: float, duration: float) -> np.ndarray:
+def ideal(shape: str | None, t: np.ndarray, amplitude: float, duration: float) -> np.ndarray:
     """The ideal pulse [kG] at times ``t`` [s] from its start."""
     x = np.asarray(t, dtype=float) / duration
     inside = (x >= 0) & (x <= 1)
@@ -63,22 +63,22 @@ def ideal(shape: str, t: np.ndarray, amplitude: float, duration: float) -> np.nd
     return amplitude * np.where(inside, y, 0.0)
 
 
-def width_fraction(shape: str) -> float:
+def width_fraction(shape: str | None) -> float:
     """The shape's width at :data:`DURATION_LEVEL` of its peak, a fraction of its base."""
     return {"half-sine": 1 - 2 * math.asin(DURATION_LEVEL) / math.pi,
             "sawtooth": 1 - DURATION_LEVEL,
-            "trapezoid": 1 - 2 * TRAPEZOID_RAMP * DURATION_LEVEL}.get(shape, 1.0)
+            "trapezoid": 1 - 2 * TRAPEZOID_RAMP * DURATION_LEVEL}.get(shape or "none", 1.0)
 
 
-def peak_offset(shape: str) -> float:
+def peak_offset(shape: str | None) -> float:
     """Time from the ideal's start to its peak, a fraction of its base."""
     return 1.0 if shape == "sawtooth" else 0.5
 
 
-def duration_definition(shape: str) -> str:
+def duration_definition(shape: str | None) -> str:
     """How the duration is measured, in words, for a verdict."""
     f = width_fraction(shape)
-    if shape == "none":
+    if shape in (None, "none"):
         return f"the width between the crossings of {DURATION_LEVEL:.0%} of the peak"
     return (f"the {shape}'s base: the width between the crossings of {DURATION_LEVEL:.0%} "
             f"of the peak / {f:.4f}")
@@ -194,6 +194,8 @@ def corridor_limits(spec: Specification, tau: np.ndarray) -> tuple[np.ndarray, n
     largest value is the peak where the window holds the peak's time, else the larger end,
     and its smallest value is the smaller end: two evaluations, not a search.
     """
+    spec = spec.resolved()
+    assert spec.time_slack is not None  # resolved
     amplitude, duration = _nominals(spec)
     slack = spec.time_slack * duration
     early = ideal(spec.shape, tau - slack, amplitude, duration)
@@ -215,6 +217,7 @@ def judge_rows(t: np.ndarray, kg: np.ndarray, spec: Specification) -> dict[str, 
         margin, a fraction of the nominal peak; only with a corridor), ``onset`` [s] and
         ``span`` (start and end [s] of the span judged).
     """
+    spec = spec.resolved()
     t = np.asarray(t, dtype=float)
     kg = np.atleast_2d(np.asarray(kg, dtype=float))
     dt = t[1] - t[0]
@@ -264,9 +267,12 @@ def srs_criterion(t: np.ndarray, kg: np.ndarray, spec: Specification) -> tuple[C
     """The SRS criterion and the margin at each required frequency [dB]."""
     from .shock import srs
 
+    spec = spec.resolved()
     r = spec.srs
-    if r is None:
+    if r is None or spec.srs_q is None or spec.srs_lower_db is None or \
+            spec.srs_upper_db is None or spec.srs_outside is None:
         raise ValueError("the specification has no SRS requirement")
+    q, lower_db, upper_db = spec.srs_q, spec.srs_lower_db, spec.srs_upper_db
     dt = float(t[1] - t[0])
     top = max(r.frequencies)
     if top > 0.1 / dt:
@@ -276,12 +282,12 @@ def srs_criterion(t: np.ndarray, kg: np.ndarray, spec: Specification) -> tuple[C
                           f"{top:,.0f} Hz, above a tenth of the record's {1 / dt:,.0f} "
                           f"samples a second, where the SRS is not computed; expected "
                           f"requirement rows up to {0.1 / dt:,.0f} Hz, or a faster record")
-    levels = srs(np.asarray(kg, dtype=float), dt, np.array(r.frequencies), r.q)
+    levels = srs(np.asarray(kg, dtype=float), dt, np.array(r.frequencies), q)
     with np.errstate(divide="ignore"):
         margins = 20 * np.log10(levels / np.array(r.levels_kg))
-    outside = (margins < r.lower_db) | (margins > r.upper_db)
-    room = np.minimum(margins - r.lower_db, r.upper_db - margins)
-    allowed = int(math.floor(r.outside_fraction * len(margins) + 1e-9))
+    outside = (margins < lower_db) | (margins > upper_db)
+    room = np.minimum(margins - lower_db, upper_db - margins)
+    allowed = int(math.floor(spec.srs_outside * len(margins) + 1e-9))
     passed = int(outside.sum()) <= allowed
     # the margin of the verdict: the (allowed + 1)-th smallest room, so that letting some
     # frequencies out shows
@@ -291,14 +297,17 @@ def srs_criterion(t: np.ndarray, kg: np.ndarray, spec: Specification) -> tuple[C
     detail = (f"{int(outside.sum())} of {len(margins)} frequencies outside (allowed "
               f"{allowed})" + (f": {names}" if names else ""))
     worst = float(margins[np.argmin(room)])
-    return Criterion("SRS", worst, "dB", r.lower_db, r.upper_db, margin, "dB", passed,
-                     detail), margins
+    return Criterion("SRS", worst, "dB", lower_db, upper_db, margin, "dB", passed,
+                     detail + f"; Q {q:g}"), margins
 
 
 def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
           warnings: list[str] | None = None) -> Verdict:
     """The verdict on one pulse ``kg`` [kG] sampled at ``t`` [s] (the record judged: already
     zeroed and filtered as the specification asks)."""
+    from ..specification import unjudged
+
+    spec = spec.resolved()
     values = judge_rows(t, kg, spec)
     row = {k: v[0] for k, v in values.items()}
     criteria = []
@@ -318,11 +327,13 @@ def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
         criteria.append(Criterion("corridor", 100 * margin, "%", 0.0, None,
                                   100 * margin, "%", margin >= 0,
                                   f"±{spec.corridor:.0%} of {_nominals(spec)[0]:.4g} kG, time "
-                                  f"slack ±{spec.time_slack:.0%}, placed by {spec.placement}"))
+                                  f"slack ±{spec.time_slack:.0%}, placed by "
+                                  f"{spec.placement}"))
         definitions.append(f"corridor: the ideal {spec.shape} starts at "
                            f"{row['onset'] * 1e3:.4f} ms ({spec.placement})")
     if spec.srs is not None:
         criteria.append(srs_criterion(np.asarray(t), np.asarray(kg), spec)[0])
+    definitions += spec.provenance() + unjudged(spec)
     verdict = Verdict(criteria, spec, definitions, list(warnings or []),
                       float(row["onset"]) if math.isfinite(row["onset"]) else None,
                       (float(lo), float(hi)) if math.isfinite(lo) and math.isfinite(hi)
@@ -474,6 +485,6 @@ def flags_of(values: np.ndarray, spec: Specification) -> dict[str, np.ndarray]:
     """:func:`pass_flags` of a :class:`BlockJudge`'s columns; a diverged shot (NaN) fails
     every criterion."""
     named = {name: values[:, k] for k, name in enumerate(BLOCK_VALUES)}
-    if spec.corridor is None or spec.shape == "none":
+    if spec.corridor is None or spec.shape in (None, "none"):
         named.pop("corridor")
     return pass_flags(named, spec)

@@ -60,6 +60,21 @@ def parse_sd(text):
     return cell, fields, sd / 100 if match.group(3) else sd, bool(match.group(3))
 
 
+def parse_sds(texts):
+    """Every ``--sd``, by :func:`parse_sd`; a cell scattered twice is refused (the last one
+    would silently win)."""
+    sds = []
+    seen: dict[str, str] = {}
+    for text in texts:
+        sd = parse_sd(text)
+        if sd[0] in seen:
+            raise OptionError(f"--sd: found {sd[0]} twice ({seen[sd[0]]!r} and {text!r}), "
+                              "expected one scatter per cell")
+        seen[sd[0]] = text
+        sds.append(sd)
+    return sds
+
+
 #: An absolute --sd below this fraction of its cell's value is refused: a percentage that lost
 #: its "%" (E40=3 is 3 Pa on 2.7e7 Pa), whose spread would be zero to every digit shown.
 SD_FLOOR = 1e-6

@@ -24,19 +24,32 @@ from ..cells import BY_ADDRESS, CELLS, PARAMETER_COLUMNS, TIME_HEADER, UNUSED_K1
 from ..errors import AirgunXlError, CellError, WorkbookError
 from ..params import Found, ShotParams, describe
 from . import guard
-from .formula_eval import Evaluator, FormulaFailure, SheetView, shown_formula
+from .formula_eval import MAX_FORMULA, Evaluator, FormulaFailure, SheetView, shown_formula
 from .law_sheet import KEY as LAW_KEY
 from .law_sheet import SHEET_NAME as LAW_SHEET
 from .law_sheet import law_from_cells
 from .spec_sheet import KEY as SPEC_KEY
+from .spec_sheet import LAST_ROW as SPEC_LAST_ROW
 from .spec_sheet import SHEET_NAME as SPEC_SHEET
-from .spec_sheet import spec_from_cells
+from .spec_sheet import SRS_COLUMNS, spec_from_cells
 
 #: Columns read from a sheet other than the parameter sheet (Outputs, or one a formula names).
 OTHER_COLUMNS = 26
 
 #: Relative difference above which a cached formula value "disagrees" with its evaluation.
 CACHE_RTOL = 1e-12
+
+
+def rows_read(title):
+    """How many rows of a sheet are read: the block's, or the Specification sheet's to the
+    end of its SRS rows (:data:`~airgun_xl.workbook.spec_sheet.LAST_ROW`)."""
+    return SPEC_LAST_ROW if title.upper() == SPEC_KEY else limits.BLOCK_ROWS
+
+
+def _kept(title, row, col):
+    """Whether a cell of a sheet is kept: within the rows read, or (on the Specification
+    sheet) a cell of its SRS columns past them, kept so that it is refused, not dropped."""
+    return row <= rows_read(title) or (title.upper() == SPEC_KEY and col in SRS_COLUMNS)
 
 
 @dataclass
@@ -82,7 +95,7 @@ class Source:
         """A :class:`SheetView` over the parameter sheet and the other sheets."""
         sheets = dict(self.other_sheets)
         sheets[self.sheet_title.upper()] = self.block
-        bounds = {name: (limits.BLOCK_ROWS, OTHER_COLUMNS) for name in sheets}
+        bounds = {name: (rows_read(name), OTHER_COLUMNS) for name in sheets}
         if extra_columns is None:  # only the block was read: references beyond it must fail
             bounds[self.sheet_title.upper()] = (limits.BLOCK_ROWS, PARAMETER_COLUMNS)
             return SheetView(sheets, self.sheet_title.upper(), {}, bounds)
@@ -111,11 +124,15 @@ def _read_zip(path, data):
                 continue  # e.g. the Tracked or ChartData sheets of a filled workbook
             cells = {}
             max_col = PARAMETER_COLUMNS if first else OTHER_COLUMNS
-            for row_f, row_v in zip(ws_f.iter_rows(max_row=limits.BLOCK_ROWS, max_col=max_col),
-                                    ws_v.iter_rows(max_row=limits.BLOCK_ROWS, max_col=max_col),
+            # the Specification sheet to its end (the guard has capped its size), so that a
+            # cell past its last SRS row is refused, not dropped
+            max_row = None if ws_f.title.upper() == SPEC_KEY else limits.BLOCK_ROWS
+            for row_f, row_v in zip(ws_f.iter_rows(max_row=max_row, max_col=max_col),
+                                    ws_v.iter_rows(max_row=max_row, max_col=max_col),
                                     strict=True):
                 for cf, cv in zip(row_f, row_v, strict=True):
-                    if cf.value is None or not hasattr(cf, "column"):
+                    if cf.value is None or not hasattr(cf, "column") or not _kept(
+                            ws_f.title, cf.row, cf.column):
                         continue
                     cells[(cf.row, cf.column)] = (cv.value, _formula_text(cf))
             if first:
@@ -174,9 +191,13 @@ def _read_xls(path, data):
             first = not sheets
             rows = wb.get_sheet_by_name(name).to_python(skip_empty_area=False)
             cells = {}
-            for r, row in enumerate(rows[:limits.BLOCK_ROWS], start=1):
+            for r, row in enumerate(rows, start=1):
+                if r > limits.BLOCK_ROWS and name.upper() != SPEC_KEY:
+                    break
                 for c, value in enumerate(row, start=1):
                     if c > (PARAMETER_COLUMNS if first else OTHER_COLUMNS) and (r, c) != (1, 8):
+                        continue
+                    if not first and not _kept(name, r, c):
                         continue
                     if value is not None and value != "":
                         cells[(r, c)] = (value, None)
@@ -244,6 +265,9 @@ def cell_value(evaluator, sheet, pos, cell, where, label):
     cached, formula = cell
     if formula is None:
         return cached, None
+    if len(formula) > MAX_FORMULA:  # refused, not run on its cached value (issue 30.7)
+        return Found(f"a formula of {len(formula):,} characters, over Excel's "
+                     f"{MAX_FORMULA:,}"), None
     try:
         value = evaluator.value(sheet, *pos)
     except FormulaFailure as exc:

@@ -11,8 +11,8 @@ from __future__ import annotations
 import math
 
 from ..errors import CellError
-from ..params import describe
-from ..specification import FIELDS, MAX_SRS_ROWS, Specification, from_fields
+from ..params import Found, describe
+from ..specification import KEYS, MAX_SRS_ROWS, Specification, SrsRequirement, from_keys
 from ..units import KG_MS2, G
 
 SHEET_NAME = "Specification"
@@ -22,11 +22,12 @@ KEY = SHEET_NAME.upper()
 ROWS = (
     ("shape", "Shape", "half-sine, sawtooth (terminal peak), trapezoid, or none (limits only)"),
     ("peak", "Peak", "nominal peak acceleration"),
-    ("peak_tolerance", "Peak tolerance", "± % of the nominal peak"),
+    ("peak_tolerance", "Peak tolerance", "± % of the nominal peak (10), or -10%,+20%"),
     ("duration", "Duration", "nominal pulse duration (the shape's base)"),
-    ("duration_tolerance", "Duration tolerance", "± % of the nominal duration"),
+    ("duration_tolerance", "Duration tolerance", "± % of the nominal duration, or -10%,+20%"),
     ("velocity_change", "Velocity change", "nominal velocity change"),
-    ("velocity_change_tolerance", "Velocity change tolerance", "± % of the nominal"),
+    ("velocity_change_tolerance", "Velocity change tolerance",
+     "± % of the nominal, or -10%,+20%"),
     ("corridor", "Corridor", "± % of the nominal peak round the ideal pulse"),
     ("time_slack", "Time slack", "± % of the duration the corridor may slide"),
     ("window", "Window", "monitored before and after the pulse (blank: half the duration)"),
@@ -38,7 +39,16 @@ ROWS = (
     ("srs_outside", "SRS outside", "% of the frequencies allowed outside (blank: 0)"),
 )
 FIRST_ROW = 2
+
+#: The unit column's words where they say more than the unit of the number (a bare number in
+#: the value column is in the key's unit, :data:`airgun_xl.specification.KEYS`).
+UNITS_SHOWN = {"corridor": "% of peak", "time_slack": "% of duration"}
 SRS_COLUMNS = (6, 7)  # F, G
+
+
+#: The last row the sheet is read to: the field rows, or the SRS rows up to
+#: :data:`~airgun_xl.specification.MAX_SRS_ROWS`; a cell past it is refused, not dropped.
+LAST_ROW = FIRST_ROW + MAX_SRS_ROWS - 1
 
 
 def _where(col_letter: str, row: int) -> str:
@@ -47,39 +57,52 @@ def _where(col_letter: str, row: int) -> str:
 
 def spec_from_cells(cells: dict) -> Specification | None:
     """The specification a sheet's cells ``{(row, col): (value, formula)}`` (formulas already
-    evaluated) give, or None when it is empty.
+    evaluated) give, or None when it is empty. Each field's cell is read by the
+    specification's grammar (a number in the row's unit, or text such as ``12kG`` or
+    ``-10%,+20%``); the SRS rows run from row 2 to the first blank row, and a cell after it is
+    refused, naming it.
 
     Raises
     ------
-    CellError
+    CellError, OptionError
         Naming the cell at fault.
-    OptionError
-        For fields that cannot be judged together (a corridor without a shape), naming the
-        sheet.
     """
+    rows_of = {name: FIRST_ROW + k for k, (name, _, _) in enumerate(ROWS)}
+    labels = {name: label for name, label, _ in ROWS}
     values: dict = {}
-    for k, (name, label, _) in enumerate(ROWS):
-        row = FIRST_ROW + k
+    for name, row in rows_of.items():
         value = cells.get((row, 2), (None, None))[0]
-        if value is None or (isinstance(value, str) and not value.strip()):
-            continue
-        kind = FIELDS[name][0]
-        if kind == "text":
-            if not isinstance(value, str) and name == "record" and isinstance(
-                    value, (int, float)) and not isinstance(value, bool):
-                value = f"cfc {int(value)}" if float(value).is_integer() else str(value)
-            if not isinstance(value, str):
-                raise CellError(_where("B", row), label, describe(value), "text")
-        elif isinstance(value, bool) or not isinstance(value, (int, float)) or not \
-                math.isfinite(value):
-            raise CellError(_where("B", row), label, describe(value),
-                            f"a number in {FIELDS[name][1]}")
-        values[name] = value
+        if isinstance(value, Found):
+            raise CellError(_where("B", row), labels[name], str(value), "a value (a formula "
+                            "the tool can evaluate)")
+        if value is not None:
+            values[name] = value
+    srs = _srs_rows(cells)
+    if not any(v is not None and not (isinstance(v, str) and not v.strip())
+               for v in values.values()) and srs is None:
+        return None
+    return from_keys(values, f"the '{SHEET_NAME}' sheet",
+                     lambda key: f"{_where('B', rows_of[key])} ({labels[key]})", srs)
+
+
+def _srs_rows(cells: dict) -> SrsRequirement | None:
+    """The SRS requirement of columns F and G: rows from :data:`FIRST_ROW` to the first blank
+    one, at most :data:`~airgun_xl.specification.MAX_SRS_ROWS`."""
     rows: list[tuple[float, float]] = []
-    for row in range(FIRST_ROW, FIRST_ROW + MAX_SRS_ROWS + 1):
+    end = None
+    for (row, col), (value, _) in sorted(cells.items()):
+        if col not in SRS_COLUMNS or row < FIRST_ROW or value is None or (
+                isinstance(value, str) and not value.strip()):
+            continue
+        letter = "F" if col == SRS_COLUMNS[0] else "G"
+        if row > LAST_ROW:
+            raise CellError(_where(letter, row), "SRS requirement", describe(value),
+                            f"nothing past row {LAST_ROW:,} (at most {MAX_SRS_ROWS:,} rows)")
+    for row in range(FIRST_ROW, LAST_ROW + 1):
         f = cells.get((row, SRS_COLUMNS[0]), (None, None))[0]
         level = cells.get((row, SRS_COLUMNS[1]), (None, None))[0]
-        if f is None and level is None:
+        if _blank(f) and _blank(level):
+            end = row
             break
         for letter, v in (("F", f), ("G", level)):
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not (
@@ -90,9 +113,21 @@ def spec_from_cells(cells: dict) -> Specification | None:
             raise CellError(_where("F", row), "SRS requirement", describe(f),
                             f"a frequency above the row before's {rows[-1][0]:g} Hz")
         rows.append((float(f), float(level) * G / KG_MS2))
-    if not values and not rows:
+    if end is not None:  # nothing may follow the blank row that ends the requirement
+        for (row, col), (value, _) in sorted(cells.items()):
+            if col in SRS_COLUMNS and row > end and not _blank(value):
+                letter = "F" if col == SRS_COLUMNS[0] else "G"
+                raise CellError(_where(letter, row), "SRS requirement", describe(value),
+                                f"nothing after the blank row {end} that ends the "
+                                "requirement (or fill that row)")
+    if not rows:
         return None
-    return from_fields(values, f"the '{SHEET_NAME}' sheet", rows or None)
+    freqs, levels = zip(*rows, strict=True)
+    return SrsRequirement(tuple(freqs), tuple(levels))
+
+
+def _blank(value) -> bool:
+    return value is None or (isinstance(value, str) and not value.strip())
 
 
 def write_spec_sheet(wb, shot=None):
@@ -114,10 +149,11 @@ def write_spec_sheet(wb, shot=None):
     for k, (name, label, meaning) in enumerate(ROWS):
         row = FIRST_ROW - 1 + k
         ws.write_string(row, 0, label)
-        ws.write_string(row, 2, FIELDS[name][1])
+        ws.write_string(row, 2, UNITS_SHOWN.get(name, KEYS[name].unit))
         ws.write_string(row, 3, meaning, wrap)
     note_row = FIRST_ROW + len(ROWS)
-    ws.write_string(note_row, 0, "fill, design and accept read this sheet; their options "
-                    "(--peak 12kG:10%, --profile NAME...) override it field by field.")
+    ws.write_string(note_row, 0, "fill, design and accept read this sheet over a --profile; "
+                    "their options (--peak 12kG:10%...) override it field by field. A number "
+                    "is in the row's unit; text carries its own (12kG, 0.3ms, -3dB).")
     one_page(ws, note_row, 6, shot=shot, title=SHEET_NAME)
     return ws
