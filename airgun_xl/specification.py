@@ -251,10 +251,14 @@ TIME_UNITS = {"s": "1", "ms": "1e-3", "us": "1e-6", "µs": "1e-6", "ns": "1e-9"}
 VELOCITY_UNITS = {"m/s": 1.0}
 
 
+def _q(text: object) -> str:
+    """A value as a message quotes it: its repr, cut to a readable length."""
+    shown = repr(text)
+    return shown if len(shown) <= 60 else f"{shown[:50]}... ({len(shown):,} characters)"
+
+
 def _refuse(where: str, text: object, expected: str) -> OptionError:
-    shown = repr(text) if not isinstance(text, str) or len(text) <= 60 else \
-        repr(text[:57] + "...")
-    return OptionError(f"{where}: found {shown}, expected {expected}")
+    return OptionError(f"{where}: found {_q(text)}, expected {expected}")
 
 
 def _split(text: str, where: str, expected: str) -> tuple[str, Decimal, str]:
@@ -275,10 +279,10 @@ def _unit(unit: str, units: dict, text: str, where: str, expected: str) -> Any:
     if unit in units:
         return units[unit]
     if not unit:
-        raise OptionError(f"{where}: found {text!r} without a unit, expected {expected}")
+        raise OptionError(f"{where}: found {_q(text)} without a unit, expected {expected}")
     near = [u for u in units if u.lower() == unit.lower()]
     hint = f" (did you mean {near[0]}?)" if near else ""
-    raise OptionError(f"{where}: found the unit {unit!r} in {text!r}{hint}, expected "
+    raise OptionError(f"{where}: found the unit {_q(unit)} in {_q(text)}{hint}, expected "
                       f"{expected}")
 
 
@@ -292,7 +296,7 @@ def _quantity(text: str, where: str, what: str, units: dict, example: str, cap: 
     sign, magnitude, unit_text = _split(text, where, expected)
     factor = _unit(unit_text, units, text, where, expected)
     if sign:
-        raise OptionError(f"{where}: found the sign {sign!r} in {text!r}, where none is "
+        raise OptionError(f"{where}: found the sign {sign!r} in {_q(text)}, where none is "
                           f"meaningful; expected {expected}")
     if isinstance(factor, str):  # a time: "5e0us" and "5us" give float("5e-6")
         value = _scaled(magnitude, factor)
@@ -311,7 +315,7 @@ def _percent(text: str, where: str, what: str, low_open: bool, allow_sign: bool 
     sign, magnitude, unit_text = _split(text, where, expected)
     _unit(unit_text, {"%": 1}, text, where, expected)
     if sign and not allow_sign:
-        raise OptionError(f"{where}: found the sign {sign!r} in {text!r}, where none is "
+        raise OptionError(f"{where}: found the sign {sign!r} in {_q(text)}, where none is "
                           f"meaningful; expected {expected}")
     value = _scaled(magnitude, "0.01")
     if not (math.isfinite(value) and (value > 0 if low_open else value >= 0) and value < 1):
@@ -330,7 +334,7 @@ def parse_tolerance_text(text: str, where: str) -> tuple[float, float]:
     if len(parts) == 1:
         sign, value = _percent(parts[0], where, "a tolerance", False, allow_sign=True)
         if sign in ("-", "+"):
-            raise OptionError(f"{where}: found {text!r}, a single signed tolerance, which is "
+            raise OptionError(f"{where}: found {_q(text)}, a single signed tolerance, which is "
                               f"ambiguous; expected {TOLERANCE_EXPECTED}")
         return value, value
     if len(parts) != 2:
@@ -339,7 +343,7 @@ def parse_tolerance_text(text: str, where: str) -> tuple[float, float]:
     minus = [v for s, v in signed if s == "-"]
     plus = [v for s, v in signed if s == "+"]
     if len(minus) != 1 or len(plus) != 1:
-        raise OptionError(f"{where}: found {text!r}, expected the lower tolerance with - and "
+        raise OptionError(f"{where}: found {_q(text)}, expected the lower tolerance with - and "
                           "the upper with + (-10%,+20%)")
     return minus[0], plus[0]
 
@@ -439,7 +443,7 @@ def _shortest(value: float, scale: str, unit: str) -> str:
         text = _plain_decimal(format(exact, f".{digits - 1}e"))
         if _scaled(Decimal(text), scale) == value:
             return text + unit
-    raise AssertionError(f"no 17-digit text for {value!r}")  # a double always has one
+    raise AssertionError(f"no 17-digit text for {_q(value)}")  # a double always has one
 
 
 def _plain_decimal(text: str) -> str:
@@ -452,7 +456,7 @@ def _plain_decimal(text: str) -> str:
 
 
 def _show_peak(kg: float) -> str:
-    return f"{kg!r}kG"
+    return _shortest(kg, "1", "kG")
 
 
 def _show_time(seconds: float) -> str:
@@ -471,7 +475,7 @@ def _show_tolerance(pair: tuple[float, float]) -> str:
 
 
 def _show_db(db: float) -> str:
-    return f"{'+' if db > 0 else ''}{db!r}dB".replace(".0dB", "dB")
+    return ("+" if db > 0 else "-" if db < 0 else "") + _shortest(abs(db), "1", "dB")
 
 
 def _peak(text: str, where: str) -> float:
@@ -498,7 +502,7 @@ KEYS: dict[str, Key] = {
     "peak_tolerance": Key("peak", "%", parse_tolerance_text, _show_tolerance),
     "duration": Key("duration", "ms", _time("duration"), _show_time),
     "duration_tolerance": Key("duration", "%", parse_tolerance_text, _show_tolerance),
-    "velocity_change": Key("velocity_change", "m/s", _velocity, lambda v: f"{v!r}m/s"),
+    "velocity_change": Key("velocity_change", "m/s", _velocity, lambda v: _shortest(v, "1", "m/s")),
     "velocity_change_tolerance": Key("velocity_change", "%", parse_tolerance_text,
                                      _show_tolerance),
     "corridor": Key("corridor", "%", lambda t, w: _percent(t, w, "a corridor", True)[1],
@@ -509,7 +513,7 @@ KEYS: dict[str, Key] = {
     "record": Key("cfc", "", parse_record, lambda c: f"cfc{c}" if c else "unfiltered"),
     "placement": Key("placement", "", lambda t, w: _name(t, w, PLACEMENTS, "a placement"),
                      str),
-    "srs_q": Key("srs_q", "", parse_q, lambda q: f"{q!r}"),
+    "srs_q": Key("srs_q", "", parse_q, lambda q: _shortest(q, "1", "")),
     "srs_lower_db": Key("srs_lower_db", "dB", lambda t, w: _db(t, w, "lower"), _show_db),
     "srs_upper_db": Key("srs_upper_db", "dB", lambda t, w: _db(t, w, "upper"), _show_db),
     "srs_outside": Key("srs_outside", "%", lambda t, w: _percent(
@@ -576,7 +580,7 @@ def parse_key(key: str, value: object, where: str) -> Any:
         raise _refuse(where, value, "text")
     sign = "-" if number < 0 else ""
     if key.endswith("_tolerance") and sign:
-        raise OptionError(f"{where}: found {value!r}, a single signed tolerance, which is "
+        raise OptionError(f"{where}: found {_q(value)}, a single signed tolerance, which is "
                           f"ambiguous; expected {TOLERANCE_EXPECTED}")
     if key == "srs_upper_db" and number > 0:
         sign = "+"

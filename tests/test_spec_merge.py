@@ -239,7 +239,7 @@ def test_30_4_an_srs_cell_with_no_srs_is_refused_naming_the_cell(tmp_path, capsy
     shot = sheet_shot(tmp_path, {"B3": 12, "B4": 10, "B14": 2})
     refused(capsys, tmp_path, ["accept", str(shot), str(recording(tmp_path)), "-o",
                                str(tmp_path / "v.xlsx")],
-            "'Specification'!B14 (SRS Q): found 2.0 with no SRS requirement")
+            "'Specification'!B14 (SRS Q): found 2 with no SRS requirement")
 
 
 # -- 5. option values read strictly --------------------------------------------------------------
@@ -379,7 +379,7 @@ def test_the_verdict_prints_where_each_field_came_from_and_the_defaults(tmp_path
     assert code == 0
     assert f"from profile lab: peak tolerance 20%, duration tolerance 10%" in out
     assert "from the 'Specification' sheet: duration 5ms" in out
-    assert "from options: peak 12.0kG" in out
+    assert "from options: peak 12kG" in out
     assert ("defaults (the tool's, no source gave them): shape none, time slack 0%, "
             "placement least-squares, record unfiltered, window half the nominal duration"
             ) in out
