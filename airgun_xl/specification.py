@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import OptionError
-from .units import G, KG_MS2
+from .units import KG_MS2, G
 
 #: The pulse shapes a specification can name; "none" judges the limits only (no corridor).
 SHAPES = ("half-sine", "sawtooth", "trapezoid", "none")

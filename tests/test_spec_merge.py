@@ -18,14 +18,10 @@ import airgun_xl
 from airgun_xl.cli import main
 from airgun_xl.errors import AirgunXlError, OptionError
 from airgun_xl.specification import (
-    DEFAULTS,
-    KEYS,
     MAX_SRS_ROWS,
     Specification,
-    SrsRequirement,
     Tolerance,
     combine,
-    judged_fields,
     load_profile,
 )
 from airgun_xl.studies.acceptance import ideal, judge
@@ -377,9 +373,24 @@ def test_the_verdict_prints_where_each_field_came_from_and_the_defaults(tmp_path
     shot = sheet_shot(tmp_path, {"B5": 5})
     code, out, _ = accept(tmp_path, capsys, "--profile", lab, "--peak", "12kG", shot=shot)
     assert code == 0
-    assert f"from profile lab: peak tolerance 20%, duration tolerance 10%" in out
+    assert "from profile lab: peak tolerance 20%, duration tolerance 10%" in out
     assert "from the 'Specification' sheet: duration 5ms" in out
     assert "from options: peak 12kG" in out
     assert ("defaults (the tool's, no source gave them): shape none, time slack 0%, "
             "placement least-squares, record unfiltered, window half the nominal duration"
             ) in out
+
+
+def test_the_documented_profile_example_loads_as_documented(tmp_path):
+    """docs/acceptance.md's JSON example is a working profile of the grammar it describes."""
+    from pathlib import Path
+
+    text = (Path(__file__).parents[1] / "docs" / "acceptance.md").read_text()
+    example = text.split("```json\n", 1)[1].split("```", 1)[0]
+    path = tmp_path / "drop-table.json"
+    path.write_text(example)
+    spec = load_profile(str(path))
+    assert math.isnan(spec.peak.nominal) and (spec.peak.minus, spec.peak.plus) == (0.1, 0.2)
+    assert (spec.shape, spec.corridor, spec.cfc) == ("half-sine", 0.15, 1000)
+    assert (spec.srs_lower_db, spec.srs_upper_db) == (-1.0, 1.0)
+    assert spec.duration.minus == spec.duration.plus == 0.1

@@ -38,8 +38,9 @@ def judged_cfc(args, spec):
     given = spec.origin("record") not in (None, "default")
     if args.cfc is not None and given and args.cfc != spec.cfc:
         judged = f"CFC {spec.cfc}" if spec.cfc else "unfiltered"
-        raise OptionError(f"--cfc: found {args.cfc}, but the specification ({spec.origin('record')}) "
-                          f"judges the record {judged}; expected one of them (or --record)")
+        raise OptionError(f"--cfc: found {args.cfc}, but the specification "
+                          f"({spec.origin('record')}) judges the record {judged}; expected "
+                          "one of them (or --record)")
     return args.cfc if args.cfc is not None else spec.cfc
 
 

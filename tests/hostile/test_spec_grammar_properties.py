@@ -155,7 +155,7 @@ def namespace(**given):
 @SETTINGS
 @given(data=st.data())
 def test_sources_agree_an_option_a_sheet_cell_and_a_profile_key(data, tmp_path):
-    for key, k in KEYS.items():
+    for key in KEYS:
         value = data.draw(VALUES[key], label=key)
         group = [key]  # keys an option gives together
         if key.endswith("_tolerance"):
