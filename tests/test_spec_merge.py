@@ -394,3 +394,21 @@ def test_the_documented_profile_example_loads_as_documented(tmp_path):
     assert (spec.shape, spec.corridor, spec.cfc) == ("half-sine", 0.15, 1000)
     assert (spec.srs_lower_db, spec.srs_upper_db) == (-1.0, 1.0)
     assert spec.duration.minus == spec.duration.plus == 0.1
+
+
+def test_a_tolerance_typed_as_a_percentage_in_excel_is_read_as_it_shows(tmp_path):
+    """Typed "10%" in Excel, a cell holds 0.1 with a percent format: it is 10 %, not 0.1 %
+    (the sheet's unit column says %). Without the format, 0.1 is 0.1 %."""
+    wb = openpyxl.load_workbook(TEMPLATE)
+    ws = wb["Specification"]
+    ws["B3"], ws["B4"], ws["B9"], ws["B10"] = 12, 0.1, 0.2, 0.05
+    for ref in ("B4", "B9", "B10"):
+        ws[ref].number_format = "0%"
+    ws["B2"], ws["B5"], ws["B6"] = "half-sine", 5, 10
+    path = tmp_path / "pct.xlsx"
+    wb.save(path)
+    spec = airgun_xl.load(path).spec
+    assert (spec.peak.minus, spec.corridor, spec.time_slack) == (0.1, 0.2, 0.05)
+    ws["B4"].number_format = "General"
+    wb.save(path)
+    assert airgun_xl.load(path).spec.peak.minus == 0.001

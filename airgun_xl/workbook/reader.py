@@ -68,6 +68,9 @@ class Source:
         ``value`` is the cached value, ``formula`` the formula text or None.
     other_sheets : dict
         Upper-cased title -> cells, like ``block``, for formulas that point to other sheets.
+    percent_cells : frozenset
+        (row, col) of the Specification sheet's cells formatted as a percentage: a cell
+        typed "10%" holds 0.1 (.xlsx and .xlsm; an .xls is read without its formats).
     """
 
     path: Path
@@ -75,6 +78,7 @@ class Source:
     sheet_title: str
     block: dict
     other_sheets: dict = field(default_factory=dict)
+    percent_cells: frozenset = frozenset()
 
     @property
     def outputs_block(self):
@@ -117,6 +121,7 @@ def _read_zip(path, data):
         wb_v = openpyxl.load_workbook(io.BytesIO(data), read_only=True, data_only=True,
                                       keep_links=False)
         sheets: dict = {}
+        percent: set = set()
         wanted: set = set()  # after the first sheet: the sheets its formulas name, Outputs
         for ws_f, ws_v in zip(wb_f.worksheets, wb_v.worksheets, strict=True):
             first = not sheets
@@ -135,6 +140,9 @@ def _read_zip(path, data):
                             ws_f.title, cf.row, cf.column):
                         continue
                     cells[(cf.row, cf.column)] = (cv.value, _formula_text(cf))
+                    if ws_f.title.upper() == SPEC_KEY and "%" in str(
+                            getattr(cf, "number_format", "")):
+                        percent.add((cf.row, cf.column))
             if first:
                 h1 = next(ws_v.iter_rows(min_row=1, max_row=1, min_col=8, max_col=8,
                                          values_only=True), (None,))[0]
@@ -156,7 +164,7 @@ def _read_zip(path, data):
                 wb.close()
     if not sheets:
         raise WorkbookError(f"{shown}: has no worksheet, expected the report's parameter sheet")
-    return sheets
+    return sheets, frozenset(percent)
 
 
 def _reason(exc):
@@ -229,11 +237,12 @@ def read_source(path):
     """
     path = Path(path)
     data, kind = guard.read_input(path)
-    sheets = _read_zip(path, data) if kind == "zip" else _read_xls(path, data)
+    sheets, percent = _read_zip(path, data) if kind == "zip" else (_read_xls(path, data),
+                                                                    frozenset())
     title = next(iter(sheets))
     block = sheets.pop(title)
     return Source(path, hashlib.sha256(data).hexdigest(), title, block,
-                  {name.upper(): cells for name, cells in sheets.items()})
+                  {name.upper(): cells for name, cells in sheets.items()}, percent)
 
 
 def _disagrees(cached, value):
@@ -333,7 +342,7 @@ def read_spec(source):
     if source is None or source.spec_block is None:
         return None, []
     cells, warnings = sheet_values(source, SPEC_KEY, SPEC_SHEET, "specification")
-    return spec_from_cells(cells), warnings
+    return spec_from_cells(cells, source.percent_cells), warnings
 
 
 def check_time_header(source):

@@ -9,6 +9,7 @@ it (``'Specification'!B3``). Blank cells specify nothing.
 from __future__ import annotations
 
 import math
+from decimal import Decimal
 
 from ..errors import CellError
 from ..params import Found, describe
@@ -55,12 +56,13 @@ def _where(col_letter: str, row: int) -> str:
     return f"'{SHEET_NAME}'!{col_letter}{row}"
 
 
-def spec_from_cells(cells: dict) -> Specification | None:
+def spec_from_cells(cells: dict, percent_cells=frozenset()) -> Specification | None:
     """The specification a sheet's cells ``{(row, col): (value, formula)}`` (formulas already
     evaluated) give, or None when it is empty. Each field's cell is read by the
     specification's grammar (a number in the row's unit, or text such as ``12kG`` or
     ``-10%,+20%``); the SRS rows run from row 2 to the first blank row, and a cell after it is
-    refused, naming it.
+    refused, naming it. A number in a % row whose cell is formatted as a percentage
+    (``percent_cells``: typed "10%", it holds 0.1) is read as the percentage it shows.
 
     Raises
     ------
@@ -75,6 +77,9 @@ def spec_from_cells(cells: dict) -> Specification | None:
         if isinstance(value, Found):
             raise CellError(_where("B", row), labels[name], str(value), "a value (a formula "
                             "the tool can evaluate)")
+        if (row, 2) in percent_cells and KEYS[name].unit == "%" and isinstance(
+                value, (int, float)) and not isinstance(value, bool) and math.isfinite(value):
+            value = float(Decimal(repr(float(value))) * 100)  # 0.1 shown as 10% is 10
         if value is not None:
             values[name] = value
     srs = _srs_rows(cells)
