@@ -391,7 +391,7 @@ def parse_record(text: str, where: str = "--record") -> int:
 def parse_q(text: str, where: str = "--srs-q") -> float:
     """The SRS's quality factor: a number without a unit, above 0.5."""
     expected = f"a quality factor without a unit or sign, above 0.5 and at most " \
-               f"{CAPS['srs_q']:g}, such as 10"
+               f"{CAPS['srs_q']:,g}, such as 10"
     sign, magnitude, unit_text = _split(text, where, expected)
     if sign or unit_text:
         raise _refuse(where, text, expected)
@@ -480,7 +480,7 @@ def _show_db(db: float) -> str:
 
 def _peak(text: str, where: str) -> float:
     return _quantity(text, where, "a peak", PEAK_UNITS, "12kG, 11750g or 1.2e5m/s^2",
-                     CAPS["peak"], f"{CAPS['peak']:g} kG")
+                     CAPS["peak"], f"{CAPS['peak']:,g} kG")
 
 
 def _time(name: str, zero: bool = False) -> Callable[[str, str], float]:
@@ -492,7 +492,7 @@ def _time(name: str, zero: bool = False) -> Callable[[str, str], float]:
 
 def _velocity(text: str, where: str) -> float:
     return _quantity(text, where, "a velocity change", VELOCITY_UNITS, "35m/s",
-                     CAPS["velocity_change"], f"{CAPS['velocity_change']:g} m/s")
+                     CAPS["velocity_change"], f"{CAPS['velocity_change']:,g} m/s")
 
 
 #: The grammar's keys, by name: the profile's keys, the sheet's rows and the options'.

@@ -116,6 +116,7 @@ def print_summary(output, filled):
                      + "; ".join(f"{c.name} {c.value:.5g} {c.unit} {c.margin:+.2f} "
                                  f"{c.margin_unit} {'PASS' if c.passed else 'FAIL'}"
                                  for c in v.criteria))
+        lines += [f"    {line}" for line in v.sources()]
     print("\n".join(lines))
 
 

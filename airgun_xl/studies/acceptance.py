@@ -118,6 +118,13 @@ class Verdict:
     def word(self) -> str:
         return "PASS" if self.passed else "FAIL"
 
+    def sources(self) -> list[str]:
+        """Where each field of the specification came from, the defaults it used, and what a
+        source gave that was not judged: a line each (:meth:`Specification.provenance`)."""
+        from ..specification import unjudged
+
+        return self.spec.provenance() + unjudged(self.spec)
+
     def tolerances(self) -> list[str]:
         """The tolerances used, one line each, as every verdict prints them."""
         return [f"{c.name}: {_limits_text(c)}" for c in self.criteria]
@@ -305,8 +312,6 @@ def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
           warnings: list[str] | None = None) -> Verdict:
     """The verdict on one pulse ``kg`` [kG] sampled at ``t`` [s] (the record judged: already
     zeroed and filtered as the specification asks)."""
-    from ..specification import unjudged
-
     spec = spec.resolved()
     values = judge_rows(t, kg, spec)
     row = {k: v[0] for k, v in values.items()}
@@ -333,11 +338,11 @@ def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
                            f"{row['onset'] * 1e3:.4f} ms ({spec.placement})")
     if spec.srs is not None:
         criteria.append(srs_criterion(np.asarray(t), np.asarray(kg), spec)[0])
-    definitions += spec.provenance() + unjudged(spec)
     verdict = Verdict(criteria, spec, definitions, list(warnings or []),
                       float(row["onset"]) if math.isfinite(row["onset"]) else None,
                       (float(lo), float(hi)) if math.isfinite(lo) and math.isfinite(hi)
                       else None)
+    verdict.definitions += verdict.sources()
     if not criteria:
         verdict.warnings.append("the specification gives no criterion: nothing was judged")
     for c in criteria:
