@@ -58,18 +58,30 @@ CAPS = {
     "peak": 1e4,  # [kG]: about 10^5 g, past any pyroshock
     "duration": 10.0,  # [s]
     "velocity_change": 1e4,  # [m/s]
-    "window": 10.0,  # [s]
+    "window": 10.0,  # [s], a window's side in time
+    "window_d": 100.0,  # a window's side in nominal durations
     "srs_q": 1000.0,  # quality factor
     "db": 60.0,  # |SRS tolerance| [dB]
 }
 
+#: The duration definitions: each shape's own D (``base``: a half-sine's or a trapezoid's
+#: base, a sawtooth's rise), or the width at 10 % of the peak (JEDEC-style).
+DURATION_DEFS = ("base", "width@10%")
+
 #: The defaults by :data:`KEYS` name, applied once after the merge
-#: (:meth:`Specification.resolved`); the window's default is a rule (half the nominal
-#: duration), so it stays None.
+#: (:meth:`Specification.resolved`). The record judged has no value default: not given, it is
+#: the tool's noise-bounded low-pass (:mod:`airgun_xl.studies.acceptance`). The corridor's
+#: and the decay's defaults apply only with a shape that draws them (:data:`SHAPE_DEFAULTS`).
 DEFAULTS: dict[str, Any] = {
-    "shape": "none", "time_slack": 0.0, "placement": "least-squares", "record": 0,
+    "shape": "none", "time_slack": 0.0, "placement": "least-squares",
+    "dv_window": ((0.5, "D"), (0.5, "D")), "monitor": ((0.5, "D"), (0.5, "D")),
+    "duration_def": "base",
     "srs_q": 10.0, "srs_lower_db": -3.0, "srs_upper_db": 6.0, "srs_outside": 0.0,
 }
+
+#: Defaults that only a named shape takes: the band round its ideal (a shape named is a shape
+#: judged), and the sawtooth's decay allowance, a fraction of D.
+SHAPE_DEFAULTS: dict[str, Any] = {"corridor": 0.2, "decay": 0.1}
 
 #: Marks the fields of :class:`Specification` that say where it came from, not what it asks.
 META = {"meta": True}
@@ -128,8 +140,15 @@ class Specification:
         Half-width of the corridor round the ideal pulse, a fraction of the nominal peak.
     time_slack : float or None
         Time slack of the corridor, a fraction of the nominal duration (default 0).
-    window : float or None
-        Monitoring window before and after the pulse [s] (None: half the duration).
+    dv_window, monitor : tuple or None
+        The velocity change's window and the corridor's monitoring window, before and after
+        the pulse: ((before, unit), (after, unit)), unit "s" or "D" (nominal durations);
+        default half a duration each side.
+    duration_def : str or None
+        One of :data:`DURATION_DEFS` (default base).
+    decay : float or None
+        The terminal-peak sawtooth's decay allowance, a fraction of D (default 0.1): the
+        band admits any decay from none to it.
     cfc : int or None
         The record judged: 0 unfiltered (the default), or through SAE J211 CFC ``cfc``.
     placement : str or None
@@ -157,7 +176,10 @@ class Specification:
     velocity_change: Tolerance | None = None
     corridor: float | None = None
     time_slack: float | None = None
-    window: float | None = None
+    dv_window: tuple | None = None
+    monitor: tuple | None = None
+    duration_def: str | None = None
+    decay: float | None = None
     cfc: int | None = None
     placement: str | None = None
     srs: SrsRequirement | None = None
@@ -197,10 +219,13 @@ class Specification:
         only with an SRS requirement); each default's origin is "default"."""
         changes: dict[str, Any] = {}
         origins = dict(self.origins)
-        for key, value in DEFAULTS.items():
+        shaped = self.shape not in (None, "none")
+        for key, value in {**DEFAULTS, **SHAPE_DEFAULTS}.items():
             name = KEYS[key].field
-            if getattr(self, name) is None and (self.srs is not None or
-                                                not key.startswith("srs_")):
+            wanted = (self.srs is not None if key.startswith("srs_") else
+                      shaped if key == "corridor" else
+                      self.shape == "sawtooth" if key == "decay" else True)
+            if getattr(self, name) is None and wanted:
                 changes[name] = value
                 origins[key] = "default"
         if not changes:
@@ -224,8 +249,8 @@ class Specification:
         lines = [f"from {where}: {', '.join(items)}" for where, items in by_source.items()
                  if where != "default"]
         defaults = by_source.get("default", [])
-        if self.window is None and self.origin("window") is None:
-            defaults.append("window half the nominal duration")
+        if self.cfc is None:
+            defaults.append("record the tool's default (see record judged)")
         if defaults:
             lines.append(f"defaults (the tool's, no source gave them): {', '.join(defaults)}")
         return lines
@@ -478,6 +503,37 @@ def _show_db(db: float) -> str:
     return ("+" if db > 0 else "-" if db < 0 else "") + _shortest(abs(db), "1", "dB")
 
 
+WINDOW_EXPECTED = ("a window BEFORE,AFTER, each a duration or a multiple of the nominal "
+                   "duration D (0.5ms,1ms or 0.4D,0.1D; one value for both sides), from 0 to "
+                   f"{CAPS['window']:g} s or {CAPS['window_d']:g}D")
+
+
+def parse_window(text: str, where: str) -> tuple:
+    """``0.4D,0.1D`` -> ((0.4, "D"), (0.1, "D")); ``0.5ms`` -> the same both sides [s]."""
+    parts = str(text).split(",")
+    if len(parts) not in (1, 2):
+        raise _refuse(where, text, WINDOW_EXPECTED)
+    sides = []
+    for part in parts:
+        sign, magnitude, unit = _split(part, where, WINDOW_EXPECTED)
+        if unit == "D":
+            if sign:
+                raise OptionError(f"{where}: found the sign {sign!r} in {_q(text)}, where "
+                                  f"none is meaningful; expected {WINDOW_EXPECTED}")
+            value = float(magnitude)
+            if not (math.isfinite(value) and value <= CAPS["window_d"]):
+                raise _refuse(where, text, WINDOW_EXPECTED)
+            sides.append((value, "D"))
+        else:
+            sides.append((_time("window", zero=True)(part, where), "s"))
+    return tuple(sides * 2) if len(sides) == 1 else tuple(sides)
+
+
+def show_window(window: tuple) -> str:
+    return ",".join(_shortest(v, "1", "D") if unit == "D" else _show_time(v)
+                    for v, unit in window)
+
+
 def _peak(text: str, where: str) -> float:
     return _quantity(text, where, "a peak", PEAK_UNITS, "12kG, 11750g or 1.2e5m/s^2",
                      CAPS["peak"], f"{CAPS['peak']:,g} kG")
@@ -509,7 +565,12 @@ KEYS: dict[str, Key] = {
                     _show_fraction),
     "time_slack": Key("time_slack", "%", lambda t, w: _percent(t, w, "a time slack",
                                                                False)[1], _show_fraction),
-    "window": Key("window", "ms", _time("window", zero=True), _show_time),
+    "dv_window": Key("dv_window", "", lambda t, w: parse_window(t, w), show_window),
+    "monitor": Key("monitor", "", lambda t, w: parse_window(t, w), show_window),
+    "duration_def": Key("duration_def", "", lambda t, w: _name(
+        t, w, DURATION_DEFS, "a duration definition"), str),
+    "decay": Key("decay", "%", lambda t, w: _percent(t, w, "a decay allowance", False)[1],
+                 _show_fraction),
     "record": Key("cfc", "", parse_record, lambda c: f"cfc{c}" if c else "unfiltered"),
     "placement": Key("placement", "", lambda t, w: _name(t, w, PLACEMENTS, "a placement"),
                      str),
@@ -525,13 +586,27 @@ OPTIONS = {"shape": "--shape", "peak": "--peak", "peak_tolerance": "--peak",
            "duration": "--duration", "duration_tolerance": "--duration",
            "velocity_change": "--velocity-change",
            "velocity_change_tolerance": "--velocity-change", "corridor": "--corridor",
-           "time_slack": "--time-slack", "window": "--window", "record": "--record",
+           "time_slack": "--time-slack", "dv_window": "--dv-window",
+           "monitor": "--monitor", "duration_def": "--duration-def", "decay": "--decay",
+           "record": "--record",
            "placement": "--placement", "srs_q": "--srs-q", "srs_lower_db": "--srs-tol",
            "srs_upper_db": "--srs-tol", "srs_outside": "--srs-outside"}
 
 
+#: Keys kept one release for the old layout: each gives the keys it stands for, unless the
+#: same source gives those itself (``window``: both windows, in time, before and after).
+ALIASES = {"window": ("dv_window", "monitor")}
+
+
+#: How a verdict names a key where its name is not plain words.
+LABELS = {"dv_window": "velocity-change window", "monitor": "monitoring window",
+          "duration_def": "duration definition", "decay": "decay allowance",
+          "srs_q": "SRS Q", "srs_lower_db": "SRS lower tolerance",
+          "srs_upper_db": "SRS upper tolerance", "srs_outside": "SRS outside"}
+
+
 def key_label(key: str) -> str:
-    return key.replace("_", " ").replace("srs ", "SRS ").replace("db", "dB")
+    return LABELS.get(key, key.replace("_", " "))
 
 
 def value_of(spec: Specification, key: str) -> Any:
@@ -598,13 +673,32 @@ def from_keys(values: dict[str, Any], where: str, key_where: Callable[[str], str
     """A specification from :data:`KEYS` values (a profile's or a sheet's), each read by
     :func:`parse_key`; ``key_where(key)`` names a key in messages. Blank values give
     nothing."""
-    unknown = sorted(k for k in values if k not in KEYS)
+    unknown = sorted(k for k in values if k not in KEYS and k not in ALIASES)
     if unknown:
         raise OptionError(f"{key_where(unknown[0])}: is not a specification field, expected "
                           f"fields from {', '.join(KEYS)}")
-    parsed = {key: parse_key(key, value, key_where(key)) for key, value in values.items()
-              if value is not None and not (isinstance(value, str) and not value.strip())}
-    return spec_of_keys(parsed, where, srs, {key: key_where(key) for key in parsed})
+    given = {key: value for key, value in values.items()
+             if value is not None and not (isinstance(value, str) and not value.strip())}
+    places = {}
+    parsed: dict[str, Any] = {}
+    for key, value in given.items():
+        if key in ALIASES:
+            window = parse_window(value if isinstance(value, str) else
+                                  _alias_number(value, key_where(key)), key_where(key))
+            for target in ALIASES[key]:
+                if target not in given:
+                    parsed[target], places[target] = window, key_where(key)
+        else:
+            parsed[key], places[key] = parse_key(key, value, key_where(key)), key_where(key)
+    return spec_of_keys(parsed, where, srs, places)
+
+
+def _alias_number(value: object, where: str) -> str:
+    """The old ``window`` key's bare number: ms."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(
+            value) or (isinstance(value, int) and abs(value) > 10**18):
+        raise _refuse(where, value, "a number in ms, or " + WINDOW_EXPECTED)
+    return f"{'-' if value < 0 else ''}{_plain(abs(float(value)))}ms"
 
 
 def spec_of_keys(parsed: dict[str, Any], source: str, srs: SrsRequirement | None = None,
@@ -703,6 +797,10 @@ def check(spec: Specification, where: str) -> Specification:
         if tol is not None and not (math.isfinite(tol.minus) and math.isfinite(tol.plus)):
             raise OptionError(f"{where}: found a {words} of {tol.nominal:g} without a "
                               f"tolerance, expected one (VALUE:10%, a profile or the sheet)")
+    if spec.shape not in (None, "none") and (spec.peak is None or spec.duration is None):
+        raise OptionError(f"{where}: found the shape {spec.shape} without a nominal peak and "
+                          "duration, expected both (a named shape is judged: its ideal pulse "
+                          "is drawn from them), or the shape none")
     if spec.corridor is not None:
         if spec.shape in (None, "none"):
             raise OptionError(f"{where}: found a corridor with the shape none, expected a "

@@ -39,7 +39,8 @@ def mil_spec(**changes):
     spec = Specification(shape="half-sine", peak=Tolerance(A, 0.2, 0.2),
                          duration=Tolerance(T, 0.1, 0.1),
                          velocity_change=Tolerance(DV, 0.2, 0.2), corridor=0.2,
-                         time_slack=0.1, window=T)
+                         time_slack=0.1, dv_window=((T, "s"), (T, "s")),
+                         monitor=((T, "s"), (T, "s")))
     return Specification(**{**spec.__dict__, **changes})
 
 

@@ -101,7 +101,7 @@ def test_30_1_a_profiles_srs_tolerance_is_judged(tmp_path, capsys):
     lab = profile(tmp_path, srs_lower_db=-1, srs_upper_db=1, srs_q=10)
     code, out, _ = accept(tmp_path, capsys, "--srs", req, "--profile", lab)
     assert code == 3 and "FAIL  SRS: " in out and "(limits -1 to 1 dB;" in out
-    assert "SRS lower dB -1dB" in out and "SRS upper dB +1dB" in out  # said, with its source
+    assert "SRS lower tolerance -1dB" in out and "SRS upper tolerance +1dB" in out  # sourced
 
 
 def test_30_1_the_sheets_srs_tolerance_survives_srs_rows_from_an_option(tmp_path, capsys):
@@ -116,7 +116,7 @@ def test_30_1_a_profiles_srs_fields_without_a_requirement_are_said_not_judged(tm
                                  origins=(("peak", "options"),)))
     verdict = judge(TIME, PULSE, spec)
     assert verdict.passed
-    assert any(line.startswith("not judged: SRS q") for line in verdict.definitions)
+    assert any(line.startswith("not judged: SRS Q") for line in verdict.definitions)
 
 
 # -- 2. a value equal to its default overrides --------------------------------------------------
@@ -143,8 +143,8 @@ def _namespace(**given):
     import argparse
 
     names = ("profile", "shape", "peak", "duration", "velocity_change", "corridor",
-             "time_slack", "window", "placement", "record", "srs", "srs_tol", "srs_q",
-             "srs_outside", "accel_unit")
+             "time_slack", "window", "dv_window", "monitor", "duration_def", "decay",
+             "placement", "record", "srs", "srs_tol", "srs_q", "srs_outside", "accel_unit")
     return argparse.Namespace(**{n: given.get(n) for n in names})
 
 
@@ -377,8 +377,8 @@ def test_the_verdict_prints_where_each_field_came_from_and_the_defaults(tmp_path
     assert "from the 'Specification' sheet: duration 5ms" in out
     assert "from options: peak 12kG" in out
     assert ("defaults (the tool's, no source gave them): shape none, time slack 0%, "
-            "placement least-squares, record unfiltered, window half the nominal duration"
-            ) in out
+            "placement least-squares, velocity-change window 0.5D,0.5D, monitoring window "
+            "0.5D,0.5D, duration definition base, record the tool's default") in out
 
 
 def test_the_documented_profile_example_loads_as_documented(tmp_path):

@@ -49,7 +49,7 @@ def run(args):
 
     from ..errors import OptionError
     from ..shot import Shot
-    from ..studies.acceptance import judge
+    from ..studies.acceptance import judge_record
     from ..studies.measured import prepare
     from ..transaction import check_output
     from ..workbook.trace import input_file, read_trace
@@ -74,14 +74,20 @@ def run(args):
     spec = dataclasses.replace(spec, cfc=cfc)
     trace = read_trace(args.recording, args.time_unit, args.accel_unit, args.sign,
                        args.channel)
-    rec = prepare(trace, cfc, anti_alias="none")
-    time, kg = rec.trace.time, rec.filtered
-    verdict = judge(time, kg, spec, warnings=shot.warnings + rec.warnings)
+    from ..studies.shock import check_cfc
+
+    filtering = check_cfc(cfc, trace.dt) if cfc else []
+    rec = prepare(trace, None, anti_alias="none")  # zeroed; the record judged is made below
+    verdict = judge_record(rec.trace.time, rec.corrected, spec, trace.name,
+                           noise=rec.base.noise,
+                           warnings=shot.warnings + filtering + rec.warnings)
+    assert verdict.record is not None
+    time, kg = verdict.record
     pulse, spectra = report_data(time, kg, spec, verdict)
     about = [("Shot", str(args.shot)), ("Recording", trace.name),
              ("Units read", f"time {trace.units[0]}, acceleration {trace.units[1]}"),
-             ("Record judged", f"CFC {cfc}" if cfc else "unfiltered (baseline removed)"),
-             ("Verdict", verdict.word)]
+             ("Record judged", verdict.definitions[0].removeprefix("record judged: ")),
+             ("Baseline", rec.base.words()), ("Verdict", verdict.word)]
     from ..workbook.acceptance import write_acceptance
 
     # the verdict's record first, taken back if the workbook is not published: a failure or

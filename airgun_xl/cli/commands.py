@@ -35,7 +35,8 @@ class _Parser(argparse.ArgumentParser):
 #: Options whose value may start with a minus sign as typed (``--srs-tol -3dB,+6dB``, and
 #: ``--time-slack -1%``, refused by the grammar with its reason), which argparse would take
 #: for an option.
-DASHED_VALUES = ("--srs-tol", *(option for _, option in QUANTITY_OPTIONS + PLAIN_OPTIONS))
+DASHED_VALUES = ("--srs-tol", "--window",
+                 *(option for _, option in QUANTITY_OPTIONS + PLAIN_OPTIONS))
 
 
 def joined_values(argv):

@@ -82,8 +82,8 @@ def run(args):
     if r is not None:
         print(f"  ISO/TS 18571 rating {r.overall:.3f} ({r.grade}): corridor {r.corridor:.3f}, "
               f"phase {r.phase:.3f}, magnitude {r.magnitude:.3f}, slope {r.slope:.3f}")
-    print(f"  baseline {c.baseline.offset:.4g} kG removed, pre-trigger noise "
-          f"{c.baseline.noise:.3g} kG; impact at {c.level:.1%} of the peak; anti-alias model "
+    print(f"  baseline: {c.baseline.words()}; impact at {c.level:.1%} of the peak; "
+          "anti-alias model "
           + (f"{c.anti_alias:,.0f} Hz" if c.anti_alias else "none"))
     warn(c.warnings)
     return 0

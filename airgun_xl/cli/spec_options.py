@@ -4,15 +4,16 @@ design, accept): a profile, then the fields, each overriding the shot's Specific
 Every value is read by the specification's grammar (:data:`airgun_xl.specification.KEYS`),
 the one the profile and the sheet use; a value an option gives overrides the sheet's and the
 profile's even when it equals the default (``--time-slack 0%``)."""
-from ..specification import PLACEMENTS, SHAPES
+from ..specification import DURATION_DEFS, PLACEMENTS, SHAPES
 
 #: The options with the grammar keys they give (a quantity's option gives its tolerance too).
 QUANTITY_OPTIONS = (("peak", "--peak"), ("duration", "--duration"),
                     ("velocity_change", "--velocity-change"))
 PLAIN_OPTIONS = (("shape", "--shape"), ("corridor", "--corridor"),
-                 ("time_slack", "--time-slack"), ("window", "--window"),
-                 ("placement", "--placement"), ("record", "--record"), ("srs_q", "--srs-q"),
-                 ("srs_outside", "--srs-outside"))
+                 ("time_slack", "--time-slack"), ("dv_window", "--dv-window"),
+                 ("monitor", "--monitor"), ("duration_def", "--duration-def"),
+                 ("decay", "--decay"), ("placement", "--placement"), ("record", "--record"),
+                 ("srs_q", "--srs-q"), ("srs_outside", "--srs-outside"))
 
 
 def add_spec_options(p):
@@ -35,9 +36,20 @@ def add_spec_options(p):
                         "20%%")
     g.add_argument("--time-slack", metavar="PCT",
                    help="time slack of the corridor, %% of the duration: 10%% (default 0%%)")
+    g.add_argument("--dv-window", metavar="BEFORE,AFTER",
+                   help="the velocity change's window before and after the pulse, in time or"
+                        " in nominal durations: 0.4D,0.1D or 1ms,0.5ms (default 0.5D,0.5D)")
+    g.add_argument("--monitor", metavar="BEFORE,AFTER",
+                   help="the corridor's monitoring window before and after the pulse: 1D,1D "
+                        "(default 0.5D,0.5D)")
     g.add_argument("--window", metavar="DURATION",
-                   help="monitoring window before and after the pulse: 0.5ms (default: half "
-                        "the duration)")
+                   help="(alias for one release) both windows, the same each side: 0.5ms")
+    g.add_argument("--duration-def", metavar="|".join(DURATION_DEFS),
+                   help="the duration judged: each shape's base (a sawtooth's rise; the "
+                        "default) or the width at 10%% of the peak")
+    g.add_argument("--decay", metavar="PCT",
+                   help="the terminal-peak sawtooth's decay allowance, %% of the duration: "
+                        "10%% (the default)")
     g.add_argument("--placement", metavar="|".join(PLACEMENTS),
                    help="where the ideal pulse sits: least squares (default) or on the peak")
     g.add_argument("--record", metavar="unfiltered|cfcN",
@@ -61,7 +73,15 @@ def options_spec(args):
     airgun_xl.errors.OptionError
         Naming the option and what it expects.
     """
-    from ..specification import KEYS, OPTIONS, SrsRequirement, parse_db_pair, spec_of_keys
+    from ..specification import (
+        ALIASES,
+        KEYS,
+        OPTIONS,
+        SrsRequirement,
+        parse_db_pair,
+        parse_window,
+        spec_of_keys,
+    )
     from ..workbook.trace import read_spectrum
 
     parsed = {}
@@ -73,6 +93,10 @@ def options_spec(args):
         text = getattr(args, key, None)
         if text is not None:
             parsed[key] = KEYS[key].parse(text, option)
+    if getattr(args, "window", None) is not None:  # the alias: what the options do not say
+        window = parse_window(args.window, "--window")
+        for key in ALIASES["window"]:
+            parsed.setdefault(key, window)
     if getattr(args, "srs_tol", None) is not None:
         parsed["srs_lower_db"], parsed["srs_upper_db"] = parse_db_pair(args.srs_tol)
     srs = None
@@ -82,6 +106,9 @@ def options_spec(args):
     if not parsed and srs is None:
         return None
     places = {key: option for key, option in OPTIONS.items() if key in parsed}
+    if getattr(args, "window", None) is not None:
+        places.update({k: "--window" for k in ALIASES["window"] if k not in places or
+                       getattr(args, k, None) is None})
     return spec_of_keys(parsed, "options", srs, {**places, "srs": "--srs"})
 
 

@@ -1,32 +1,46 @@
-"""Did a pulse meet its specification? Criteria, margins and a verdict (issue 25).
+"""Did a pulse meet its specification? Criteria, margins and a verdict (issues 25 and 31).
 
 One judge serves the recording (``accept``), the prediction (``fill``'s Summary) and every
 shot of a Monte Carlo (``design --confidence``): :func:`judge_rows` takes a block of pulses on
 one time grid and gives each criterion's value per pulse, with numpy over the block, so a
-single pulse and ten thousand are judged by the same lines.
+single pulse and ten thousand are judged by the same lines; :func:`judge_record` prepares a
+recorded or predicted pulse the one way (its sampling, clipping and glitches checked, the
+record judged made) and judges it.
 
-Definitions (each verdict prints them):
+Definitions (each verdict prints them, with every convention and where it came from):
 
+- **record judged**: the one the specification names (unfiltered, or SAE J211 CFC N), or by
+  default the tool's noise-bounded record: as it is when its noise at rest is within
+  :data:`NOISE_BOUND` of its peak (a prediction has none), else through a 4-pole Bessel
+  low-pass run both ways (no overshoot, no phase) at :data:`LOWPASS_PER_D` / D, D the nominal
+  duration (the measured one without), which changes an ideal pulse's peak and duration by
+  under 1 %; with its noise unknown, as it is, with a warning. A prediction and a recording
+  are judged alike, from rest; a single-sample glitch is taken out of the default record.
 - **peak**: the largest sample of the record judged [kG].
-- **duration**: the base width of the nominal shape, from the two crossings of 10 % of the
-  peak (linearly interpolated) divided by that shape's width at 10 % (half-sine
-  1 - 2 asin(0.1)/pi = 0.9362; terminal-peak sawtooth 0.9; trapezoid with 10 % ramps 0.98;
-  none 1: the width at 10 % itself). An ideal pulse of duration T measures T.
-- **velocity change**: the trapezoidal integral of the acceleration [m/s] over the pulse and
-  its monitoring windows: from ``window`` before the ideal pulse's start to ``window`` after
-  its end (without a shape: round the 10 % crossings). A half-sine gives 2 A T / pi.
+- **duration** (``duration_def``): ``base``, each shape's own D: a half-sine's or a
+  trapezoid's base, from the two crossings of 10 % of the peak (linearly interpolated)
+  divided by the shape's width there (half-sine 1 - 2 asin(0.1)/pi = 0.9362, trapezoid with
+  10 % ramps 0.98, none 1); a terminal-peak sawtooth's rise:
+  its peak over the slope of a least-squares line through its rise from 10 % to 90 % (its
+  decay does not count). ``width@10%``: the width between the 10 % crossings.
+- **velocity change**: the trapezoidal integral of the acceleration [m/s] from ``dv_window``
+  before the ideal pulse's start to ``dv_window`` after its end (without a shape: round the
+  10 % crossings). A half-sine gives 2 A T / pi.
 - **corridor**: the ideal pulse of the nominal peak and duration, placed over the record by
-  least squares (its cross-correlation's best lag, refined to a fraction of a sample) or with
-  its peak on the record's; the limits are the ideal's largest and smallest values within
-  ± the time slack, plus and minus the corridor's half-width; before and after the pulse, for
-  the window, the limits are ± the half-width. The margin is the least distance to a limit
-  over the window, a fraction of the nominal peak.
+  least squares or with its peak on the record's; the limits are the ideal's largest and
+  smallest values within ± the time slack (a sawtooth's upper one with its decay allowance,
+  its lower one with none), plus and minus the band; before and after the pulse, over the
+  ``monitor`` window, ± the band. A named shape is always judged: with no band given, the
+  tool's ±20 % applies. The margin is the least distance to a limit, a fraction of the
+  nominal peak.
 - **SRS**: the maximax absolute-acceleration SRS at the requirement's frequencies and Q; its
   margin at each is 20 log10(SRS / required) dB, inside [lower, upper]; up to the allowed
   fraction of frequencies may fall outside.
 
-Margins are positive inside the tolerance and negative outside: a fraction of the nominal
-for the figures and the corridor, dB for the SRS.
+Limits are inclusive: a value on its limit is within it, to :data:`LIMIT_ULPS` units in the
+last place of the limit (12 kG x 1.2 is 14.399999999999999 in binary). Margins are positive
+inside the tolerance and negative outside: a fraction of the nominal for the figures and the
+corridor, dB for the SRS.
 """
 from __future__ import annotations
 
@@ -35,11 +49,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import OptionError
 from ..specification import Specification
 from ..units import KG_MS2
 
-#: Crossing level of the duration, a fraction of the peak.
+#: Crossing level of the duration, a fraction of the peak (and the sawtooth rise's top).
 DURATION_LEVEL = 0.10
+RISE_TOP = 0.90
 
 #: The trapezoid's rise and fall, each a fraction of its base.
 TRAPEZOID_RAMP = 0.10
@@ -47,24 +63,62 @@ TRAPEZOID_RAMP = 0.10
 #: Samples over the nominal duration on which the ideal pulse is placed by least squares.
 PLACEMENT_SAMPLES = 400
 
+#: The default record's low-pass cut-off times the nominal duration, by shape: its fastest
+#: feature sets it (a half-sine's whole base; a trapezoid's 10 % ramps; a sawtooth's decay).
+#: Each keeps an ideal pulse's peak and duration within 1 % (tests/test_verdict_sign.py).
+LOWPASS_PER_D = {"half-sine": 6.0, "none": 6.0, "trapezoid": 20.0, "sawtooth": 40.0}
+LOWPASS_ORDER = 4
 
-def ideal(shape: str | None, t: np.ndarray, amplitude: float, duration: float) -> np.ndarray:
-    """The ideal pulse [kG] at times ``t`` [s] from its start."""
+#: Above this fraction of the sample rate a cut-off would not filter: the record is judged as
+#: it is, and the verdict says so.
+LOWPASS_MAX_RATE = 0.4
+
+#: The default record is low-passed only when its noise at rest passes this fraction of its
+#: peak (1 sigma): a clean record (a prediction, a quiet recorder) is judged as it is, its
+#: real transients kept; a noisy one is bounded. Unknown noise: as it is, with a warning.
+NOISE_BOUND = 0.005
+
+#: A value on a limit is within it to this many units in the last place of the limit.
+LIMIT_ULPS = 16
+
+#: Fewest samples across the nominal duration: below it a verdict is refused; below
+#: :data:`FEW_SAMPLES` it is warned, with the duration's resolution.
+MIN_SAMPLES, FEW_SAMPLES = 3, 20
+
+#: A single sample that stands out of both its neighbours, the same way, by this fraction of
+#: the peak (and :data:`GLITCH_SIGMAS` of the noise) is a glitch.
+GLITCH_FRACTION, GLITCH_SIGMAS = 0.1, 8.0
+
+#: Samples at exactly the record's largest value, in a row, that mark it clipped.
+CLIPPED_RUN = 3
+
+#: A criterion within this many of its noise-induced standard deviations of a limit could be
+#: moved across it by the pre-trigger noise: the verdict warns.
+NOISE_FLIP_SIGMAS = 2.0
+
+
+def ideal(shape: str | None, t: np.ndarray, amplitude: float, duration: float,
+          decay: float = 0.0) -> np.ndarray:
+    """The ideal pulse [kG] at times ``t`` [s] from its start; a sawtooth rises over
+    ``duration`` and falls to zero over ``decay`` x ``duration`` (0: at once)."""
     x = np.asarray(t, dtype=float) / duration
-    inside = (x >= 0) & (x <= 1)
     if shape == "half-sine":
-        y = np.sin(np.pi * np.clip(x, 0, 1))
+        y = np.where((x >= 0) & (x <= 1), np.sin(np.pi * np.clip(x, 0, 1)), 0.0)
     elif shape == "sawtooth":
-        y = np.clip(x, 0, 1)
+        rise = np.where((x >= 0) & (x <= 1), np.clip(x, 0, 1), 0.0)
+        fall = (1 - (x - 1) / decay) if decay > 0 else np.zeros_like(x)
+        y = np.where((x > 1) & (x <= 1 + decay), fall, rise)
     elif shape == "trapezoid":
-        y = np.clip(np.minimum(x, 1 - x) / TRAPEZOID_RAMP, 0, 1)
+        y = np.where((x >= 0) & (x <= 1), np.clip(np.minimum(x, 1 - x) / TRAPEZOID_RAMP, 0,
+                                                     1), 0.0)
     else:
         raise ValueError(f"no ideal pulse for the shape {shape!r}")
-    return amplitude * np.where(inside, y, 0.0)
+    return amplitude * y
 
 
 def width_fraction(shape: str | None) -> float:
-    """The shape's width at :data:`DURATION_LEVEL` of its peak, a fraction of its base."""
+    """The shape's width at :data:`DURATION_LEVEL` of its peak, a fraction of its base (a
+    sawtooth's without a decay)."""
     return {"half-sine": 1 - 2 * math.asin(DURATION_LEVEL) / math.pi,
             "sawtooth": 1 - DURATION_LEVEL,
             "trapezoid": 1 - 2 * TRAPEZOID_RAMP * DURATION_LEVEL}.get(shape or "none", 1.0)
@@ -75,13 +129,24 @@ def peak_offset(shape: str | None) -> float:
     return 1.0 if shape == "sawtooth" else 0.5
 
 
-def duration_definition(shape: str | None) -> str:
+def duration_definition(shape: str | None, definition: str | None = "base") -> str:
     """How the duration is measured, in words, for a verdict."""
-    f = width_fraction(shape)
-    if shape in (None, "none"):
+    if definition == "width@10%" or shape in (None, "none"):
         return f"the width between the crossings of {DURATION_LEVEL:.0%} of the peak"
+    if shape == "sawtooth":
+        return (f"the sawtooth's rise: its peak over the slope of a least-squares line through"
+                f" its rise from {DURATION_LEVEL:.0%} to {RISE_TOP:.0%} of it (its decay does "
+                "not count)")
     return (f"the {shape}'s base: the width between the crossings of {DURATION_LEVEL:.0%} "
-            f"of the peak / {f:.4f}")
+            f"of the peak / {width_fraction(shape):.4f}")
+
+
+def base_duration(spec: Specification) -> float:
+    """The nominal D the ideal pulse is drawn with [s]: the nominal duration, or with
+    ``width@10%`` the base whose width at 10 % it is."""
+    nominal = _nominals(spec)[1]
+    return nominal / width_fraction(spec.shape) if spec.duration_def == "width@10%" \
+        else nominal
 
 
 @dataclass
@@ -108,7 +173,8 @@ class Verdict:
     definitions: list[str]
     warnings: list[str] = field(default_factory=list)
     onset: float | None = None  # [s], the ideal pulse's start where placed
-    window: tuple[float, float] | None = None  # [s], the span judged
+    window: tuple[float, float] | None = None  # [s], the span monitored
+    record: tuple[np.ndarray, np.ndarray] | None = None  # (t [s], kg) of the record judged
 
     @property
     def passed(self) -> bool:
@@ -127,45 +193,66 @@ class Verdict:
 
     def tolerances(self) -> list[str]:
         """The tolerances used, one line each, as every verdict prints them."""
-        return [f"{c.name}: {_limits_text(c)}" for c in self.criteria]
+        return [f"{c.name}: {limits_text(c)}" for c in self.criteria]
 
 
-def _limits_text(c: Criterion) -> str:
+def limits_text(c: Criterion) -> str:
+    """A criterion's limits in words: ``9.6 to 14.4 kG``; a corridor's as its band."""
+    if c.name == "corridor":
+        return "the record inside the band (margin 0 % or more)"
     lo = "-inf" if c.low is None else f"{c.low:.5g}"
     hi = "+inf" if c.high is None else f"{c.high:.5g}"
     return f"{lo} to {hi} {c.unit}".strip()
+
+
+def within(value, low, high):
+    """``low <= value <= high`` with the limits widened by :data:`LIMIT_ULPS` units in their
+    last place: a value on a limit, computed either side of it, is within it."""
+    low, high = np.asarray(low, dtype=float), np.asarray(high, dtype=float)
+    slack = LIMIT_ULPS * np.spacing(np.maximum(np.abs(low), np.abs(high)))
+    return (value >= low - slack) & (value <= high + slack)
+
+
+def _crossing_before(t, kg, peak_index, level):
+    """Each row's last crossing of ``level`` (per row) before its peak, interpolated (NaN
+    where the record starts above it)."""
+    m, n = kg.shape
+    below = kg < level[:, None]
+    before = below & (np.arange(n)[None, :] < peak_index[:, None])
+    has = before.any(axis=1)
+    i0 = np.minimum(n - 1 - np.argmax(before[:, ::-1], axis=1), n - 2)
+    rows = np.arange(m)
+    a0, a1 = kg[rows, i0], kg[rows, i0 + 1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        start = t[i0] + (level - a0) / (a1 - a0) * (t[i0 + 1] - t[i0])
+    return np.where(has, start, np.nan)
 
 
 def _crossings(t: np.ndarray, kg: np.ndarray, peak_index: np.ndarray, peak: np.ndarray):
     """(start, end) [s] of each row's crossings of :data:`DURATION_LEVEL` x its peak round its
     peak, linearly interpolated (NaN where the record starts or ends above the level)."""
     m, n = kg.shape
-    level = (DURATION_LEVEL * peak)[:, None]
-    below = kg < level
-    idx = np.arange(n)[None, :]
-    before = below & (idx < peak_index[:, None])
-    after = below & (idx > peak_index[:, None])
-    has_before, has_after = before.any(axis=1), after.any(axis=1)
-    i0 = n - 1 - np.argmax(before[:, ::-1], axis=1)  # last sample below, before the peak
-    i1 = np.argmax(after, axis=1)  # first sample below, after the peak
+    level = DURATION_LEVEL * peak
+    start = _crossing_before(t, kg, peak_index, level)
+    after = (kg < level[:, None]) & (np.arange(n)[None, :] > peak_index[:, None])
+    has_after = after.any(axis=1)
+    i1 = np.maximum(np.argmax(after, axis=1), 1)
     rows = np.arange(m)
-    i0c, i1c = np.minimum(i0, n - 2), np.maximum(i1, 1)
-    a0, a1 = kg[rows, i0c], kg[rows, i0c + 1]
-    b0, b1 = kg[rows, i1c - 1], kg[rows, i1c]
-    lv = level[:, 0]
+    b0, b1 = kg[rows, i1 - 1], kg[rows, i1]
     with np.errstate(invalid="ignore", divide="ignore"):
-        start = t[i0c] + (lv - a0) / (a1 - a0) * (t[i0c + 1] - t[i0c])
-        end = t[i1c - 1] + (b0 - lv) / (b0 - b1) * (t[i1c] - t[i1c - 1])
-    return np.where(has_before, start, np.nan), np.where(has_after, end, np.nan)
+        end = t[i1 - 1] + (b0 - level) / (b0 - b1) * (t[i1] - t[i1 - 1])
+    return start, np.where(has_after, end, np.nan)
 
 
 def _placement(t: np.ndarray, kg: np.ndarray, spec: Specification, peak_index: np.ndarray):
     """Each row's ideal pulse start [s]: least squares (the cross-correlation's best lag,
     refined by a parabola through its neighbours) or the peak rule."""
     dt = t[1] - t[0]
-    amplitude, duration = _nominals(spec)
+    amplitude, duration = _nominals(spec)[0], base_duration(spec)
     if spec.placement == "peak":
         return t[peak_index] - peak_offset(spec.shape) * duration
+    if spec.shape == "sawtooth":
+        return _rise_fits(t, kg, peak_index)[0]
     from scipy.signal import fftconvolve
 
     # on every q-th sample, q keeping PLACEMENT_SAMPLES over the pulse (a prediction at 0.5 us
@@ -186,6 +273,29 @@ def _placement(t: np.ndarray, kg: np.ndarray, spec: Specification, peak_index: n
     return t[0] + (k + np.clip(frac, -0.5, 0.5)) * q * dt
 
 
+def _rise_fits(t: np.ndarray, kg: np.ndarray, peak_index: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's sawtooth start [s] and rise slope [kG/s]: a least-squares line through its
+    rise (the samples from 10 % to 90 % of its peak, before it), its start where it meets
+    zero. Its decay, anywhere in the allowance, does not pull it as a whole-pulse fit would,
+    and noise moves it less than two crossings."""
+    onsets = np.full(len(kg), np.nan)
+    slopes = np.full(len(kg), np.nan)
+    for k, row in enumerate(kg):
+        p = int(peak_index[k])
+        peak = row[p]
+        rising = np.flatnonzero(row[:p + 1] < DURATION_LEVEL * peak)
+        first = int(rising[-1]) + 1 if len(rising) else 0
+        part = slice(first, p + 1)
+        keep = row[part] <= RISE_TOP * peak
+        x, y = t[part][keep], row[part][keep]
+        if len(x) >= 2 and np.ptp(x) > 0:
+            slope, intercept = np.polyfit(x, y, 1)
+            if slope > 0:
+                onsets[k], slopes[k] = -intercept / slope, slope
+    return onsets, slopes
+
+
 def _nominals(spec: Specification) -> tuple[float, float]:
     """The nominal peak [kG] and duration [s] the ideal pulse is drawn from."""
     if spec.peak is None or spec.duration is None:
@@ -195,7 +305,8 @@ def _nominals(spec: Specification) -> tuple[float, float]:
 
 def corridor_limits(spec: Specification, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Upper and lower limits [kG] at times ``tau`` [s] from the ideal's start: its largest
-    and smallest values within ± the time slack, ± the half-width.
+    and smallest values within ± the time slack, ± the band; a sawtooth's upper limit with
+    its decay allowance, its lower one with none (the band admits any decay between).
 
     Every shape rises to its peak and then falls, so over a window [tau - s, tau + s] its
     largest value is the peak where the window holds the peak's time, else the larger end,
@@ -203,15 +314,23 @@ def corridor_limits(spec: Specification, tau: np.ndarray) -> tuple[np.ndarray, n
     """
     spec = spec.resolved()
     assert spec.time_slack is not None  # resolved
-    amplitude, duration = _nominals(spec)
+    amplitude, duration = _nominals(spec)[0], base_duration(spec)
     slack = spec.time_slack * duration
-    early = ideal(spec.shape, tau - slack, amplitude, duration)
-    late = ideal(spec.shape, tau + slack, amplitude, duration)
+    decay = spec.decay or 0.0
+    early = ideal(spec.shape, tau - slack, amplitude, duration, decay)
+    late = ideal(spec.shape, tau + slack, amplitude, duration, decay)
+    low_early = ideal(spec.shape, tau - slack, amplitude, duration)
+    low_late = ideal(spec.shape, tau + slack, amplitude, duration)
     t_peak = peak_offset(spec.shape) * duration
     holds_peak = (tau - slack <= t_peak) & (tau + slack >= t_peak)
     band = (spec.corridor or 0.0) * amplitude
     upper = np.where(holds_peak, amplitude, np.maximum(early, late))
-    return upper + band, np.minimum(early, late) - band
+    return upper + band, np.minimum(low_early, low_late) - band
+
+
+def _window_seconds(window: tuple, reference) -> tuple:
+    """A window's (before, after) [s]: a side in D times ``reference`` [s]."""
+    return tuple(value * reference if unit == "D" else value for value, unit in window)
 
 
 def judge_rows(t: np.ndarray, kg: np.ndarray, spec: Specification) -> dict[str, np.ndarray]:
@@ -221,8 +340,9 @@ def judge_rows(t: np.ndarray, kg: np.ndarray, spec: Specification) -> dict[str, 
     -------
     dict
         ``peak`` [kG], ``duration`` [s], ``velocity change`` [m/s], ``corridor`` (least
-        margin, a fraction of the nominal peak; only with a corridor), ``onset`` [s] and
-        ``span`` (start and end [s] of the span judged).
+        margin, a fraction of the nominal peak; only with a corridor), ``onset`` [s],
+        ``span`` (start and end [s] of the velocity change's window) and ``monitored`` (of
+        the corridor's).
     """
     spec = spec.resolved()
     t = np.asarray(t, dtype=float)
@@ -231,17 +351,29 @@ def judge_rows(t: np.ndarray, kg: np.ndarray, spec: Specification) -> dict[str, 
     peak_index = np.argmax(kg, axis=1)
     peak = kg[np.arange(len(kg)), peak_index]
     start, end = _crossings(t, kg, peak_index, peak)
-    out = {"peak": peak, "duration": (end - start) / width_fraction(spec.shape)}
+    width = end - start
+    if spec.duration_def == "width@10%":
+        duration = width
+    elif spec.shape == "sawtooth":
+        duration = peak / _rise_fits(t, kg, peak_index)[1]
+    else:
+        duration = width / width_fraction(spec.shape)
+    out = {"peak": peak, "duration": duration}
     placed = spec.shape != "none" and spec.peak is not None and spec.duration is not None
     if placed:
         onset = _placement(t, kg, spec, peak_index)
-        length = _nominals(spec)[1]
+        length = np.full(len(kg), base_duration(spec))
+        reference = spec.duration.nominal if spec.duration is not None else length
     else:
-        length = out["duration"]
+        length = width / width_fraction(spec.shape)
         onset = start - (1 - width_fraction(spec.shape)) / 2 * length
-    window = spec.window if spec.window is not None else 0.5 * (
-        spec.duration.nominal if spec.duration is not None else np.nan_to_num(length))
-    lo, hi = onset - window, onset + length + window
+        reference = (spec.duration.nominal if spec.duration is not None else
+                     np.nan_to_num(duration))
+    decay = (spec.decay or 0.0) if spec.shape == "sawtooth" else 0.0
+    ending = length * (1 + decay)
+    assert spec.dv_window is not None and spec.monitor is not None  # resolved
+    before, after = _window_seconds(spec.dv_window, reference)
+    lo, hi = onset - before, onset + ending + after
     out["onset"] = onset
     out["span"] = np.stack([lo, hi], axis=1)
     # the trapezoidal rule over the samples inside the span [lo, hi], row by row: partial
@@ -253,8 +385,11 @@ def judge_rows(t: np.ndarray, kg: np.ndarray, spec: Specification) -> dict[str, 
     rows = np.arange(len(kg))
     out["velocity change"] = np.where(
         last > first, sums[rows, last] - sums[rows, np.minimum(first, last)], 0.0) * dt * KG_MS2
+    m_before, m_after = _window_seconds(spec.monitor, reference)
+    m_lo, m_hi = onset - m_before, onset + ending + m_after
+    out["monitored"] = np.stack([m_lo, m_hi], axis=1)
     if spec.corridor is not None and placed:
-        inside = (t[None, :] >= lo[:, None]) & (t[None, :] <= hi[:, None])
+        inside = (t[None, :] >= m_lo[:, None]) & (t[None, :] <= m_hi[:, None])
         upper, lower = corridor_limits(spec, t[None, :] - onset[:, None])
         room = np.minimum(upper - kg, kg - lower)
         out["corridor"] = np.min(np.where(inside, room, np.inf), axis=1) / _nominals(spec)[0]
@@ -264,9 +399,9 @@ def judge_rows(t: np.ndarray, kg: np.ndarray, spec: Specification) -> dict[str, 
 def _figure(name: str, value: float, tol, unit: str, scale: float) -> Criterion:
     lo, hi = tol.limits
     margin = min(value - lo, hi - value) / tol.nominal if math.isfinite(value) else -math.inf
+    passed = bool(within(value, lo, hi)) if math.isfinite(value) else False
     return Criterion(name, float(value) * scale, unit, lo * scale, hi * scale,
-                     float(100 * margin), "%",
-                     bool(lo <= value <= hi))
+                     float(100 * margin) if not passed or margin >= 0 else 0.0, "%", passed)
 
 
 def srs_criterion(t: np.ndarray, kg: np.ndarray, spec: Specification) -> tuple[Criterion,
@@ -283,8 +418,6 @@ def srs_criterion(t: np.ndarray, kg: np.ndarray, spec: Specification) -> tuple[C
     dt = float(t[1] - t[0])
     top = max(r.frequencies)
     if top > 0.1 / dt:
-        from ..errors import OptionError
-
         raise OptionError(f"the SRS requirement ({spec.source or 'options'}): found a row at "
                           f"{top:,.0f} Hz, above a tenth of the record's {1 / dt:,.0f} "
                           f"samples a second, where the SRS is not computed; expected "
@@ -292,32 +425,41 @@ def srs_criterion(t: np.ndarray, kg: np.ndarray, spec: Specification) -> tuple[C
     levels = srs(np.asarray(kg, dtype=float), dt, np.array(r.frequencies), q)
     with np.errstate(divide="ignore"):
         margins = 20 * np.log10(levels / np.array(r.levels_kg))
-    outside = (margins < lower_db) | (margins > upper_db)
+    inside = within(margins, lower_db, upper_db)
     room = np.minimum(margins - lower_db, upper_db - margins)
+    room = np.where(inside, np.maximum(room, 0.0), room)
     allowed = int(math.floor(spec.srs_outside * len(margins) + 1e-9))
-    passed = int(outside.sum()) <= allowed
+    passed = int((~inside).sum()) <= allowed
     # the margin of the verdict: the (allowed + 1)-th smallest room, so that letting some
     # frequencies out shows
     margin = float(np.sort(room)[min(allowed, len(room) - 1)])
     names = ", ".join(f"{f:,.0f} Hz ({m:+.2f} dB)" for f, m in
-                      zip(np.array(r.frequencies)[outside], margins[outside], strict=True))
-    detail = (f"{int(outside.sum())} of {len(margins)} frequencies outside (allowed "
+                      zip(np.array(r.frequencies)[~inside], margins[~inside], strict=True))
+    detail = (f"{int((~inside).sum())} of {len(margins)} frequencies outside (allowed "
               f"{allowed})" + (f": {names}" if names else ""))
     worst = float(margins[np.argmin(room)])
     return Criterion("SRS", worst, "dB", lower_db, upper_db, margin, "dB", passed,
                      detail + f"; Q {q:g}"), margins
 
 
+def _window_words(window: tuple) -> str:
+    from ..specification import show_window
+
+    before, after = show_window(window).split(",")
+    return f"{before} before, {after} after"
+
+
 def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
-          warnings: list[str] | None = None) -> Verdict:
+          warnings: list[str] | None = None, record: str | None = None) -> Verdict:
     """The verdict on one pulse ``kg`` [kG] sampled at ``t`` [s] (the record judged: already
-    zeroed and filtered as the specification asks)."""
+    zeroed and filtered as the specification asks; ``record`` says how, in words)."""
     spec = spec.resolved()
     values = judge_rows(t, kg, spec)
     row = {k: v[0] for k, v in values.items()}
     criteria = []
-    definitions = [f"record judged: {'CFC %d' % spec.cfc if spec.cfc else 'unfiltered'}",
-                   f"duration: {duration_definition(spec.shape)}"]
+    assert spec.dv_window is not None and spec.monitor is not None  # resolved
+    definitions = [f"record judged: {record or describe_record(spec)}",
+                   f"duration: {duration_definition(spec.shape, spec.duration_def)}"]
     if spec.peak is not None:
         criteria.append(_figure("peak", row["peak"], spec.peak, "kG", 1.0))
     if spec.duration is not None:
@@ -326,21 +468,29 @@ def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
         criteria.append(_figure("velocity change", row["velocity change"],
                                 spec.velocity_change, "m/s", 1.0))
     lo, hi = row["span"]
-    definitions.append(f"velocity change: integrated from {lo * 1e3:.4f} to {hi * 1e3:.4f} ms")
+    definitions.append(f"velocity change: integrated from {lo * 1e3:.4f} to {hi * 1e3:.4f} ms"
+                       f" ({_window_words(spec.dv_window)} the pulse)")
+    m_lo, m_hi = row["monitored"]
     if "corridor" in row:
         margin = float(row["corridor"])
+        decay = (f", decay allowed 0 to {spec.decay:.0%} of D" if spec.shape == "sawtooth"
+                 else "")
         criteria.append(Criterion("corridor", 100 * margin, "%", 0.0, None,
                                   100 * margin, "%", margin >= 0,
                                   f"±{spec.corridor:.0%} of {_nominals(spec)[0]:.4g} kG, time "
                                   f"slack ±{spec.time_slack:.0%}, placed by "
-                                  f"{spec.placement}"))
+                                  f"{spec.placement}{decay}"))
         definitions.append(f"corridor: the ideal {spec.shape} starts at "
-                           f"{row['onset'] * 1e3:.4f} ms ({spec.placement})")
+                           f"{row['onset'] * 1e3:.4f} ms ({spec.placement}); monitored from "
+                           f"{m_lo * 1e3:.4f} to {m_hi * 1e3:.4f} ms "
+                           f"({_window_words(spec.monitor)} the pulse)")
+    elif spec.shape == "none":
+        definitions.append("shape: none, so the limits only: no corridor judged")
     if spec.srs is not None:
         criteria.append(srs_criterion(np.asarray(t), np.asarray(kg), spec)[0])
     verdict = Verdict(criteria, spec, definitions, list(warnings or []),
                       float(row["onset"]) if math.isfinite(row["onset"]) else None,
-                      (float(lo), float(hi)) if math.isfinite(lo) and math.isfinite(hi)
+                      (float(m_lo), float(m_hi)) if math.isfinite(m_lo) and math.isfinite(m_hi)
                       else None)
     verdict.definitions += verdict.sources()
     if not criteria:
@@ -353,6 +503,241 @@ def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
     return verdict
 
 
+# -- the record judged ---------------------------------------------------------------------------
+
+def lowpass_hz(spec: Specification, duration: float) -> float:
+    """The default record's cut-off [Hz] for a pulse of ``duration`` [s]."""
+    return LOWPASS_PER_D.get(spec.shape or "none", LOWPASS_PER_D["none"]) / duration
+
+
+def describe_record(spec: Specification, duration: float | None = None,
+                    dt: float | None = None, quiet: str | None = None) -> str:
+    """The record judged, in words, as the verdict prints it; ``quiet`` says why the default
+    record needed no low-pass."""
+    if spec.cfc:
+        return f"CFC {spec.cfc} (SAE J211), both ways"
+    if spec.cfc == 0:
+        return "unfiltered"
+    if quiet:
+        return f"unfiltered, the tool's default for a record {quiet} (no record named)"
+    per_d = LOWPASS_PER_D.get(spec.shape or "none", LOWPASS_PER_D["none"])
+    if duration is None or not math.isfinite(duration) or duration <= 0:
+        return (f"the tool's default: a {LOWPASS_ORDER}-pole Bessel low-pass at {per_d:g}/D, "
+                "both ways (no record named)")
+    hz = per_d / duration
+    which = "nominal" if spec.duration is not None else "measured"
+    if dt is not None and hz > LOWPASS_MAX_RATE / dt:
+        return (f"unfiltered: the tool's default low-pass ({per_d:g}/D = {hz:,.0f} Hz, D the "
+                f"{which} duration) lies above {LOWPASS_MAX_RATE:g} of the rate")
+    return (f"the tool's default: a {LOWPASS_ORDER}-pole Bessel low-pass at {hz:,.0f} Hz "
+            f"({per_d:g}/D, D the {which} {duration * 1e3:.4g} ms), both ways (no record "
+            "named)")
+
+
+def _reference_duration(t: np.ndarray, kg: np.ndarray, spec: Specification) -> np.ndarray:
+    """Each row's D for the default low-pass: the nominal duration, else the measured one."""
+    if spec.duration is not None:
+        return np.full(len(kg), spec.duration.nominal)
+    return np.nan_to_num(judge_rows(t, kg, spec.resolved())["duration"], nan=0.0)
+
+
+def judged_record(t: np.ndarray, kg: np.ndarray, spec: Specification, noise: float = 0.0
+                  ) -> tuple[np.ndarray, np.ndarray, str]:
+    """A pulse (or a block of them, a row each) as the specification judges it, from rest
+    (:data:`~airgun_xl.studies.measured.REST_BEFORE` of it prepended, for a phaseless
+    filter's lead): through its CFC, unchanged (unfiltered), or by default bounded in noise:
+    as it is when ``noise`` (its rest's, 1 sigma [kG]; 0 for a prediction, NaN unknown) is
+    within :data:`NOISE_BOUND` of its peak, else through the low-pass of
+    :func:`lowpass_hz`; and the record in words."""
+    from .measured import REST_BEFORE
+    from .shock import cfc_filter
+
+    kg = np.asarray(kg, dtype=float)
+    if spec.cfc == 0:  # unfiltered: the record as it is
+        return t, kg, describe_record(spec)
+    if spec.cfc is None:
+        peak = float(np.max(kg)) if kg.size else 0.0
+        if not math.isfinite(noise):
+            return t, kg, describe_record(spec, quiet="whose noise is unknown")
+        if noise <= NOISE_BOUND * peak:
+            return t, kg, describe_record(spec, quiet=(
+                "without noise (a prediction)" if noise == 0 else
+                f"whose noise at rest, {noise:.3g} kG, is within {NOISE_BOUND:.1%} of its "
+                "peak"))
+    dt = float(t[1] - t[0])
+    n = int(round(REST_BEFORE / dt))
+    rows = np.atleast_2d(kg)
+    durations = _reference_duration(t, rows, spec) if not spec.cfc else None
+    t = np.concatenate([t[0] - dt * np.arange(n, 0, -1), t])
+    padded = np.concatenate([np.zeros(kg.shape[:-1] + (n,)), kg], axis=-1)
+    if spec.cfc:
+        return t, cfc_filter(padded, dt, spec.cfc), describe_record(spec)
+    from scipy.signal import bessel, sosfiltfilt
+
+    assert durations is not None
+    out = np.atleast_2d(padded).copy()
+    for k, duration in enumerate(durations):
+        hz = lowpass_hz(spec, duration) if duration > 0 else math.inf
+        if hz <= LOWPASS_MAX_RATE / dt:
+            sos = bessel(LOWPASS_ORDER, hz, fs=1 / dt, output="sos", norm="mag")
+            out[k] = sosfiltfilt(sos, out[k])
+    words = describe_record(spec, float(durations[0]), dt)
+    return t, (out if kg.ndim > 1 else out[0]), words
+
+
+def sampling_checks(dt: float, spec: Specification, what: str) -> list[str]:
+    """Refuse a record with fewer than :data:`MIN_SAMPLES` samples across the nominal
+    duration; warn below :data:`FEW_SAMPLES`, stating the duration's resolution."""
+    if spec.duration is None:
+        return []
+    d = spec.duration.nominal
+    n = d / dt
+    if n < MIN_SAMPLES:
+        raise OptionError(f"{what}: found {1 / dt:,.0f} samples a second, {n:.2g} across the "
+                          f"nominal duration {d * 1e3:.4g} ms, expected at least "
+                          f"{MIN_SAMPLES} (a rate of {MIN_SAMPLES / d:,.0f} or more)")
+    if n < FEW_SAMPLES:
+        return [f"{what}: {n:.3g} samples across the nominal duration {d * 1e3:.4g} ms "
+                f"({1 / dt:,.0f} a second), fewer than {FEW_SAMPLES}: its crossings are "
+                f"placed to about ±{dt * 1e3 / 2:.3g} ms each, so the duration is resolved to "
+                f"about ±{dt * 1e3:.3g} ms ({100 * dt / d:.0f} % of D); the peak may fall "
+                "between samples"]
+    return []
+
+
+def clipped_samples(kg: np.ndarray) -> np.ndarray:
+    """Indices of the record's runs of :data:`CLIPPED_RUN` or more samples at exactly its
+    largest value: a record held at its range, whose peak it cannot show."""
+    kg = np.asarray(kg, dtype=float)
+    at_top = np.flatnonzero(kg == np.max(kg))
+    if len(at_top) < CLIPPED_RUN:
+        return np.array([], dtype=int)
+    runs = np.split(at_top, np.flatnonzero(np.diff(at_top) != 1) + 1)
+    long = [r for r in runs if len(r) >= CLIPPED_RUN]
+    return np.concatenate(long) if long else np.array([], dtype=int)
+
+
+def glitches(kg: np.ndarray, noise: float) -> np.ndarray:
+    """Indices of single samples that stand out of both neighbours the same way by more than
+    :data:`GLITCH_FRACTION` of the peak and :data:`GLITCH_SIGMAS` x the noise."""
+    kg = np.asarray(kg, dtype=float)
+    if len(kg) < 3:
+        return np.array([], dtype=int)
+    left, right = kg[1:-1] - kg[:-2], kg[1:-1] - kg[2:]
+    noise = noise if math.isfinite(noise) else 0.0
+    floor = max(GLITCH_FRACTION * float(np.max(np.abs(kg))), GLITCH_SIGMAS * noise)
+    out = (np.sign(left) == np.sign(right)) & (np.minimum(np.abs(left), np.abs(right)) > floor)
+    return np.flatnonzero(out) + 1
+
+
+def judge_record(t: np.ndarray, kg: np.ndarray, spec: Specification, what: str,
+                 noise: float = math.nan, warnings: list[str] | None = None) -> Verdict:
+    """The verdict on a recorded or predicted pulse ``kg`` [kG] (zeroed, unfiltered) at
+    ``t`` [s], named ``what`` in messages; ``noise`` is its rest's standard deviation [kG]
+    (NaN: unknown). The sampling is checked, a clipped peak fails as not measurable,
+    single-sample glitches are taken out of the default record (and warned either way),
+    and a criterion the noise could move across its limit is warned."""
+    spec = spec.resolved()
+    t = np.asarray(t, dtype=float)
+    kg = np.asarray(kg, dtype=float)
+    dt = float(t[1] - t[0])
+    said = list(warnings or []) + sampling_checks(dt, spec, what)
+    clipped = clipped_samples(kg)
+    spikes = glitches(kg, noise)
+    if len(spikes):
+        shown = ", ".join(f"{t[i] * 1e3:.4f} ms ({kg[i]:.4g} kG)" for i in spikes[:5])
+        more = f" and {len(spikes) - 5} more" if len(spikes) > 5 else ""
+        if spec.cfc is None:  # the default record: taken out, each by its neighbours' mean
+            kg = kg.copy()
+            kg[spikes] = 0.5 * (kg[spikes - 1] + kg[np.minimum(spikes + 1, len(kg) - 1)])
+            said.append(f"{what}: {len(spikes)} single-sample glitch"
+                        f"{'es' * (len(spikes) != 1)} at {shown}{more}, taken out of the "
+                        "record judged (each replaced by its neighbours' mean)")
+        else:
+            said.append(f"{what}: {len(spikes)} single-sample glitch"
+                        f"{'es' * (len(spikes) != 1)} at {shown}{more}, kept in the record "
+                        f"judged ({describe_record(spec)}, as the specification names it): "
+                        "it may lift the peak")
+    if spec.cfc is None and not math.isfinite(noise):
+        said.append(f"{what}: its noise is unknown (no record at rest before or after the "
+                    "pulse), so it is judged unfiltered: noise would lift its peak; name the "
+                    "record judged (--record) to filter it")
+    tj, kj, words = judged_record(t, kg, spec, noise)
+    verdict = judge(tj, kj, spec, said, record=words)
+    verdict.record = (tj, kj)
+    if len(clipped):
+        for c in verdict.criteria:
+            if c.name == "peak":
+                c.passed, c.detail = False, "not measurable: the record is clipped"
+                c.value, c.margin = math.nan, -math.inf
+        verdict.warnings.append(
+            f"{what}: clipped: {len(clipped)} samples from {t[clipped[0]] * 1e3:.4f} to "
+            f"{t[clipped[-1]] * 1e3:.4f} ms sit at exactly its largest value, "
+            f"{kg[clipped[0]]:.6g} kG (the recorder's range): the peak is not measurable "
+            "and judged FAIL")
+    if math.isfinite(noise) and noise > 0:
+        verdict.warnings += noise_could_flip(verdict, tj, kj, spec, noise, what)
+    return verdict
+
+
+def noise_could_flip(verdict: Verdict, t: np.ndarray, kg: np.ndarray, spec: Specification,
+                     noise: float, what: str) -> list[str]:
+    """Warnings for the criteria that the rest's noise (``noise`` [kG], 1 sigma, unfiltered)
+    could move across a limit: within :data:`NOISE_FLIP_SIGMAS` of its effect on each."""
+    dt = float(t[1] - t[0])
+    peak = float(np.max(kg))
+    if spec.cfc == 0 or (spec.cfc is None and noise <= NOISE_BOUND * peak):
+        hz = None  # judged as it is
+    else:  # J211's -3 dB point is 1.65 x its class; the low-pass's is its cut-off
+        hz = spec.cfc * 1.65 if spec.cfc else lowpass_hz(
+            spec, float(_reference_duration(t, np.atleast_2d(kg), spec)[0]) or math.inf)
+    sigma = noise * math.sqrt(min(1.0, 2 * hz * dt)) if hz else noise  # after the filter
+    slope = np.abs(np.gradient(kg, dt))
+    level = DURATION_LEVEL * peak
+    near = np.abs(kg - level) < 0.05 * peak
+    steep = float(np.median(slope[near])) if near.any() else math.inf
+    lo, hi = judge_rows(t, kg, spec)["span"][0]
+    n_dv = max(1, int(round((hi - lo) / dt))) if math.isfinite(hi - lo) else len(kg)
+    effects = {"peak": sigma,
+               "duration": math.sqrt(2) * sigma / steep * 1e3 if steep > 0 else math.inf,
+               "velocity change": noise * dt * math.sqrt(n_dv) * KG_MS2,
+               "corridor": 100 * sigma / (spec.peak.nominal if spec.peak else peak)}
+    said = []
+    for c in verdict.criteria:
+        effect = effects.get(c.name)
+        if effect is None or not math.isfinite(c.value):
+            continue
+        if c.name == "corridor":
+            gap = abs(c.value)
+        else:
+            gap = min(abs(c.value - lim) for lim in (c.low, c.high) if lim is not None)
+        if gap <= NOISE_FLIP_SIGMAS * effect:
+            said.append(f"{what}: the noise at rest ({noise:.3g} kG, 1 sigma; about "
+                        f"{effect:.3g} {c.unit} on the {c.name} of the record judged) could "
+                        f"move the {c.name} across its limit: it is {gap:.3g} {c.unit} from "
+                        f"it; the {c.name}'s {'PASS' if c.passed else 'FAIL'} is not sure")
+    return said
+
+
+def predicted_verdict(result, spec: Specification) -> Verdict:
+    """The verdict on a run's predicted pulse (the test item's acceleration, at rest before
+    the impact), judged as a recording is (:func:`judge_record`)."""
+    from .shock import check_cfc
+
+    spec = spec.resolved()
+    ok = np.isfinite(result.accel_kg)
+    t, kg = result.history.time[ok], result.accel_kg[ok]
+    warnings: list[str] = []
+    if spec.cfc:
+        try:
+            warnings += check_cfc(spec.cfc, float(t[1] - t[0]))
+        except OptionError as exc:
+            raise OptionError(f"the specification's record (CFC {spec.cfc}): {exc}") from None
+    verdict = judge_record(t, kg, spec, "the predicted pulse", noise=0.0, warnings=warnings)
+    verdict.definitions.insert(0, "judged: the predicted pulse (the test item's acceleration)")
+    return verdict
+
+
 def pass_flags(values: dict[str, np.ndarray], spec: Specification) -> dict[str, np.ndarray]:
     """Each criterion's PASS per row of :func:`judge_rows`' values (the SRS is not among
     them: it is judged on single pulses)."""
@@ -361,11 +746,40 @@ def pass_flags(values: dict[str, np.ndarray], spec: Specification) -> dict[str, 
                       ("velocity change", spec.velocity_change)):
         if tol is not None:
             lo, hi = tol.limits
-            v = values[name]
-            flags[name] = (v >= lo) & (v <= hi)
+            flags[name] = within(values[name], lo, hi)
     if "corridor" in values:
         flags["corridor"] = values["corridor"] >= 0
     return flags
+
+
+#: The columns of :class:`BlockJudge`'s values.
+BLOCK_VALUES = ("peak", "duration", "velocity change", "corridor")
+
+
+@dataclass(frozen=True)
+class BlockJudge:
+    """``run_batch``'s ``extra``: each shot's :data:`BLOCK_VALUES`, judged as
+    :func:`predicted_verdict` judges one shot (picklable, for Dask workers)."""
+
+    spec: Specification
+    width: int = len(BLOCK_VALUES)
+
+    def __call__(self, t: np.ndarray, kg: np.ndarray) -> np.ndarray:
+        spec = self.spec.resolved()
+        t, kg, _ = judged_record(t, kg, spec)
+        values = judge_rows(t, kg, spec)
+        return np.column_stack([values.get(name, np.full(len(kg), np.nan))
+                                for name in BLOCK_VALUES])
+
+
+def flags_of(values: np.ndarray, spec: Specification) -> dict[str, np.ndarray]:
+    """:func:`pass_flags` of a :class:`BlockJudge`'s columns; a diverged shot (NaN) fails
+    every criterion."""
+    spec = spec.resolved()
+    named = {name: values[:, k] for k, name in enumerate(BLOCK_VALUES)}
+    if spec.corridor is None or spec.shape in (None, "none"):
+        named.pop("corridor")
+    return pass_flags(named, spec)
 
 
 def wilson_interval(passes: int, n: int, z: float = 1.959963984540054) -> tuple[float, float]:
@@ -427,69 +841,3 @@ def equivalent_half_sine(t: np.ndarray, kg: np.ndarray, frequencies: np.ndarray,
             return peak, float(found.x), governing
     peak, governing = least_peak(float(durations[k]))
     return peak, float(durations[k]), governing
-
-
-def predicted_verdict(result, spec: Specification) -> Verdict:
-    """The verdict on a run's predicted pulse (the test item's acceleration, at rest before
-    the impact, through the specification's CFC filter when it names one)."""
-    from ..errors import OptionError
-    from .shock import check_cfc
-
-    ok = np.isfinite(result.accel_kg)
-    t, kg = result.history.time[ok], result.accel_kg[ok]
-    warnings: list[str] = []
-    if spec.cfc:
-        try:
-            warnings += check_cfc(spec.cfc, float(t[1] - t[0]))
-        except OptionError as exc:
-            raise OptionError(f"the specification's record (CFC {spec.cfc}): {exc}") from None
-    t, kg = judged_record(t, kg, spec.cfc)
-    verdict = judge(t, kg, spec, warnings)
-    verdict.definitions.insert(0, "judged: the predicted pulse (the test item's acceleration)")
-    return verdict
-
-
-def judged_record(t: np.ndarray, kg: np.ndarray, cfc: int | None):
-    """A predicted pulse (or a block of them, a row each) as the specification judges it:
-    through CFC ``cfc`` from rest (:data:`~airgun_xl.studies.measured.REST_BEFORE` of it
-    before the impact, for the phaseless filter's lead), or unchanged."""
-    from .measured import REST_BEFORE
-    from .shock import cfc_filter
-
-    kg = np.asarray(kg, dtype=float)
-    if not cfc:  # unfiltered: the record as it is (a run starts at rest)
-        return t, kg
-    dt = float(t[1] - t[0])
-    n = int(round(REST_BEFORE / dt))
-    t = np.concatenate([t[0] - dt * np.arange(n, 0, -1), t])
-    rest = np.zeros(kg.shape[:-1] + (n,))
-    kg = np.concatenate([rest, kg], axis=-1)
-    return t, (cfc_filter(kg, dt, cfc) if cfc else kg)
-
-
-#: The columns of :class:`BlockJudge`'s values.
-BLOCK_VALUES = ("peak", "duration", "velocity change", "corridor")
-
-
-@dataclass(frozen=True)
-class BlockJudge:
-    """``run_batch``'s ``extra``: each shot's :data:`BLOCK_VALUES`, judged as
-    :func:`predicted_verdict` judges one shot (picklable, for Dask workers)."""
-
-    spec: Specification
-    width: int = len(BLOCK_VALUES)
-
-    def __call__(self, t: np.ndarray, kg: np.ndarray) -> np.ndarray:
-        t, kg = judged_record(t, kg, self.spec.cfc)
-        values = judge_rows(t, kg, self.spec)
-        return np.column_stack([values.get(name, np.full(len(kg), np.nan))
-                                for name in BLOCK_VALUES])
-
-
-def flags_of(values: np.ndarray, spec: Specification) -> dict[str, np.ndarray]:
-    """:func:`pass_flags` of a :class:`BlockJudge`'s columns; a diverged shot (NaN) fails
-    every criterion."""
-    named = {name: values[:, k] for k, name in enumerate(BLOCK_VALUES)}
-    if spec.corridor is None or spec.shape in (None, "none"):
-        named.pop("corridor")
-    return pass_flags(named, spec)

@@ -99,38 +99,107 @@ ANTI_ALIAS_ORDER = 4
 ANTI_ALIAS_FRACTION = 0.2
 
 
+#: A stretch of record is at rest when a straight line through it rises by no more than this
+#: fraction of the pulse's excursion, or than :data:`REST_SIGMAS` standard errors of such a
+#: line through its own noise (a pulse's rise or tail is not a baseline).
+REST_DRIFT, REST_SIGMAS = 0.02, 4.0
+
+#: After the pulse, a stretch is at rest only if its spread is noise, not the item ringing:
+#: within this factor of its sample-to-sample noise (from its second differences, which a
+#: ringing many samples long hardly has).
+REST_WHITE = 2.0
+
+
 @dataclass
 class Baseline:
-    """The recording's zero and noise, from its pre-trigger record.
+    """The recording's zero and noise, from where it is at rest: before the pulse, or (with
+    no quiet pre-trigger) after it.
 
     Attributes
     ----------
     offset : float
-        Median of the pre-trigger samples [kG], removed from the recording.
+        Median of the samples at rest [kG], removed from the recording (0 without any).
     noise : float
-        Their standard deviation about it [kG] (NaN without a pre-trigger record).
+        Their standard deviation about it [kG] (NaN without a record at rest).
     samples : int
-        Pre-trigger samples used.
+        Samples at rest used.
+    where : str
+        "before" or "after" the pulse, or "none".
+    start : int
+        Index of the first of them.
     """
 
     offset: float
     noise: float
     samples: int
+    where: str = "before"
+    start: int = 0
+
+    def words(self) -> str:
+        """The baseline as a verdict or a comparison prints it."""
+        if self.where == "none":
+            return ("no record at rest before or after the pulse: offset taken as 0, noise "
+                    "unknown")
+        return (f"{self.offset:.4g} kG removed, noise {self.noise:.3g} kG (1 sigma): "
+                f"{self.samples:,} samples at rest {self.where} the pulse")
+
+
+def _at_rest(segment, excursion, white=False):
+    """How many samples of ``segment`` from its start (``segment`` reversed: from its end)
+    are at rest: the stretch is cut by a fifth until a line through it stays flat
+    (:data:`REST_DRIFT`, :data:`REST_SIGMAS`) and, with ``white``, its spread is its
+    sample-to-sample noise (:data:`REST_WHITE`)."""
+    n = len(segment)
+    while n >= MIN_PRE_SAMPLES:
+        part = segment[:n]
+        x = np.arange(n, dtype=float)
+        slope, intercept = np.polyfit(x, part, 1)
+        resid = float(np.std(part - (slope * x + intercept)))
+        rise = abs(slope) * (n - 1)
+        flat = rise <= max(REST_DRIFT * excursion, REST_SIGMAS * resid * math.sqrt(12.0 / n))
+        if flat and (not white or resid <= REST_WHITE * _sample_noise(part)):
+            return n
+        n = int(n * 0.8)
+    return 0
+
+
+def _sample_noise(part):
+    """The sample-to-sample noise of a stretch (1 sigma): its second differences' median
+    absolute deviation, scaled for white noise (their variance is 6 sigma^2)."""
+    d2 = np.diff(part, 2)
+    return 1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / math.sqrt(6.0)
 
 
 def baseline(accel, dt):
-    """The :class:`Baseline` of a recording (``accel`` [kG] at step ``dt`` [s]); a record
-    without :data:`MIN_PRE_SAMPLES` before its pulse gets offset 0 and noise NaN."""
+    """The :class:`Baseline` of a recording (``accel`` [kG] at step ``dt`` [s]): the samples
+    at rest before its pulse, else those after it; with neither, offset 0 and noise NaN."""
     accel = np.asarray(accel, dtype=float)
-    opening = np.median(accel[:max(MIN_PRE_SAMPLES, len(accel) // 10)])
+    # the level at rest: the median of the quieter end (a record may start in its pulse)
+    m = max(MIN_PRE_SAMPLES, len(accel) // 10)
+    ends = [accel[:m], accel[-m:]]
+    opening = float(np.median(min(ends, key=lambda e: float(np.std(e)))))
     excursion = accel - opening
-    edge = int(np.argmax(excursion >= PULSE_EDGE * excursion.max()))
-    end = edge - int(round(PRE_GUARD / dt))
-    if end < MIN_PRE_SAMPLES:
-        return Baseline(0.0, np.nan, max(end, 0))
-    pre = accel[:end]
-    offset = float(np.median(pre))
-    return Baseline(offset, float(np.std(pre - offset)), end)
+    top = float(np.max(np.abs(excursion))) if len(accel) else 0.0
+    above = np.flatnonzero(np.abs(excursion) >= PULSE_EDGE * top) if top > 0 else \
+        np.array([], dtype=int)
+    if len(above) == 0:
+        return Baseline(0.0, np.nan, 0, "none")
+    guard = int(round(PRE_GUARD / dt))
+    end = int(above[0]) - guard
+    quiet = _at_rest(accel[:max(end, 0)], top)
+    if quiet >= MIN_PRE_SAMPLES:
+        pre = accel[:quiet]
+        offset = float(np.median(pre))
+        return Baseline(offset, float(np.std(pre - offset)), quiet, "before", 0)
+    start = int(above[-1]) + 1 + guard
+    tail = accel[start:]
+    quiet = _at_rest(tail[::-1], top, white=True)
+    if quiet >= MIN_PRE_SAMPLES:
+        post = accel[len(accel) - quiet:]
+        offset = float(np.median(post))
+        return Baseline(offset, float(np.std(post - offset)), quiet, "after",
+                        len(accel) - quiet)
+    return Baseline(0.0, np.nan, max(end, 0), "none")
 
 
 def anti_aliased(time, values, hz):
@@ -224,10 +293,14 @@ def prepare(trace, cfc=None, anti_alias=None, dt_model=None):
 
     warnings = check_cfc(cfc, trace.dt) if cfc else []
     base = baseline(trace.accel_kg, trace.dt)
-    if base.samples < MIN_PRE_SAMPLES:
-        warnings.append(f"{trace.name}: {base.samples} samples before the pulse, fewer than "
-                        f"{MIN_PRE_SAMPLES}: no baseline (offset taken as 0) and no noise "
-                        "level; the impact is found at the plain threshold")
+    if base.where == "none":
+        warnings.append(f"{trace.name}: no {MIN_PRE_SAMPLES} samples at rest before or after "
+                        "the pulse: no baseline (offset taken as 0) and the noise unknown; "
+                        "the impact is found at the plain threshold")
+    elif base.where == "after":
+        warnings.append(f"{trace.name}: no record at rest before the pulse (it starts in the "
+                        f"pulse's rise): the baseline and the noise are taken from "
+                        f"{base.samples:,} samples at rest after it")
     corrected = np.asarray(trace.accel_kg, dtype=float) - base.offset
     filtered = cfc_filter(corrected, trace.dt, cfc) if cfc else corrected
     if not np.isfinite(filtered).all() or np.max(np.abs(filtered)) == 0:
@@ -238,8 +311,8 @@ def prepare(trace, cfc=None, anti_alias=None, dt_model=None):
                           f"{np.min(filtered):.4g} to {np.max(filtered):.4g} kG after its "
                           f"{base.offset:.4g} kG offset), expected the macro's sign, a "
                           "deceleration positive (try --sign -1)")
-    noise = (float(np.std(filtered[:base.samples])) if base.samples >= MIN_PRE_SAMPLES
-             else 0.0)
+    noise = (float(np.std(filtered[base.start:base.start + base.samples]))
+             if base.where != "none" else 0.0)
     fraction = max(IMPACT_FRACTION, NOISE_SIGMAS * noise / float(np.max(filtered)))
     if fraction > 0.5:
         raise OptionError(f"{trace.name}: the pre-trigger noise ({noise:.4g} kG, 1 sigma) is "

@@ -126,7 +126,7 @@ def write_calibration(path, shot, cal, files, options, force=False):
             row = write_warnings(wb, ws, row - 1, cal.notes, 5, line_chars=95,
                                  heading="Notes") + 2
         for i, rec in enumerate(cal.recordings, start=1):
-            ws.write_string(row, 0, f"Shot {i}: baseline removed, pre-trigger noise")
+            ws.write_string(row, 0, f"Shot {i}: baseline removed, noise at rest")
             ws.write_number(row, 1, rec.base.offset, num)
             if not math.isnan(rec.base.noise):
                 ws.write_number(row, 2, rec.base.noise, num)

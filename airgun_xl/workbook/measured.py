@@ -99,10 +99,11 @@ def _write_scores(wb, ws, c, head, bold, models):
     for method, value in sorted(c.shifts.items()):
         rows.append((f"Shift by {method}", value * 1e3, "ms", ms))
     if c.baseline is not None:
-        rows += [("Baseline offset removed (pre-trigger median)", c.baseline.offset, "kG", kg),
-                 ("Pre-trigger noise (1 sigma)", c.baseline.noise, "kG", kg),
-                 ("Pre-trigger noise after the filter", c.noise_filtered, "kG", kg),
-                 ("Pre-trigger samples", float(c.baseline.samples), "",
+        at_rest = f"at rest {c.baseline.where} the pulse"
+        rows += [(f"Baseline offset removed (median {at_rest})", c.baseline.offset, "kG", kg),
+                 (f"Noise {at_rest} (1 sigma)", c.baseline.noise, "kG", kg),
+                 ("Noise at rest after the filter", c.noise_filtered, "kG", kg),
+                 (f"Samples {at_rest}", float(c.baseline.samples), "",
                   wb.add_format({"num_format": "#,##0"})),
                  ("Impact level (fraction of the peak)", c.level, "", pct)]
     rows.append(("Anti-alias model on the prediction", c.anti_alias or 0.0,

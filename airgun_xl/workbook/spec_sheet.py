@@ -31,19 +31,26 @@ ROWS = (
      "± % of the nominal, or -10%,+20%"),
     ("corridor", "Corridor", "± % of the nominal peak round the ideal pulse"),
     ("time_slack", "Time slack", "± % of the duration the corridor may slide"),
-    ("window", "Window", "monitored before and after the pulse (blank: half the duration)"),
+    ("window", "Window (both)", "both windows below, the same each side (kept one release)"),
     ("record", "Record judged", "unfiltered, or CFC 60, 180, 600 or 1000"),
     ("placement", "Placement", "least-squares (default) or peak: where the ideal pulse sits"),
     ("srs_q", "SRS Q", "quality factor of the SRS requirement (blank: 10)"),
     ("srs_lower_db", "SRS lower tolerance", "dB below the requirement allowed (blank: -3)"),
     ("srs_upper_db", "SRS upper tolerance", "dB above the requirement allowed (blank: +6)"),
     ("srs_outside", "SRS outside", "% of the frequencies allowed outside (blank: 0)"),
+    ("dv_window", "Velocity change window", "before,after the pulse: 0.4D,0.1D or 1ms,0.5ms "
+                                            "(blank: 0.5D,0.5D)"),
+    ("monitor", "Monitoring window", "before,after the pulse, where the corridor is judged "
+                                     "(blank: 0.5D,0.5D)"),
+    ("duration_def", "Duration definition", "base (each shape's D; blank) or width@10%"),
+    ("decay", "Sawtooth decay allowance", "% of the duration (blank: 10)"),
 )
 FIRST_ROW = 2
 
 #: The unit column's words where they say more than the unit of the number (a bare number in
 #: the value column is in the key's unit, :data:`airgun_xl.specification.KEYS`).
-UNITS_SHOWN = {"corridor": "% of peak", "time_slack": "% of duration"}
+UNITS_SHOWN = {"corridor": "% of peak", "time_slack": "% of duration", "window": "ms",
+               "decay": "% of duration"}
 SRS_COLUMNS = (6, 7)  # F, G
 
 
@@ -77,7 +84,7 @@ def spec_from_cells(cells: dict, percent_cells=frozenset()) -> Specification | N
         if isinstance(value, Found):
             raise CellError(_where("B", row), labels[name], str(value), "a value (a formula "
                             "the tool can evaluate)")
-        if (row, 2) in percent_cells and KEYS[name].unit == "%" and isinstance(
+        if (row, 2) in percent_cells and name in KEYS and KEYS[name].unit == "%" and isinstance(
                 value, (int, float)) and not isinstance(value, bool) and math.isfinite(value):
             value = float(Decimal(repr(float(value))) * 100)  # 0.1 shown as 10% is 10
         if value is not None:
@@ -154,7 +161,7 @@ def write_spec_sheet(wb, shot=None):
     for k, (name, label, meaning) in enumerate(ROWS):
         row = FIRST_ROW - 1 + k
         ws.write_string(row, 0, label)
-        ws.write_string(row, 2, UNITS_SHOWN.get(name, KEYS[name].unit))
+        ws.write_string(row, 2, UNITS_SHOWN[name] if name in UNITS_SHOWN else KEYS[name].unit)
         ws.write_string(row, 3, meaning, wrap)
     note_row = FIRST_ROW + len(ROWS)
     ws.write_string(note_row, 0, "fill, design and accept read this sheet over a --profile; "

@@ -25,6 +25,7 @@ OPTIONS = ("peak", "duration", "velocity_change", "corridor", "time_slack", "win
 def namespace(values):
     ns = argparse.Namespace(profile=None, shape=None, peak=None, duration=None,
                             velocity_change=None, corridor=None, time_slack=None, window=None,
+                            dv_window=None, monitor=None, duration_def=None, decay=None,
                             placement=None, record=None, srs=None, srs_tol=None, srs_q=None,
                             srs_outside=None, accel_unit=None)
     for name, value in values.items():

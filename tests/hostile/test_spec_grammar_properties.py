@@ -24,9 +24,11 @@ from airgun_xl.specification import (
     CAPS,
     CFC_CLASSES,
     DEFAULTS,
+    DURATION_DEFS,
     KEYS,
     OPTIONS,
     PLACEMENTS,
+    SHAPE_DEFAULTS,
     SHAPES,
     Specification,
     SrsRequirement,
@@ -59,7 +61,14 @@ VALUES = {
     "velocity_change_tolerance": st.tuples(fraction(), fraction()),
     "corridor": fraction(low_open=True),
     "time_slack": fraction(),
-    "window": st.floats(0.0, CAPS["window"]),
+    "dv_window": st.tuples(*[st.one_of(st.tuples(st.floats(0.0, CAPS["window"]), st.just("s")),
+                                        st.tuples(st.floats(0.0, CAPS["window_d"]),
+                                                  st.just("D")))] * 2),
+    "monitor": st.tuples(*[st.one_of(st.tuples(st.floats(0.0, CAPS["window"]), st.just("s")),
+                                      st.tuples(st.floats(0.0, CAPS["window_d"]),
+                                                st.just("D")))] * 2),
+    "duration_def": st.sampled_from(DURATION_DEFS),
+    "decay": fraction(),
     "record": st.sampled_from((0, *CFC_CLASSES)),
     "placement": st.sampled_from(PLACEMENTS),
     "srs_q": st.floats(0.5, CAPS["srs_q"], exclude_min=True),
@@ -123,9 +132,14 @@ def test_precedence_option_over_sheet_over_profile_over_default(data):
             elif key == "srs":
                 expected, origin = None, None
             else:
-                expected = BASE.get(key, DEFAULTS.get(key))
+                default = DEFAULTS.get(key)
+                if key == "corridor":  # a named shape is judged in the tool's band
+                    default = SHAPE_DEFAULTS[key] if spec.shape != "none" else None
+                if key == "decay":  # a sawtooth's decay allowance
+                    default = SHAPE_DEFAULTS[key] if spec.shape == "sawtooth" else None
+                expected = BASE.get(key, default)
                 origin = "profile lab" if key in BASE else (
-                    "default" if key in DEFAULTS else None)
+                    "default" if default is not None else None)
             got = spec.srs if key == "srs" else value_of(spec, key)
             assert got == expected, (key, givers)
             assert spec.origin(key) == origin, (key, givers)
@@ -147,8 +161,8 @@ def test_round_trip_every_key_prints_in_its_own_syntax_and_parses_back(data):
 
 def namespace(**given):
     names = ("profile", "shape", "peak", "duration", "velocity_change", "corridor",
-             "time_slack", "window", "placement", "record", "srs", "srs_tol", "srs_q",
-             "srs_outside", "accel_unit")
+             "time_slack", "window", "dv_window", "monitor", "duration_def", "decay",
+             "placement", "record", "srs", "srs_tol", "srs_q", "srs_outside", "accel_unit")
     return argparse.Namespace(**{n: given.get(n) for n in names})
 
 
