@@ -168,6 +168,9 @@ class Specification:
         Each key's option, cell or profile key, as a refusal names it.
     set_aside : tuple of str
         What a source gave that a later one made moot, in words (a verdict prints it).
+    units : tuple of (str, str)
+        The unit the peak's and the duration's nominal were given in: a verdict reports them
+        in it (:func:`shown_unit`).
     """
 
     shape: str | None = None
@@ -192,6 +195,7 @@ class Specification:
     origins: tuple[tuple[str, str], ...] = field(default=(), metadata=META)
     places: tuple[tuple[str, str], ...] = field(default=(), metadata=META)
     set_aside: tuple[str, ...] = field(default=(), metadata=META)
+    units: tuple[tuple[str, str], ...] = field(default=(), metadata=META)
 
     @property
     def empty(self) -> bool:
@@ -212,7 +216,8 @@ class Specification:
         return replace(self, **changes, source=sources, notes=self.notes + other.notes,
                        origins=tuple({**dict(self.origins), **dict(other.origins)}.items()),
                        places=tuple({**dict(self.places), **dict(other.places)}.items()),
-                       set_aside=self.set_aside + other.set_aside)
+                       set_aside=self.set_aside + other.set_aside,
+                       units=tuple({**dict(self.units), **dict(other.units)}.items()))
 
     def resolved(self) -> Specification:
         """This specification with :data:`DEFAULTS` in the fields no source gave (the SRS's
@@ -593,6 +598,29 @@ OPTIONS = {"shape": "--shape", "peak": "--peak", "peak_tolerance": "--peak",
            "srs_upper_db": "--srs-tol", "srs_outside": "--srs-outside"}
 
 
+#: The units a verdict reports the peak and the duration in, as their nominal was given:
+#: unit typed -> (unit shown, factor from the inside unit, kG or s).
+SHOWN_UNITS = {
+    "peak": {"kG": ("kG", 1.0), "g": ("g", KG_MS2 / G), "m/s^2": ("m/s^2", KG_MS2),
+             "m/s2": ("m/s^2", KG_MS2), "m/s²": ("m/s^2", KG_MS2)},
+    "duration": {"s": ("s", 1.0), "ms": ("ms", 1e3), "us": ("us", 1e6), "µs": ("us", 1e6),
+                 "ns": ("ns", 1e9)},
+}
+
+
+def typed_unit(text: str) -> str:
+    """The unit a quantity's text ends in (``500g`` -> ``g``)."""
+    match = _SIGNED.match(text.partition(":")[0])
+    return match.group("unit") if match else ""
+
+
+def shown_unit(spec: Specification, key: str) -> tuple[str, float]:
+    """(unit, factor from kG or s) a verdict reports ``key`` (peak, duration) in: the unit its
+    nominal was given in, else kG and ms."""
+    table = SHOWN_UNITS[key]
+    return table.get(dict(spec.units).get(key, ""), table["kG" if key == "peak" else "ms"])
+
+
 #: Keys kept one release for the old layout: each gives the keys it stands for, unless the
 #: same source gives those itself (``window``: both windows, in time, before and after).
 ALIASES = {"window": ("dv_window", "monitor")}
@@ -690,7 +718,9 @@ def from_keys(values: dict[str, Any], where: str, key_where: Callable[[str], str
                     parsed[target], places[target] = window, key_where(key)
         else:
             parsed[key], places[key] = parse_key(key, value, key_where(key)), key_where(key)
-    return spec_of_keys(parsed, where, srs, places)
+    units = {key: typed_unit(value) for key, value in given.items()
+             if key in SHOWN_UNITS and isinstance(value, str)}
+    return spec_of_keys(parsed, where, srs, places, units)
 
 
 def _alias_number(value: object, where: str) -> str:
@@ -702,7 +732,8 @@ def _alias_number(value: object, where: str) -> str:
 
 
 def spec_of_keys(parsed: dict[str, Any], source: str, srs: SrsRequirement | None = None,
-                 places: dict[str, str] | None = None) -> Specification:
+                 places: dict[str, str] | None = None, units: dict[str, str] | None = None
+                 ) -> Specification:
     """A specification from parsed key values (:func:`parse_key`'s or an option's), from
     ``source``; ``places`` names each key's option, cell or profile key."""
     kwargs: dict[str, Any] = {}
@@ -717,7 +748,8 @@ def spec_of_keys(parsed: dict[str, Any], source: str, srs: SrsRequirement | None
     given = list(parsed) + (["srs"] if srs is not None else [])
     return Specification(**kwargs, srs=srs, source=source,
                          origins=tuple((key, source) for key in given),
-                         places=tuple((key, (places or {}).get(key, source)) for key in given))
+                         places=tuple((key, (places or {}).get(key, source)) for key in given),
+                         units=tuple((units or {}).items()))
 
 
 #: A profile file is read only up to this size: it is a few hundred bytes of JSON.
@@ -835,10 +867,25 @@ def combine(profile: str | Specification | None, sheet: Specification | None,
     for part in parts:
         spec = spec.merged(part)
     spec = _shape_none_over_a_corridor(spec, [part.source for part in parts])
+    spec = _derived_velocity_change(spec)
     spec = check(spec, "the specification")
     if spec.empty:
         return None
     return spec.resolved()
+
+
+def _derived_velocity_change(spec: Specification) -> Specification:
+    """A half-sine's nominal velocity change where a source gives its tolerance only: it
+    follows from the peak and the duration, 2 A T / pi [m/s] (A in kG x 9800 m/s^2)."""
+    dv, peak, duration = spec.velocity_change, spec.peak, spec.duration
+    if dv is None or math.isfinite(dv.nominal) or spec.shape != "half-sine" or peak is None \
+            or duration is None or not math.isfinite(peak.nominal * duration.nominal) or \
+            spec.duration_def not in (None, "base"):
+        return spec
+    nominal = 2 * peak.nominal * KG_MS2 * duration.nominal / math.pi
+    origins = {**dict(spec.origins), "velocity_change": "derived: 2AT/pi of the half-sine"}
+    return replace(spec, velocity_change=Tolerance(nominal, dv.minus, dv.plus),
+                   origins=tuple(origins.items()))
 
 
 def _shape_none_over_a_corridor(spec: Specification, order: list[str]) -> Specification:

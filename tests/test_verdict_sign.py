@@ -56,9 +56,8 @@ def accept(tmp_path, capsys, t, kg, *flags):
     return code, captured.out, captured.err
 
 
-def spec(**given):
-    """A specification from option texts, as the command line gives it, merged and
-    resolved."""
+def options(**given):
+    """The specification option texts give, as the command line reads them (not merged)."""
     import argparse
 
     from airgun_xl.cli.spec_options import options_spec
@@ -66,8 +65,12 @@ def spec(**given):
     names = ("profile", "shape", "peak", "duration", "velocity_change", "corridor",
              "time_slack", "window", "dv_window", "monitor", "duration_def", "decay",
              "placement", "record", "srs", "srs_tol", "srs_q", "srs_outside", "accel_unit")
-    return combine(None, None, options_spec(argparse.Namespace(
-        **{n: given.get(n) for n in names})))
+    return options_spec(argparse.Namespace(**{n: given.get(n) for n in names}))
+
+
+def spec(**given):
+    """A specification from option texts, merged and resolved as a command's."""
+    return combine(None, None, options(**given))
 
 
 NOMINAL = dict(peak=f"{A_G}g:20%", duration="11ms:10%")
@@ -164,8 +167,8 @@ def test_31_3_the_other_side_nominal_noisy_half_sines_pass_with_their_peak_withi
         t, kg = pulse(rate=rate, noise=0.03, seed=seed)
         v = judged(t, kg, noise=0.03 * A, shape="half-sine")
         assert v.passed, (seed, [(x.name, x.value, x.margin) for x in v.criteria])
-        peak = by_name(v)["peak"].value
-        assert abs(peak / A - 1) < 0.02, (seed, peak / A)
+        peak = by_name(v)["peak"].value  # in g, as the specification gave it
+        assert abs(peak / A_G - 1) < 0.02, (seed, peak / A_G)
         assert "Bessel low-pass" in v.definitions[0]
 
 
@@ -190,10 +193,10 @@ def test_31_3_a_single_sample_glitch_does_not_lift_the_peak_and_is_warned():
     k = int(np.argmax(kg))
     kg[k + 3] += 0.5 * A
     v = judged(t, kg, noise=0.01 * A)
-    assert abs(by_name(v)["peak"].value / A - 1) < 0.02
+    assert abs(by_name(v)["peak"].value / A_G - 1) < 0.02
     assert any("single-sample glitch" in w and "taken out" in w for w in v.warnings)
     named = judged(t, kg, noise=0.01 * A, record="unfiltered")  # named: kept, and warned
-    assert by_name(named)["peak"].value > 1.4 * A
+    assert by_name(named)["peak"].value > 1.4 * A_G
     assert any("kept in the record judged" in w for w in named.warnings)
 
 
@@ -331,3 +334,53 @@ def test_31_9_a_baseline_is_taken_after_the_pulse_when_none_is_before():
     base = baseline(kg[start:] + 0.2, 1 / 51_200.0)
     assert base.where == "after" and base.offset == pytest.approx(0.2, abs=0.005)
     assert base.noise == pytest.approx(0.01 * A, rel=0.15)
+
+
+# -- 7. the profile's caveat, and 8. the smaller points -------------------------------------------
+
+def test_31_7_the_example_profiles_caveat_is_on_the_terminal_and_the_verdict_page(tmp_path,
+                                                                                  capsys):
+    import openpyxl
+
+    t, kg = pulse(rate=1e6 / 8)
+    dv = f"{2 * A * KG_MS2 * D / math.pi!r}m/s"
+    code, out, _ = accept(tmp_path, capsys, t, kg, "--profile", "mil-std-810h-half-sine",
+                          "--peak", f"{A_G}g", "--duration", "11ms", "--velocity-change", dv)
+    assert code == 0 and "note: EXAMPLE, QUOTED NOT CHECKED" in out
+    ws = openpyxl.load_workbook(tmp_path / "verdict.xlsx")["Verdict"]
+    cell = next(c for row in ws.iter_rows() for c in row
+                if isinstance(c.value, str) and c.value.startswith("EXAMPLE, QUOTED NOT"))
+    assert cell.value.endswith("before judging a test by them.")  # whole, not cut
+    assert cell.alignment.wrap_text and f"A{cell.row}:H{cell.row}" in {
+        str(r) for r in ws.merged_cells.ranges}  # wrapped across the printed columns
+    assert ws.row_dimensions[cell.row].height >= 30  # two lines or more, not one cut
+
+
+def test_31_8_a_test_given_in_g_is_reported_in_g_and_the_corridor_by_its_band(tmp_path,
+                                                                             capsys):
+    t, kg = pulse(scale=500 / A_G)
+    code, out, _ = accept(tmp_path, capsys, t, kg, "--shape", "half-sine", "--peak",
+                          "500g:10%", "--duration", "11000us:10%")
+    assert code == 0
+    assert "PASS  peak: 500 g (limits 450 to 550 g;" in out
+    assert "PASS  duration: 11000 us (limits 9900 to 12100 us;" in out
+    assert "corridor: " in out and "0 to +inf" not in out
+    assert "(limits the record inside the band (margin 0 % or more);" in out
+
+
+def test_31_8_a_half_sines_velocity_change_follows_from_its_peak_and_duration(tmp_path):
+    """The profile gives the velocity change's tolerance only: a half-sine's nominal is
+    2 A T / pi, derived and said, not refused."""
+    s = combine("mil-std-810h-half-sine", None, options(peak=f"{A_G}g", duration="11ms"))
+    assert s.velocity_change.nominal == pytest.approx(2 * A * KG_MS2 * D / math.pi, rel=1e-12)
+    assert s.origin("velocity_change") == "derived: 2AT/pi of the half-sine"
+    t, kg = pulse()
+    v = judge_record(t, kg, s, "the pulse", noise=0.0)
+    assert v.passed and "velocity change" in by_name(v)
+
+
+def test_31_8_accepts_help_speaks_of_one_recording(capsys):
+    with pytest.raises(SystemExit):
+        main(["accept", "--help"])
+    text = capsys.readouterr().out
+    assert "both pulses" not in text and "prediction" not in text

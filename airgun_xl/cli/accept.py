@@ -23,7 +23,10 @@ def add_parser(sub):
     p.add_argument("recording", metavar="RECORDING", help="the recorded pulse: " + RECORDING_HELP)
     add_output(p, "verdict workbook", "SHOT.accept.xlsx")
     add_force(p)
-    add_recording_options(p, anti_alias=False)
+    add_recording_options(p, anti_alias=False, cfc_help=(
+        "the record judged: SAE J211 class 60, 180, 600 or 1000, as --record cfcN (refused "
+        "where the filter is unstable, below 4.155 x the class in samples a second; a warning"
+        " below J211's 10 x)"))
     add_spec_options(p)
     p.add_argument("--archive", metavar="DIR",
                    help="record the verdict in the archive (the verdict file of the shot's "
@@ -116,14 +119,17 @@ def print_verdict(verdict, what):
     n = len(verdict.warnings)
     print(f"{verdict.word}: {what}"
           + (f" (with {n} warning{'s' * (n != 1)}: read them before relying on it)" if n else ""))
+    from ..studies.acceptance import limits_text
+
     for c in verdict.criteria:
-        limits = (f"{'-inf' if c.low is None else f'{c.low:.5g}'} to "
-                  f"{'+inf' if c.high is None else f'{c.high:.5g}'} {c.unit}")
+        limits = limits_text(c)
         margin = f"{c.margin:+.2f} {c.margin_unit}"
         print(f"  {'PASS' if c.passed else 'FAIL'}  {c.name}: {c.value:.5g} {c.unit} "
               f"(limits {limits}; margin {margin})" + (f"; {c.detail}" if c.detail else ""))
     for line in verdict.definitions:
         print(f"  {line}")
+    for line in verdict.spec.notes:  # a profile's caveats, with every verdict judged by it
+        print(f"  note: {line}")
 
 
 def report_data(time, kg, spec, verdict):

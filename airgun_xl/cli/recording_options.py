@@ -21,14 +21,15 @@ RECORDING_HELP = ("a CSV (time, acceleration, units in the header), a workbook's
 
 
 def add_recording_options(p, channel_help="TDMS only: the channel (default: the first "
-                                          "waveform channel)", anti_alias=True):
+                                          "waveform channel)", anti_alias=True,
+                          cfc_help=None):
     """The recording's options; ``anti_alias`` False for a command with no prediction to put
     through the recorder's filter (accept: the option would be accepted and ignored)."""
     p.add_argument("--channel", metavar="GROUP/CHANNEL", help=channel_help)
     p.add_argument("--cfc", type=int, default=None,
-                   help="filter both pulses: SAE J211 class 60, 180, 600 or 1000 (refused "
-                        "where the filter is unstable, below 4.155 x the class in samples a "
-                        "second; a warning below J211's 10 x)")
+                   help=cfc_help or "filter both pulses: SAE J211 class 60, 180, 600 or 1000 "
+                        "(refused where the filter is unstable, below 4.155 x the class in "
+                        "samples a second; a warning below J211's 10 x)")
     p.add_argument("--sign", type=float, default=1.0, choices=(1.0, -1.0),
                    help="-1 when the recorder's axis is opposite to the macro's")
     p.add_argument("--time-unit", help="s, ms or us (default: from the header)")

@@ -77,10 +77,12 @@ def options_spec(args):
         ALIASES,
         KEYS,
         OPTIONS,
+        SHOWN_UNITS,
         SrsRequirement,
         parse_db_pair,
         parse_window,
         spec_of_keys,
+        typed_unit,
     )
     from ..workbook.trace import read_spectrum
 
@@ -105,11 +107,13 @@ def options_spec(args):
         srs = SrsRequirement(tuple(map(float, freqs)), tuple(map(float, levels)))
     if not parsed and srs is None:
         return None
+    units = {key: typed_unit(getattr(args, key)) for key, _ in QUANTITY_OPTIONS
+             if key in SHOWN_UNITS and getattr(args, key, None) is not None}
     places = {key: option for key, option in OPTIONS.items() if key in parsed}
     if getattr(args, "window", None) is not None:
         places.update({k: "--window" for k in ALIASES["window"] if k not in places or
                        getattr(args, k, None) is None})
-    return spec_of_keys(parsed, "options", srs, {**places, "srs": "--srs"})
+    return spec_of_keys(parsed, "options", srs, {**places, "srs": "--srs"}, units)
 
 
 def _quantity_option(key, option, text):

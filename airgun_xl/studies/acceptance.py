@@ -50,7 +50,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import OptionError
-from ..specification import Specification
+from ..specification import Specification, shown_unit
 from ..units import KG_MS2
 
 #: Crossing level of the duration, a fraction of the peak (and the sawtooth rise's top).
@@ -442,6 +442,11 @@ def srs_criterion(t: np.ndarray, kg: np.ndarray, spec: Specification) -> tuple[C
                      detail + f"; Q {q:g}"), margins
 
 
+def _shown_peak(spec: Specification) -> str:
+    unit, factor = shown_unit(spec, "peak")
+    return f"{_nominals(spec)[0] * factor:.4g} {unit}"
+
+
 def _window_words(window: tuple) -> str:
     from ..specification import show_window
 
@@ -460,10 +465,11 @@ def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
     assert spec.dv_window is not None and spec.monitor is not None  # resolved
     definitions = [f"record judged: {record or describe_record(spec)}",
                    f"duration: {duration_definition(spec.shape, spec.duration_def)}"]
-    if spec.peak is not None:
-        criteria.append(_figure("peak", row["peak"], spec.peak, "kG", 1.0))
+    if spec.peak is not None:  # in the units the specification gave
+        criteria.append(_figure("peak", row["peak"], spec.peak, *shown_unit(spec, "peak")))
     if spec.duration is not None:
-        criteria.append(_figure("duration", row["duration"], spec.duration, "ms", 1e3))
+        criteria.append(_figure("duration", row["duration"], spec.duration,
+                                *shown_unit(spec, "duration")))
     if spec.velocity_change is not None:
         criteria.append(_figure("velocity change", row["velocity change"],
                                 spec.velocity_change, "m/s", 1.0))
@@ -477,7 +483,7 @@ def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
                  else "")
         criteria.append(Criterion("corridor", 100 * margin, "%", 0.0, None,
                                   100 * margin, "%", margin >= 0,
-                                  f"±{spec.corridor:.0%} of {_nominals(spec)[0]:.4g} kG, time "
+                                  f"±{spec.corridor:.0%} of {_shown_peak(spec)}, time "
                                   f"slack ±{spec.time_slack:.0%}, placed by "
                                   f"{spec.placement}{decay}"))
         definitions.append(f"corridor: the ideal {spec.shape} starts at "
@@ -698,8 +704,9 @@ def noise_could_flip(verdict: Verdict, t: np.ndarray, kg: np.ndarray, spec: Spec
     steep = float(np.median(slope[near])) if near.any() else math.inf
     lo, hi = judge_rows(t, kg, spec)["span"][0]
     n_dv = max(1, int(round((hi - lo) / dt))) if math.isfinite(hi - lo) else len(kg)
-    effects = {"peak": sigma,
-               "duration": math.sqrt(2) * sigma / steep * 1e3 if steep > 0 else math.inf,
+    effects = {"peak": sigma * shown_unit(spec, "peak")[1],  # in the criterion's unit
+               "duration": (math.sqrt(2) * sigma / steep * shown_unit(spec, "duration")[1]
+                            if steep > 0 else math.inf),
                "velocity change": noise * dt * math.sqrt(n_dv) * KG_MS2,
                "corridor": 100 * sigma / (spec.peak.nominal if spec.peak else peak)}
     said = []

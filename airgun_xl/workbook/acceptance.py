@@ -8,13 +8,16 @@ from ..units import KG_MS2, G
 from .charts import line_series, log_axis, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
 from .report import axis, chart_size, not_printed, one_page, report_workbook
-from .sheets import write_about, write_number_columns, write_warnings
+from .sheets import write_about, write_number_columns, write_warnings, write_wrapped
 
 RECORD, IDEAL, LIMIT, REQUIRED = "#c00000", "#1f4e79", "#7f7f7f", "#000000"
 G_PER_KG = KG_MS2 / G
 
 #: Printed columns of the Verdict page, and a chart's width in columns.
 VERDICT_COLS, CHART_COLS = 8, 14
+
+#: Characters a wrapped line of the Verdict page holds across its printed columns.
+VERDICT_LINE_CHARS = 160
 
 
 def write_verdict_table(wb, ws, verdict, row, bold):
@@ -36,7 +39,12 @@ def write_verdict_table(wb, ws, verdict, row, bold):
         else:
             ws.write_string(row, 1, "not measured")
         ws.write_string(row, 2, c.unit)
+        if c.name == "corridor":  # its limits are the band round the ideal, not numbers
+            ws.write_string(row, 3, "inside the band")
+            ws.write_string(row, 4, "inside the band")
         for col, limit in ((3, c.low), (4, c.high)):
+            if c.name == "corridor":
+                continue
             if limit is None:
                 ws.write_string(row, col, "none")
             else:
@@ -56,12 +64,13 @@ def write_verdict_table(wb, ws, verdict, row, bold):
                                 "relying on it", wrap)
     row += 2
     ws.write_string(row, 0, "Tolerances used, and definitions", bold)
-    row += 1
-    for line in verdict.tolerances() + verdict.definitions + [
-            f"specification from: {verdict.spec.source or 'options'}"] + [
-            f"note: {n}" for n in verdict.spec.notes]:
-        ws.write_string(row, 0, line)
-        row += 1
+    lines = verdict.tolerances() + verdict.definitions + [
+        f"specification from: {verdict.spec.source or 'options'}"]
+    row = write_wrapped(wb, ws, row + 1, lines, VERDICT_COLS - 1, VERDICT_LINE_CHARS)
+    if verdict.spec.notes:  # a profile's caveats, in full
+        ws.write_string(row + 1, 0, "Notes of the profile", bold)
+        row = write_wrapped(wb, ws, row + 2, list(verdict.spec.notes), VERDICT_COLS - 1,
+                            VERDICT_LINE_CHARS)
     return row
 
 
@@ -74,7 +83,8 @@ def _pulse_chart(wb, n, t_ms, values, has_corridor):
         line_series(chart, "Pulse data", "Corridor, lower", 1, n, 0, 4, LIMIT)
     lo, hi = nice_range(t_ms)
     ylo, yhi = nice_range(values, include_zero=True)
-    chart = titled(chart, "The pulse and its corridor", axis("Time (ms)", lo, hi),
+    chart = titled(chart, "The pulse and its corridor" if has_corridor else
+                   "The record judged", axis("Time (ms)", lo, hi),
                    axis("Acceleration (kG)", ylo, yhi))
     chart.set_size(chart_size(CHART_COLS, 24))
     return chart

@@ -243,6 +243,8 @@ def write_predicted_verdict(wb, ws, verdict, row, style, doubted=()):
     """The prediction judged by the shot's specification, from ``row``: the verdict, then a
     row a criterion (value, unit, limits, margin, PASS/FAIL); the next free row. ``doubted``:
     the cells whose warnings put the pulse's figures in doubt, and so the verdict."""
+    from ..studies.acceptance import limits_text
+
     good = wb.add_format({"bold": True, "font_color": "#006100", "bg_color": "#C6EFCE"})
     bad = wb.add_format({"bold": True, "font_color": "#9C0006", "bg_color": "#FFC7CE"})
     number = wb.add_format({"num_format": "0.000", "align": "right"})
@@ -256,10 +258,8 @@ def write_predicted_verdict(wb, ws, verdict, row, style, doubted=()):
         if np.isfinite(c.value):
             ws.write_number(row, 1, c.value, number)
         ws.write_string(row, 2, c.unit)
-        lo = "-inf" if c.low is None else f"{c.low:.5g}"
-        hi = "+inf" if c.high is None else f"{c.high:.5g}"
-        ws.write_string(row, 3, f"{'PASS' if c.passed else 'FAIL'}: limits {lo} to {hi} "
-                        f"{c.unit}, margin {c.margin:+.2f} {c.margin_unit}"
+        ws.write_string(row, 3, f"{'PASS' if c.passed else 'FAIL'}: limits {limits_text(c)}"
+                        f", margin {c.margin:+.2f} {c.margin_unit}"
                         + (f"; {c.detail}" if c.detail else ""))
         row += 1
     wrap = wb.add_format({"text_wrap": True, "valign": "top"})
@@ -353,15 +353,21 @@ def write_warnings(wb, ws, row, warnings, last_col, line_chars=WARNING_LINE_CHAR
     them; returns the last row written. Every warning the terminal showed is on the printed
     page."""
     bold = wb.add_format({"bold": True, "font_color": "#9C0006" if warnings else "#000000"})
-    wrap = wb.add_format({"text_wrap": True, "valign": "top"})
     ws.write_string(row, 0, f"{heading} ({len(warnings)})" if warnings else
                     f"{heading}: none", bold)
-    for i, text in enumerate(warnings, 1):
+    return write_wrapped(wb, ws, row + 1, warnings, last_col, line_chars) - 1
+
+
+def write_wrapped(wb, ws, row, lines, last_col, line_chars=WARNING_LINE_CHARS):
+    """``lines`` from ``row`` down, each across columns 0..``last_col`` with its text wrapped
+    (``line_chars`` to a line, for the row's height): nothing cut at the page's edge. Returns
+    the next free row."""
+    wrap = wb.add_format({"text_wrap": True, "valign": "top"})
+    for i, text in enumerate(lines):
         ws.merge_range(row + i, 0, row + i, last_col, "", wrap)
         ws.write_string(row + i, 0, text, wrap)
-        lines = -(-len(text) // line_chars)
-        ws.set_row(row + i, 15 * max(1, lines))
-    return row + len(warnings)
+        ws.set_row(row + i, 15 * max(1, -(-len(text) // line_chars)))
+    return row + len(lines)
 
 
 def write_parameters(wb, params, shot, name="Parameters"):

@@ -92,7 +92,7 @@ def test_every_key_and_field_has_a_strategy():
     covered = {KEYS[k].field for k in KEYS} | {"srs"}
     assert set(judged_fields()) == covered, "a Specification field no source can give"
     assert [f.name for f in fields(Specification) if f.metadata.get("meta")] == [
-        "source", "notes", "origins", "places", "set_aside"]
+        "source", "notes", "origins", "places", "set_aside", "units"]
 
 
 def keys_of(name):
