@@ -74,7 +74,7 @@ DURATION_DEFS = ("base", "width@10%")
 #: and the decay's defaults apply only with a shape that draws them (:data:`SHAPE_DEFAULTS`).
 DEFAULTS: dict[str, Any] = {
     "shape": "none", "time_slack": 0.0, "placement": "least-squares",
-    "dv_window": ((0.5, "D"), (0.5, "D")), "monitor": ((0.5, "D"), (0.5, "D")),
+    "dv_window": ((0.5, "D"), (0.5, "D")), "monitor": ((1.0, "D"), (1.0, "D")),
     "duration_def": "base",
     "srs_q": 10.0, "srs_lower_db": -3.0, "srs_upper_db": 6.0, "srs_outside": 0.0,
 }
@@ -143,7 +143,8 @@ class Specification:
     dv_window, monitor : tuple or None
         The velocity change's window and the corridor's monitoring window, before and after
         the pulse: ((before, unit), (after, unit)), unit "s" or "D" (nominal durations);
-        default half a duration each side.
+        default half a duration each side for the velocity change, a whole one for the
+        corridor (a bump after the pulse is judged).
     duration_def : str or None
         One of :data:`DURATION_DEFS` (default base).
     decay : float or None

@@ -378,7 +378,7 @@ def test_the_verdict_prints_where_each_field_came_from_and_the_defaults(tmp_path
     assert "from options: peak 12kG" in out
     assert ("defaults (the tool's, no source gave them): shape none, time slack 0%, "
             "placement least-squares, velocity-change window 0.5D,0.5D, monitoring window "
-            "0.5D,0.5D, duration definition base, record the tool's default") in out
+            "1D,1D, duration definition base, record the tool's default") in out
 
 
 def test_the_documented_profile_example_loads_as_documented(tmp_path):

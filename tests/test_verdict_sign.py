@@ -264,14 +264,16 @@ def test_31_5_the_velocity_change_window_decides_a_tail():
     assert any("(0.4D before, 0.1D after the pulse)" in d for d in narrow.definitions)
 
 
-def test_31_5_a_bump_after_the_pulse_is_caught_by_a_full_duration_monitor():
-    """+30 % bump 0.6-0.8 D after a nominal half-sine: outside a 0.5 D monitor, inside 1 D."""
+def test_31_5_a_bump_after_the_pulse_is_caught_by_the_default_full_duration_monitor():
+    """+30 % bump 0.6-0.8 D after a nominal half-sine, no noise: caught by the tool's default
+    monitor (1 D each side), missed by a 0.5 D one (the old default) that a profile may set."""
     t, kg = pulse(rest=2 * D)
     bump = (t >= 3.6 * D) & (t < 3.8 * D)
     kg = kg + np.where(bump, 0.3 * A, 0.0)
-    assert judged(t, kg, noise=0.0, shape="half-sine").passed
-    v = judged(t, kg, noise=0.0, shape="half-sine", monitor="1D,1D")
+    v = judged(t, kg, noise=0.0, shape="half-sine")
     assert not by_name(v)["corridor"].passed
+    assert any("(1D before, 1D after the pulse)" in d for d in v.definitions)
+    assert judged(t, kg, noise=0.0, shape="half-sine", monitor="0.5D").passed
 
 
 def test_31_5_window_stays_one_release_as_an_alias_of_both(tmp_path, capsys):

@@ -40,8 +40,8 @@ def add_spec_options(p):
                    help="the velocity change's window before and after the pulse, in time or"
                         " in nominal durations: 0.4D,0.1D or 1ms,0.5ms (default 0.5D,0.5D)")
     g.add_argument("--monitor", metavar="BEFORE,AFTER",
-                   help="the corridor's monitoring window before and after the pulse: 1D,1D "
-                        "(default 0.5D,0.5D)")
+                   help="the corridor's monitoring window before and after the pulse: "
+                        "0.5D,2D (default 1D,1D)")
     g.add_argument("--window", metavar="DURATION",
                    help="(alias for one release) both windows, the same each side: 0.5ms")
     g.add_argument("--duration-def", metavar="|".join(DURATION_DEFS),

@@ -41,7 +41,7 @@ ROWS = (
     ("dv_window", "Velocity change window", "before,after the pulse: 0.4D,0.1D or 1ms,0.5ms "
                                             "(blank: 0.5D,0.5D)"),
     ("monitor", "Monitoring window", "before,after the pulse, where the corridor is judged "
-                                     "(blank: 0.5D,0.5D)"),
+                                     "(blank: 1D,1D)"),
     ("duration_def", "Duration definition", "base (each shape's D; blank) or width@10%"),
     ("decay", "Sawtooth decay allowance", "% of the duration (blank: 10)"),
 )
