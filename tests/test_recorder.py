@@ -171,8 +171,9 @@ def test_correlation_time_against_an_ar1_closed_form():
 
 def test_compare_warnings_are_in_its_workbook(tmp_path, capsys):
     """Issue 18.1: what compare-measured warns (here: 0.5 ms of pre-trigger, too little for a
-    baseline, and none is at rest after it either, and CFC 1000 on an 8 kHz record, below the 10 x the class J211 asks for) is
-    listed under the scores of the Compared sheet too."""
+    baseline, none at rest after the pulse either, and CFC 1000 on an 8 kHz record, below
+    the 10 x the class J211 asks for) is listed under the scores of the Compared sheet
+    too."""
     rec = Recorder(rate=8_000.0, pre_trigger=5e-4)
     trace = rec.record(airgun_xl.Shot(_shot(243.53532)).run(track=()), seed=2)
     path = rec.csv(trace, tmp_path / "short.csv")
