@@ -248,11 +248,13 @@ class Specification:
         by_source: dict[str, list[str]] = {}
         for key, where in self.origins:
             if key in KEYS:
-                by_source.setdefault(where, []).append(f"{key_label(key)} {show(self, key)}")
+                by_source.setdefault(where, []).append(
+                    f"{key_label(key)} {show(self, key, digits=6)}")
             elif key == "srs" and self.srs is not None:
                 by_source.setdefault(where, []).append(
                     f"SRS requirement ({len(self.srs.frequencies)} rows)")
-        lines = [f"from {where}: {', '.join(items)}" for where, items in by_source.items()
+        lines = [f"{where}: {', '.join(items)}" if where.startswith("derived") else
+                 f"from {where}: {', '.join(items)}" for where, items in by_source.items()
                  if where != "default"]
         defaults = by_source.get("default", [])
         if self.cfc is None:
@@ -649,10 +651,22 @@ def value_of(spec: Specification, key: str) -> Any:
     return value
 
 
-def show(spec: Specification, key: str) -> str:
-    """A key's value in the grammar's own text (it parses back to itself)."""
+def show(spec: Specification, key: str, digits: int | None = None) -> str:
+    """A key's value in the grammar's own text: exact (it parses back to itself), or with
+    ``digits`` significant digits, as a verdict prints it."""
     value = value_of(spec, key)
-    return "not given" if value is None else KEYS[key].show(value)
+    if value is None:
+        return "not given"
+    return KEYS[key].show(value if digits is None else _rounded(value, digits))
+
+
+def _rounded(value: Any, digits: int) -> Any:
+    """``value`` with each float in it to ``digits`` significant digits."""
+    if isinstance(value, float):
+        return float(f"{value:.{digits}g}")
+    if isinstance(value, tuple):
+        return tuple(_rounded(v, digits) for v in value)
+    return value
 
 
 def parse_key(key: str, value: object, where: str) -> Any:
@@ -884,7 +898,8 @@ def _derived_velocity_change(spec: Specification) -> Specification:
             spec.duration_def not in (None, "base"):
         return spec
     nominal = 2 * peak.nominal * KG_MS2 * duration.nominal / math.pi
-    origins = {**dict(spec.origins), "velocity_change": "derived: 2AT/pi of the half-sine"}
+    origins = {**dict(spec.origins),
+               "velocity_change": "derived (2AT/pi of the half-sine's nominal peak and duration)"}
     return replace(spec, velocity_change=Tolerance(nominal, dv.minus, dv.plus),
                    origins=tuple(origins.items()))
 

@@ -375,7 +375,8 @@ def test_31_8_a_half_sines_velocity_change_follows_from_its_peak_and_duration(tm
     2 A T / pi, derived and said, not refused."""
     s = combine("mil-std-810h-half-sine", None, options(peak=f"{A_G}g", duration="11ms"))
     assert s.velocity_change.nominal == pytest.approx(2 * A * KG_MS2 * D / math.pi, rel=1e-12)
-    assert s.origin("velocity_change") == "derived: 2AT/pi of the half-sine"
+    assert s.origin("velocity_change") == ("derived (2AT/pi of the half-sine's nominal peak "
+                                           "and duration)")
     t, kg = pulse()
     v = judge_record(t, kg, s, "the pulse", noise=0.0)
     assert v.passed and "velocity change" in by_name(v)

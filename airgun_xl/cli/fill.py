@@ -117,6 +117,7 @@ def print_summary(output, filled):
                                  f"{c.margin_unit} {'PASS' if c.passed else 'FAIL'}"
                                  for c in v.criteria))
         lines += [f"    {line}" for line in v.sources()]
+        lines += [f"    note: {line}" for line in v.spec.notes]  # a profile's caveats
     print("\n".join(lines))
 
 

@@ -567,7 +567,7 @@ def judged_record(t: np.ndarray, kg: np.ndarray, spec: Specification, noise: flo
             return t, kg, describe_record(spec, quiet="whose noise is unknown")
         if noise <= NOISE_BOUND * peak:
             return t, kg, describe_record(spec, quiet=(
-                "without noise (a prediction)" if noise == 0 else
+                "without noise at rest (as a prediction)" if noise == 0 else
                 f"whose noise at rest, {noise:.3g} kG, is within {NOISE_BOUND:.1%} of its "
                 "peak"))
     dt = float(t[1] - t[0])
