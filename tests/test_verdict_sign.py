@@ -387,3 +387,25 @@ def test_31_8_accepts_help_speaks_of_one_recording(capsys):
         main(["accept", "--help"])
     text = capsys.readouterr().out
     assert "both pulses" not in text and "prediction" not in text
+
+
+def test_31_8_the_equivalent_half_sine_is_the_smallest_on_a_noisy_short_pulse():
+    """A 0.3 ms half-sine of 1 kG with 3 % rms noise at 200 kHz, seed 1: the search finds
+    the smallest enveloping half-sine (1.06 kG near 0.3 ms by brute force over 300 durations
+    from 0.02 to 5 ms), not one 38 % larger that noise above 10 % far from the pulse put the
+    grid off (to 0.1 %: the refinement's tolerance)."""
+    from airgun_xl.studies.acceptance import equivalent_half_sine
+    from airgun_xl.studies.shock import srs
+
+    dt = 1 / 200e3
+    t = np.arange(0, 10e-3, dt)
+    kg = ideal("half-sine", t - 2e-3, 1.0, 0.3e-3) + np.random.default_rng(1).normal(
+        0, 0.03, len(t))
+    f = np.geomspace(100, 20e3, 40)
+    target = srs(kg, dt, f, 10.0)
+    brute = min(float(np.max(target / srs(ideal("half-sine", np.arange(
+        int(math.ceil(d / dt)) + 1) * dt, 1.0, d), dt, f, 10.0)))
+        for d in np.geomspace(0.02e-3, 5e-3, 300))
+    peak, duration, _ = equivalent_half_sine(t, kg, f, 10.0)
+    # the least peak is flat in the duration near its minimum: 0.29-0.31 ms give it to 0.02 %
+    assert peak <= brute * 1.001 and duration == pytest.approx(0.3e-3, rel=0.1)

@@ -831,11 +831,15 @@ def equivalent_half_sine(t: np.ndarray, kg: np.ndarray, frequencies: np.ndarray,
         k = int(np.argmax(ratio))
         return float(ratio[k]), float(frequencies[k])
 
-    if durations is None:
-        above = np.flatnonzero(np.asarray(kg) >= DURATION_LEVEL * np.max(kg))
-        base = ((above[-1] - above[0] + 1) * dt / width_fraction("half-sine") if len(above)
-                else 1e-3)
-        durations = base * np.geomspace(0.25, 4.0, 33)
+    if durations is None:  # round the pulse's own duration (its 10 % crossings round its
+        # peak: noise elsewhere above 10 % would put the grid off the pulse)
+        row = np.atleast_2d(np.asarray(kg, dtype=float))
+        k = np.argmax(row, axis=1)
+        start, end = _crossings(np.asarray(t, dtype=float), row, k, row[0, k])
+        width = float(end[0] - start[0])
+        base = width / width_fraction("half-sine") if math.isfinite(width) and width > 0 \
+            else 1e-3
+        durations = base * np.geomspace(0.1, 10.0, 49)
     durations = np.asarray(durations, dtype=float)
     peaks = [least_peak(d)[0] for d in durations]
     k = int(np.argmin(peaks))
