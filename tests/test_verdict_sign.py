@@ -409,3 +409,26 @@ def test_31_8_the_equivalent_half_sine_is_the_smallest_on_a_noisy_short_pulse():
     peak, duration, _ = equivalent_half_sine(t, kg, f, 10.0)
     # the least peak is flat in the duration near its minimum: 0.29-0.31 ms give it to 0.02 %
     assert peak <= brute * 1.001 and duration == pytest.approx(0.3e-3, rel=0.1)
+
+
+def test_31_8_least_squares_placement_is_the_least_squares_minimum():
+    """A half-sine at 0.5 us (5 ms: the correlation runs on every 25th sample) starting
+    0.37 of a sample off the grid, no noise: the placement is the true start, to a hundredth
+    of a sample (the minimum of the sum of squares over every sample), not the decimated
+    parabola's estimate."""
+    dt = 5e-7
+    t = np.arange(0, 8e-3, dt)
+    start = 1.5e-3 + 0.37 * dt
+    kg = ideal("half-sine", t - start, 12.0, 5e-3)
+    v = judge_record(t, kg, spec(shape="half-sine", peak="12kG:10%", duration="5ms:10%"),
+                     "the pulse", noise=0.0)
+    assert abs(v.onset - start) < 0.01 * dt
+    # and a noisy one: no start within a sample of it has a smaller sum of squares
+    noisy = kg + np.random.default_rng(8).normal(0, 0.3, len(t))
+    s = spec(shape="half-sine", peak="12kG:10%", duration="5ms:10%", record="unfiltered")
+    placed = judge_record(t, noisy, s, "the pulse", noise=0.0).onset
+
+    def cost(t0):
+        return float(np.sum((noisy - ideal("half-sine", t - t0, 12.0, 5e-3)) ** 2))
+
+    assert all(cost(placed) <= cost(placed + d * dt) for d in (-1, -0.1, -0.01, 0.01, 0.1, 1))
