@@ -19,6 +19,7 @@ import time
 from pathlib import Path
 
 from .errors import AirgunXlError, OptionError
+from .specification import Specification
 from .transaction import Interrupted, display
 
 #: Outputs of the commands, left out when a folder is expanded (they are not shots to fill;
@@ -68,7 +69,8 @@ class FillSettings:
     name: str | None = None
     reproducible: bool = False
     argv: tuple = ()
-    profile: str | None = None  # a tolerance profile (issue 25), under each shot's sheet
+    # a tolerance profile (issue 25), under each shot's sheet: read once, before any shot
+    profile: str | Specification | None = None
     spec: object = None  # the specification fields of the options, over each shot's sheet
 
 

@@ -26,6 +26,7 @@ and percentages as fractions. The judging itself is :mod:`airgun_xl.studies.acce
 from __future__ import annotations
 
 import math
+import os
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field, fields, replace
@@ -767,64 +768,32 @@ def spec_of_keys(parsed: dict[str, Any], source: str, srs: SrsRequirement | None
                          units=tuple((units or {}).items()))
 
 
-#: A profile file is read only up to this size: it is a few hundred bytes of JSON.
-MAX_PROFILE_BYTES = 65_536
-
-
 def load_profile(name: str) -> Specification:
     """A tolerance profile: a JSON object of :data:`KEYS` (and ``notes``), by path or by the
-    name of one in :data:`PROFILES`.
+    name of one in :data:`PROFILES`, read by the bounded reader
+    (:func:`airgun_xl.untrusted_json.read_json`: a regular file, capped in size, depth and
+    integers, its schema checked).
 
     Raises
     ------
     OptionError
-        For a missing, oversized or malformed profile, naming it and the key at fault.
+        For a missing, special, oversized or malformed profile, naming it and the key at
+        fault.
     """
-    import json
-    import stat
+    from .untrusted_json import read_json
 
     path = Path(name)
     if not path.suffix and not path.exists():
         path = PROFILES / f"{name}.json"
     shown = f"--profile {name}"
-    try:
-        info = path.stat()
-    except (OSError, ValueError):
+    if not os.path.lexists(path):
         known = ", ".join(sorted(p.stem for p in PROFILES.glob("*.json")))
         raise OptionError(f"{shown}: no such profile file, expected a JSON file or one of "
-                          f"{known}") from None
-    if not stat.S_ISREG(info.st_mode):
-        raise OptionError(f"{shown}: is not a regular file, expected a JSON profile")
-    if info.st_size > MAX_PROFILE_BYTES:
-        raise OptionError(f"{shown}: found {info.st_size:,} bytes, expected a profile of at "
-                          f"most {MAX_PROFILE_BYTES:,}")
-    try:
-        with open(path, "rb") as handle:
-            raw = handle.read(MAX_PROFILE_BYTES + 1)
-        if len(raw) > MAX_PROFILE_BYTES:
-            raise OptionError(f"{shown}: found over {MAX_PROFILE_BYTES:,} bytes, expected a "
-                              "profile of at most that")
-        data = json.loads(raw.decode("utf-8"), parse_constant=_no_constant)
-    except OptionError:
-        raise
-    except (OSError, UnicodeDecodeError, ValueError, RecursionError) as exc:
-        raise OptionError(f"{shown}: is not readable JSON ({type(exc).__name__}), expected "
-                          "an object of specification fields") from None
-    if not isinstance(data, dict):
-        raise OptionError(f"{shown}: found {type(data).__name__}, expected an object of "
-                          "specification fields")
+                          f"{known}")
+    data = dict(read_json(path, "profile", shown, OptionError))
     notes = data.pop("notes", [])
-    if isinstance(notes, str):
-        notes = [notes]
-    if not isinstance(notes, list) or not all(isinstance(n, str) for n in notes):
-        raise OptionError(f"{shown}: notes: found notes that are not text, expected a list "
-                          "of text")
     spec = from_keys(data, f"profile {path.stem}", lambda key: f"{shown}: {key}")
-    return replace(spec, notes=tuple(notes))
-
-
-def _no_constant(name: str) -> None:
-    raise ValueError(f"{name} is not JSON")
+    return replace(spec, notes=tuple([notes] if isinstance(notes, str) else notes))
 
 
 def check(spec: Specification, where: str) -> Specification:

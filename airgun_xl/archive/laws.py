@@ -8,18 +8,18 @@ entry scans skip it). A name keeps every version: storing it again adds the next
 is ever half-written.
 """
 import datetime
-import json
 import re
 from pathlib import Path
 
 from ..crush_law import DEGREE, CrushLaw
 from ..errors import ArchiveError, OptionError
 from ..transaction import display
-from .records import all_versions, store_record, versions
+from ..untrusted_json import short
+from .records import all_versions, read_record, store_record, versions
 from .store import Archive, safe_name
 
 LAWS = ".laws"
-_REF = re.compile(r"^(?P<name>[^@]+?)(?:@(?P<version>\d+))?$")
+_REF = re.compile(r"^(?P<name>[^@]+?)(?:@(?P<version>\d{1,9}))?$")
 
 
 def _folder(root, name):
@@ -46,7 +46,7 @@ def store_law(root, name, law, shots, scores, command=()):
               "v_range": list(law.v_range), "shots": shots, "scores": scores,
               "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
               "command": list(command)}
-    version = store_record(_folder(root, name), record, "the law")
+    version = store_record(_folder(root, name), record, "the law", root)
     return f"{name}@{version}"
 
 
@@ -73,14 +73,11 @@ def load_law(root, ref):
         found = [v for v in found if v[0] == int(m.group("version"))]
     if not found:
         known = ", ".join(r["ref"] for r in list_laws(root)) or "none yet"
-        raise OptionError(f"--crush-law: found {ref!r}, expected workbook, legacy or a law in "
-                          f"{display(root)} (stored by calibrate --archive --name; there: "
-                          f"{known})")
+        raise OptionError(f"--crush-law: found {short(ref)}, expected workbook, legacy or a "
+                          f"law in {display(root)} (stored by calibrate --archive --name; "
+                          f"there: {known})")
     version, path = found[-1]
-    try:
-        record = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
-        raise ArchiveError(f"{display(path)}: cannot be read ({exc})") from None
+    record = read_record(root, path, "law")
     name = str(ref).strip().partition("@")[0]
     return _law(record, f"{name}@{version}", path), record
 
@@ -90,12 +87,13 @@ def list_laws(root):
     out: list = []
     for folder, version, path in all_versions(Path(root) / LAWS):
         try:
-            record = json.loads(path.read_text(encoding="utf-8"))
+            record = read_record(root, path, "law")
+            _law(record, f"{folder.name}@{version}", path)  # a law fill could run
             lo, hi = record["v_range"]
             out.append({"ref": f"{folder.name}@{version}", "v_range": [lo, hi],
                         "shots": len(record.get("shots", [])),
-                        "created": record.get("created", "")})
-        except (OSError, ValueError, KeyError, TypeError):
+                        "created": str(record.get("created", ""))})
+        except ArchiveError as exc:  # listed and named, not fatal
             out.append({"ref": f"{folder.name}@{version}", "v_range": None, "shots": 0,
-                        "created": "unreadable"})
+                        "created": f"unreadable: {exc}"})
     return out

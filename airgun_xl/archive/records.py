@@ -35,19 +35,60 @@ def all_versions(base):
             yield folder, version, path
 
 
-def store_record(folder, record, what):
-    """Write ``record`` as the next version in ``folder`` (created); return the version.
+def inside(root, path, what):
+    """Refuse ``path`` unless it, resolved (every link followed), lies inside the archive at
+    ``root`` and no part of it below ``root`` is a link: a planted ``.verdicts`` or
+    ``.laws/NAME`` link must not carry a write (or a read) out of the archive.
 
     Raises
     ------
     ArchiveError
-        Naming the folder and ``what`` could not be written.
+    """
+    root, path = Path(root), Path(path)
+    try:
+        relative = path.relative_to(root)
+    except ValueError:
+        relative = None
+    part = root
+    for name in (relative.parts if relative is not None else ()):
+        part = part / name
+        if part.is_symlink():
+            raise ArchiveError(f"{display(part)}: is a link, expected {what} inside the "
+                               f"archive {display(root)} (a link could lead out of it)")
+    real_root = root.resolve()
+    real = path.resolve()
+    if relative is None or not (real == real_root or real_root in real.parents):
+        raise ArchiveError(f"{display(path)}: lies outside the archive {display(root)}, "
+                           f"expected {what} inside it")
+
+
+def read_record(root, path, kind):
+    """A record of the archive at ``root`` (a law, a verdict), checked to lie inside it and
+    read by the bounded reader (:func:`airgun_xl.untrusted_json.read_json`)."""
+    from ..untrusted_json import read_json
+
+    inside(root, path, f"the {kind}")
+    return read_json(path, kind, display(path), ArchiveError)
+
+
+def store_record(folder, record, what, root=None):
+    """Write ``record`` as the next version in ``folder`` (created, inside the archive at
+    ``root``: :func:`inside`); return the version.
+
+    Raises
+    ------
+    ArchiveError
+        Naming the folder and ``what`` could not be written, or lies outside the archive.
     """
     folder = Path(folder)
+    if root is not None:
+        inside(root, folder, what)
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise ArchiveError(f"{display(folder)}: cannot be created ({exc.strerror})") from None
+    if root is not None:  # made now: a link swapped in meanwhile is caught here
+        inside(root, folder, what)
     tmp = folder / f".{uuid.uuid4().hex}.tmp"
     try:
         with open(tmp, "x", encoding="utf-8") as fh:

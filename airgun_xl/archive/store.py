@@ -114,14 +114,17 @@ class Entry:
         ArchiveError
             When it is missing or not valid JSON (``archive verify`` lists such damage).
         """
-        try:
-            return json.loads((self.path / name).read_text())
-        except FileNotFoundError:
+        from ..untrusted_json import read_json
+
+        path = self.path / name
+        if not os.path.lexists(path):
             raise ArchiveError(f"{self.ref}: {name} is missing from {display(self.path)}, "
-                               "expected a whole entry (see airgun-xl archive verify)") from None
-        except (OSError, ValueError) as exc:
-            raise ArchiveError(f"{self.ref}: {name} cannot be read ({exc}), expected a whole "
-                               "entry (see airgun-xl archive verify)") from None
+                               "expected a whole entry (see airgun-xl archive verify)")
+        if path.is_symlink():
+            raise ArchiveError(f"{self.ref}: {name} is a link, expected the entry's own file "
+                               "(see airgun-xl archive verify)")
+        return read_json(path, RECORD_KINDS.get(name, "summary"), f"{self.ref}: {name}",
+                         ArchiveError)
 
 
 def _entry_version(folder):
@@ -130,17 +133,27 @@ def _entry_version(folder):
     return int(m.group(1)) if m else None
 
 
+#: The kind (:data:`airgun_xl.untrusted_json.SCHEMAS`) of each JSON file of an entry.
+RECORD_KINDS = {"params.json": "params", "summary.json": "summary",
+                "provenance.json": "provenance", MANIFEST: "manifest"}
+
+
 def _read_manifest(folder):
     """An entry folder's manifest, or None when missing, corrupt or not for this folder."""
+    from ..untrusted_json import read_json
+
     try:
-        manifest = json.loads((folder / MANIFEST).read_text())
+        if (folder / MANIFEST).is_symlink():
+            return None
+        manifest = read_json(folder / MANIFEST, "manifest", str(folder / MANIFEST),
+                             ArchiveError)
         index = manifest["index"]
         files = manifest["files"]
         ok = (index["shot"] == folder.parent.name and index["version"] == _entry_version(folder)
               and isinstance(files, dict)
               and all(isinstance(n, str) and n == os.path.basename(n) and n not in ("", ".", "..")
                       and isinstance(d, str) for n, d in files.items()))
-    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+    except (ArchiveError, OSError, ValueError, KeyError, TypeError, AttributeError):
         return None
     return manifest if ok else None
 

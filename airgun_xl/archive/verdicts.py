@@ -5,12 +5,12 @@ lists them."""
 import dataclasses
 import datetime
 import hashlib
-import json
 from pathlib import Path
 
+from ..errors import ArchiveError
 from ..transaction import display
 from .entry import shot_name
-from .records import all_versions, store_record
+from .records import all_versions, read_record, store_record
 from .store import Archive, safe_name
 
 VERDICTS = ".verdicts"
@@ -48,7 +48,7 @@ def store_verdict(root, shot, verdict, recording, report, command=()):
     archive = Archive(root, create=True)
     folder = Path(root) / VERDICTS / safe_name(shot_name(shot))
     record = verdict_record(verdict, shot, recording, report, command)
-    version = store_record(folder, record, "the verdict")
+    version = store_record(folder, record, "the verdict", root)
     return StoredVerdict(folder / f"v{version:04d}.json", archive)
 
 
@@ -74,11 +74,11 @@ def list_verdicts(root):
     out: list[dict] = []
     for folder, version, path in all_versions(Path(root) / VERDICTS):
         try:
-            record = json.loads(path.read_text(encoding="utf-8"))
-            out.append({"shot": record.get("shot"), "version": version,
-                        "verdict": record.get("verdict"), "created": record.get("created"),
-                        "recording": record.get("recording")})
-        except (OSError, ValueError, AttributeError):  # listed, not fatal (as a law)
+            record = read_record(root, path, "verdict")
+            out.append({"shot": record["shot"], "version": version,
+                        "verdict": record["verdict"], "created": record.get("created", ""),
+                        "recording": record.get("recording", "")})
+        except ArchiveError as exc:  # listed and named, not fatal (as a law)
             out.append({"shot": folder.name, "version": version, "verdict": "?",
-                        "created": "unreadable", "recording": display(path)})
+                        "created": f"unreadable: {exc}", "recording": display(path)})
     return out

@@ -4,6 +4,7 @@ import sys
 
 from ..archive import ENV, Archive, archive_dir
 from ..transaction import display
+from ..untrusted_json import printable
 from .run_options import add_force
 
 
@@ -98,12 +99,18 @@ def _matches(params, where):
 def history_rows(entries, where=()):
     """The campaign-table row of each entry (its summary.json figures and provenance) that
     ``where`` selects."""
+    from ..errors import ArchiveError
+
     rows = []
     for e in entries:
-        if where and not _matches(e.load("params.json"), where):
+        try:
+            if where and not _matches(e.load("params.json"), where):
+                continue
+            s = e.load("summary.json")
+            prov = e.load("provenance.json")
+        except ArchiveError as exc:  # a listing flags a bad record, names it, and goes on
+            rows.append(_unreadable_row(e, exc))
             continue
-        s = e.load("summary.json")
-        prov = e.load("provenance.json")
         law = prov.get("crush_law")
         warnings = s.get("warnings")
         rows.append({
@@ -116,6 +123,16 @@ def history_rows(entries, where=()):
             "integrator": f"{prov.get('integrator')}/{prov.get('model')}",
             "crush_law": law["name"] if isinstance(law, dict) else "not recorded"})
     return rows
+
+
+def _unreadable_row(e, exc):
+    """An entry whose records cannot be read, as a row of the listing: no figures, and why."""
+    figures = ("peak_kg", "filtered_peak_kg", "time_of_peak", "pulse_duration", "max_crush",
+               "final_length", "warning_count")
+    return {**dict(e.row), "ref": e.ref, "file": e.ref, "created": e.created,
+            "v0": e.row["v0"], **{k: None for k in figures},
+            "warnings": [f"unreadable: {exc}"], "integrator": "unreadable",
+            "crush_law": f"unreadable: {exc}"}
 
 
 def _cell(value, fmt, width):
@@ -155,10 +172,11 @@ def run_history(args):
         for r in rows:
             ms = {k: None if r[k] is None else r[k] * 1e3
                   for k in ("pulse_duration", "time_of_peak")}
-            print(f"{r['file']:<24} {r['created']:<26} {_cell(r['v0'], '.2f', 8)} "
-                  f"{_cell(r['peak_kg'], '.4f', 9)} {_cell(r['filtered_peak_kg'], '.4f', 9)} "
-                  f"{_cell(ms['pulse_duration'], '.4f', 9)} {_cell(r['max_crush'], '.4f', 8)} "
-                  f"{_cell(r['warning_count'], 'd', 4)}  {r['integrator']}, {r['crush_law']}")
+            print(printable(
+                f"{r['file']:<24} {r['created']:<26} {_cell(r['v0'], '.2f', 8)} "
+                f"{_cell(r['peak_kg'], '.4f', 9)} {_cell(r['filtered_peak_kg'], '.4f', 9)} "
+                f"{_cell(ms['pulse_duration'], '.4f', 9)} {_cell(r['max_crush'], '.4f', 8)} "
+                f"{_cell(r['warning_count'], 'd', 4)}  {r['integrator']}, {r['crush_law']}"))
         print(f"{len(rows)} entr{'y' if len(rows) == 1 else 'ies'}"
               + (f" of {len(archive.entries(args.shot, args.since))} (--where)" if where
                  else ""))
@@ -167,13 +185,13 @@ def run_history(args):
             for law in laws:
                 span = ("unreadable" if law["v_range"] is None else
                         f"{law['v_range'][0]:.4g} to {law['v_range'][1]:.4g} m/s")
-                print(f"  {law['ref']:<30} {span}, fitted on {law['shots']} shot"
-                      f"{'s' * (law['shots'] != 1)}, {law['created']}")
+                print(printable(f"  {law['ref']:<30} {span}, fitted on {law['shots']} shot"
+                                f"{'s' * (law['shots'] != 1)}, {law['created']}"))
         if verdicts:
             print("verdicts (accept --archive):")
             for v in verdicts:
-                print(f"  {v['shot']}@{v['version']:<6} {v['verdict']:<5} {v['created']}  "
-                      f"{v['recording']}")
+                print(printable(f"  {v['shot']}@{v['version']:<6} {v['verdict']:<5} "
+                                f"{v['created']}  {v['recording']}"))
     if args.output:
         from ..campaign import HISTORY_TABLE
         from ..workbook.campaign import write_campaign
@@ -219,36 +237,40 @@ def run_show(args):
     if args.json:
         print(json.dumps(doc, indent=1))
         return 0
-    print(f"{e.ref} (#{e.id}), created {e.created}, in {e.path}")
-    print("inputs:")
+
+    def say(text=""):  # what a record holds reaches the terminal as text, never as codes
+        print(printable(text))
+
+    say(f"{e.ref} (#{e.id}), created {e.created}, in {e.path}")
+    say("inputs:")
     for p in doc["params"]:
-        print(f"  {p['cell']:<4} {p['label']:<32} {p['value']!r:>22} {p['unit']}")
-    print("figures:")
+        say(f"  {p['cell']:<4} {p['label']:<32} {p['value']!r:>22} {p['unit']}")
+    say("figures:")
     summary = dict(doc["summary"])
     warnings = summary.pop("warnings", None)
     verdict = summary.pop("predicted_verdict", None)
     for k, v in summary.items():
-        print(f"  {k:<24} {shown_figure(k, v)}")
+        say(f"  {k:<24} {shown_figure(k, v)}")
     if isinstance(verdict, dict):
-        print(f"predicted verdict: {verdict.get('verdict')} (specification from "
+        say(f"predicted verdict: {verdict.get('verdict')} (specification from "
               f"{verdict.get('specification')})")
         for c in verdict.get("criteria") or []:
             value = "not measured" if c["value"] is None else f"{c['value']:.6g} {c['unit']}"
             margin = "none" if c["margin"] is None else f"{c['margin']:+.2f} {c['margin_unit']}"
-            print(f"  {c['name']:<24} {value}, margin {margin}, "
+            say(f"  {c['name']:<24} {value}, margin {margin}, "
                   f"{'PASS' if c['passed'] else 'FAIL'}")
     if warnings is None:
-        print("warnings: not recorded (an entry from before they were kept)")
+        say("warnings: not recorded (an entry from before they were kept)")
     else:
-        print(f"warnings: {len(warnings) or 'none'}")
+        say(f"warnings: {len(warnings) or 'none'}")
         for text in warnings:
-            print(f"  - {text}")
+            say(f"  - {text}")
     prov = doc["provenance"]
-    print(f"provenance: airgun-xl {prov['engine']}, {prov['integrator']} integrator, "
+    say(f"provenance: airgun-xl {prov['engine']}, {prov['integrator']} integrator, "
           f"{prov['model']} model, started {prov['started']}, {prov['run_seconds']:.2f} s")
-    print(f"  input SHA-256 {prov['input_sha256']}")
-    print(f"  command: {' '.join(prov['command'])}")
-    print("files: " + ", ".join(doc["files"]))
+    say(f"  input SHA-256 {prov['input_sha256']}")
+    say(f"  command: {' '.join(prov['command'])}")
+    say("files: " + ", ".join(doc["files"]))
     return 0
 
 

@@ -124,6 +124,7 @@ def print_summary(output, filled):
 def settings_of(args):
     """The :class:`~airgun_xl.campaign.FillSettings` the command line asks for."""
     from ..campaign import FillSettings
+    from ..specification import load_profile
     from .spec_options import options_spec
 
     return FillSettings(
@@ -131,7 +132,9 @@ def settings_of(args):
         args.max_sheet_rows, args.sidecar, args.integrator, args.allow_unstable, args.model,
         args.crush_law, args.unloading, args.compare_models,
         str(archive_dir(args.archive, required=False) or "") or None, args.name,
-        args.reproducible, tuple(args.argv), args.profile, options_spec(args))
+        args.reproducible, tuple(args.argv),
+        load_profile(args.profile) if args.profile else None,  # once, before any shot
+        options_spec(args))
 
 
 def run(args):

@@ -262,7 +262,7 @@ def test_any_random_value_of_a_profile_key_is_a_value_or_one_line_naming_the_key
     except AirgunXlError as exc:
         line = str(exc)
         assert "\n" not in line and line.startswith(f"--profile {path}: "), line
-        if "not readable JSON" not in line:
+        if "JSON" not in line:  # a value JSON itself refuses (NaN, 1e999) names the file
             assert f": {key}: " in line, line
 
 

@@ -1,0 +1,311 @@
+"""Issue 32 (hostile input, third pass): profiles and the archive's records read as the
+untrusted input they are, by one bounded, typed reader (airgun_xl/untrusted_json.py), and
+every record the tool writes into an archive kept inside it.
+
+Each test is named after the finding it closes. A refusal is exit 2, one line, no traceback,
+nothing written or changed; a listing flags a bad record, names it and goes on."""
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+from conftest import TEMPLATE
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from airgun_xl.archive.laws import list_laws, load_law, store_law
+from airgun_xl.archive.verdicts import list_verdicts
+from airgun_xl.cli import main
+from airgun_xl.crush_law import LEGACY_COEFFICIENTS, CrushLaw
+from airgun_xl.errors import AirgunXlError, ArchiveError
+from airgun_xl.untrusted_json import MAX_DEPTH, read_json
+
+POSIX = os.name == "posix"
+
+
+def one_line(capsys, code, *said):
+    err = capsys.readouterr().err
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and "Traceback" not in err, err
+    for part in said:
+        assert part in lines[0], lines[0]
+    return lines[0]
+
+
+def law(root, name="LOT"):
+    return store_law(root, name, CrushLaw(tuple(LEGACY_COEFFICIENTS), (100.0, 300.0),
+                                          "fitted"), [], [])
+
+
+def record_path(root, name="LOT", version=1):
+    return root / ".laws" / name / f"v{version:04d}.json"
+
+
+# -- 1. records written outside the archive ------------------------------------------------------
+
+@pytest.mark.skipif(not POSIX, reason="symlinks as an unprivileged user")
+def test_32_1_a_law_folder_that_links_out_of_the_archive_is_refused(tmp_path):
+    root, outside = tmp_path / "archive", tmp_path / "outside"
+    law(root, "OTHER")  # the archive exists
+    outside.mkdir()
+    (root / ".laws" / "LOT").symlink_to(outside, target_is_directory=True)
+    with pytest.raises(ArchiveError, match=r"LOT: is a link, expected the law inside the "
+                                           r"archive"):
+        law(root)
+    assert list(outside.iterdir()) == []
+
+
+@pytest.mark.skipif(not POSIX, reason="symlinks as an unprivileged user")
+def test_32_1_a_verdicts_folder_that_links_out_of_the_archive_is_refused(tmp_path, capsys):
+    import numpy as np
+
+    from airgun_xl.studies.acceptance import ideal
+
+    root, outside = tmp_path / "archive", tmp_path / "outside"
+    law(root, "OTHER")
+    outside.mkdir()
+    (root / ".verdicts").symlink_to(outside, target_is_directory=True)
+    t = np.arange(0, 15e-3, 1e-5)
+    rec = tmp_path / "r.csv"
+    rec.write_text("time [s],acceleration [kG]\n" + "\n".join(
+        f"{float(a)!r},{float(b)!r}" for a, b in zip(t, ideal("half-sine", t - 5e-3, 12.0,
+                                                               5e-3), strict=True)))
+    out = tmp_path / "v.xlsx"
+    code = main(["accept", str(TEMPLATE), str(rec), "--peak", "12kG:10%", "-o", str(out),
+                 "--archive", str(root)])
+    one_line(capsys, code, ".verdicts: is a link")
+    assert list(outside.iterdir()) == [] and not out.exists()
+
+
+# -- 3, 5. FIFOs, devices and files too large to be records ---------------------------------------
+
+@pytest.mark.skipif(not POSIX, reason="FIFOs and /dev/zero")
+@pytest.mark.parametrize("kind", ["fifo", "/dev/zero", "/dev/urandom"])
+def test_32_3_and_5_a_profile_that_is_a_fifo_or_a_device_is_refused_at_once(tmp_path, kind):
+    if kind == "fifo":
+        path = tmp_path / "profile.json"
+        os.mkfifo(path)
+    else:
+        path = kind
+    out = tmp_path / "o.xlsx"
+    proc = subprocess.run([sys.executable, "-m", "airgun_xl", "fill", str(TEMPLATE), "-o",
+                           str(out), "--profile", str(path)], capture_output=True, text=True,
+                          timeout=120)  # a bound on a hang, not a speed test
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1, proc.stderr
+    assert "is not a regular file" in lines[0] and not out.exists()
+
+
+@pytest.mark.skipif(not POSIX, reason="sparse files")
+def test_32_5_a_3_gb_sparse_law_record_is_refused_by_its_size(tmp_path):
+    root = tmp_path / "archive"
+    law(root)
+    with open(record_path(root), "r+b") as fh:
+        fh.truncate(3 * 2**30)
+    with pytest.raises(ArchiveError, match=r"found 3,221,225,472 bytes, expected a law record "
+                                           r"of at most 1,048,576"):
+        load_law(root, "LOT")
+    assert list_laws(root)[0]["created"].startswith("unreadable: ")
+
+
+# -- 6. a profile's JSON past its bounds ----------------------------------------------------------
+
+@pytest.mark.parametrize("text, said", [
+    ("[" * 30_000 + "]" * 30_000, f"nested over {MAX_DEPTH} deep"),
+    ('{"peak": ' + "1" * 401 + "}", "an integer of 401 digits"),
+    ('{"peak": ' + "1" * 5_001 + "}", "an integer of 5,001 digits"),
+    ('{"peak": 1e999}', "past a float"),
+    ('{"peak": NaN}', "NaN, which is not JSON"),
+])
+def test_32_6_a_profile_past_the_readers_bounds_is_one_line(tmp_path, capsys, text, said):
+    path = tmp_path / "p.json"
+    path.write_text(text)
+    code = main(["fill", str(TEMPLATE), "-o", str(tmp_path / "o.xlsx"), "--profile",
+                 str(path)])
+    one_line(capsys, code, f"--profile {path}: ", said)
+
+
+# -- 7, 11. archive records edited by hand or by a broken disk ------------------------------------
+
+BAD_LAWS = {
+    "v_range of text": {"coefficients": list(LEGACY_COEFFICIENTS), "v_range": ["a", "b"]},
+    "v_range of nulls": {"coefficients": list(LEGACY_COEFFICIENTS), "v_range": [None, None]},
+    "coefficients as text (11)": {"coefficients": "1234567", "v_range": [100, 300]},
+    "an empty object": {},
+    "a list": [1, 2, 3],
+}
+
+
+@pytest.mark.parametrize("name", sorted(BAD_LAWS))
+def test_32_7_and_11_a_bad_law_is_flagged_by_history_and_refused_by_fill(tmp_path, capsys,
+                                                                         name):
+    root = tmp_path / "archive"
+    law(root)
+    law(root, "GOOD")
+    record_path(root).write_text(json.dumps(BAD_LAWS[name]))
+    assert main(["history", str(root)]) == 0
+    out = capsys.readouterr().out
+    assert "LOT@1" in out and "unreadable: " in out and "GOOD@1" in out
+    code = main(["fill", str(TEMPLATE), "--crush-law", "LOT", "--archive", str(root), "-o",
+                 str(tmp_path / "o.xlsx")])
+    one_line(capsys, code, "v0001.json: ")
+    assert not (tmp_path / "o.xlsx").exists()
+
+
+@pytest.mark.parametrize("text, said", [
+    ('{"coefficients": [' + "1" * 401 + ',0,0,0,0,0,0], "v_range": [100, 300]}',
+     "an integer of 401 digits"),
+    ('{"coefficients": [0,0,0,0,0,0,0], "v_range": [-Infinity, Infinity]}',
+     "-Infinity, which is not JSON"),
+    ('{"coefficients": ' + "[" * 40 + "]" * 40 + "}", "nested over 32 deep"),
+])
+def test_32_7_fill_refuses_a_law_past_the_readers_bounds(tmp_path, capsys, text, said):
+    root = tmp_path / "archive"
+    law(root)
+    record_path(root).write_text(text)
+    code = main(["fill", str(TEMPLATE), "--crush-law", "LOT", "--archive", str(root), "-o",
+                 str(tmp_path / "o.xlsx")])
+    one_line(capsys, code, said)
+
+
+def test_32_7_a_law_version_of_5000_digits_is_one_line(tmp_path, capsys):
+    root = tmp_path / "archive"
+    law(root)
+    code = main(["fill", str(TEMPLATE), "--crush-law", "LOT@" + "9" * 5_000, "--archive",
+                 str(root), "-o", str(tmp_path / "o.xlsx")])
+    line = one_line(capsys, code, "--crush-law: found")
+    assert len(line) < 600
+
+
+def test_32_7_a_verdict_record_of_an_empty_object_is_flagged(tmp_path):
+    folder = tmp_path / "archive" / ".verdicts" / "shot"
+    folder.mkdir(parents=True)
+    (folder / "v0001.json").write_text("{}")
+    (folder / "v0002.json").write_text('{"shot": "shot", "verdict": "PASS", "criteria": []}')
+    listed = list_verdicts(tmp_path / "archive")
+    assert listed[0]["verdict"] == "?"
+    assert "the record: found {}, expected the fields shot, verdict, criteria" in listed[0][
+        "created"]
+    assert listed[1]["verdict"] == "PASS"
+
+
+@pytest.fixture(scope="module")
+def entry(tmp_path_factory):
+    """An archive with one entry of shot A, judged by a specification (its summary.json has a
+    predicted verdict)."""
+    root = tmp_path_factory.mktemp("entry") / "archive"
+    assert main(["fill", str(TEMPLATE), "--archive", str(root), "--name", "shot", "-o",
+                 str(root.parent / "o.xlsx"), "--peak", "12kG:10%"]) == 0
+    return root, next(root.glob("shot/v*/summary.json"))
+
+
+EDITS = {
+    "peak as text": lambda s: {**s, "peak_kg": "12 kG"},
+    "verdict as a number": lambda s: {**s, "predicted_verdict": 3},
+    "verdict without criteria": lambda s: {**s, "predicted_verdict": {"verdict": "PASS"}},
+    "a criterion without a value": lambda s: {**s, "predicted_verdict": {
+        "verdict": "PASS", "criteria": [{"name": "peak"}]}},
+    "a criterion's value as text": lambda s: {**s, "predicted_verdict": {
+        "verdict": "PASS", "criteria": [{"name": "peak", "value": "x", "unit": "kG",
+                                         "margin": 1.0, "margin_unit": "%",
+                                         "passed": True}]}},
+    "a verdict word unknown": lambda s: {**s, "predicted_verdict": {
+        "verdict": "MAYBE", "criteria": []}},
+    "criteria as an object": lambda s: {**s, "predicted_verdict": {
+        "verdict": "PASS", "criteria": {"peak": 1}}},
+    "warnings as a number": lambda s: {**s, "warnings": 7},
+}
+
+
+@pytest.mark.parametrize("name", sorted(EDITS))
+def test_32_7_show_refuses_an_edited_summary_and_history_flags_it(entry, capsys, name):
+    root, summary = entry
+    kept = summary.read_bytes()
+    try:
+        summary.write_text(json.dumps(EDITS[name](json.loads(kept))))
+        code = main(["show", "shot@1", "--archive", str(root)])
+        one_line(capsys, code, "shot@1: summary.json: ")
+        assert main(["history", str(root)]) == 0
+        assert "unreadable: shot@1: summary.json" in capsys.readouterr().out
+    finally:
+        summary.write_bytes(kept)
+
+
+@pytest.mark.skipif(not POSIX, reason="symlinks as an unprivileged user")
+def test_32_5_a_summary_that_links_to_dev_zero_is_refused(entry, capsys):
+    root, summary = entry
+    kept = summary.read_bytes()
+    summary.unlink()
+    try:
+        summary.symlink_to("/dev/zero")
+        code = main(["show", "shot@1", "--archive", str(root)])
+        one_line(capsys, code, "summary.json is a link")
+    finally:
+        summary.unlink()
+        summary.write_bytes(kept)
+
+
+# -- 15. what a record holds is printed as text ---------------------------------------------------
+
+def test_32_15_history_prints_no_escape_sequence_from_a_record(tmp_path, capsys):
+    law(tmp_path / "archive", "OTHER")
+    folder = tmp_path / "archive" / ".verdicts" / "shot"
+    folder.mkdir(parents=True)
+    (folder / "v0001.json").write_text(json.dumps(
+        {"shot": "shot\x1b[2J", "verdict": "PASS", "criteria": [], "created": "\x1b]0;x\x07",
+         "recording": "r.csv\x1b[31m"}))
+    assert main(["history", str(tmp_path / "archive")]) == 0
+    out = capsys.readouterr().out
+    assert "\x1b" not in out and "\x07" not in out and "shot\\x1b[2J" in out
+
+
+# -- the invariant, over random records -----------------------------------------------------------
+
+RECORD = st.recursive(
+    st.one_of(st.none(), st.booleans(), st.integers(-10**6, 10**6), st.floats(allow_nan=False,
+                                                                              allow_infinity=False),
+              st.text(max_size=8)),
+    lambda inner: st.one_of(st.lists(inner, max_size=4),
+                            st.dictionaries(st.sampled_from(
+                                ["coefficients", "v_range", "shot", "verdict", "criteria",
+                                 "created", "recording", "name", "x"]), inner, max_size=5)),
+    max_leaves=12)
+
+
+@settings(max_examples=150, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(laws=st.lists(RECORD, min_size=1, max_size=3), verdicts=st.lists(RECORD, max_size=3))
+def test_a_listing_never_fails_on_a_bad_record_and_a_load_refuses_it_in_one_line(
+        tmp_path, laws, verdicts):
+    import shutil
+
+    root = tmp_path / "archive"
+    shutil.rmtree(root, ignore_errors=True)
+    law(root, "OTHER")
+    for k, record in enumerate(laws, 1):
+        folder = root / ".laws" / "RANDOM"
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / f"v{k:04d}.json").write_text(json.dumps(record))
+    for k, record in enumerate(verdicts, 1):
+        folder = root / ".verdicts" / "shot"
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / f"v{k:04d}.json").write_text(json.dumps(record))
+    listed = list_laws(root)
+    assert len(listed) == len(laws) + 1
+    assert len(list_verdicts(root)) == len(verdicts)
+    for k in range(1, len(laws) + 1):
+        try:
+            load_law(root, f"RANDOM@{k}")
+        except AirgunXlError as exc:
+            assert "\n" not in str(exc) and len(str(exc)) < 600
+
+
+def test_the_reader_refuses_what_the_library_would_choke_on(tmp_path):
+    path = tmp_path / "r.json"
+    path.write_text('{"coefficients": [1,2,3,4,5,6,7], "v_range": [1, 2]}')
+    assert read_json(path, "law", "r")["v_range"] == [1, 2]
+    path.write_text('{"coefficients": [1,2,3,4,5,6], "v_range": [1, 2]}')
+    with pytest.raises(AirgunXlError, match=r"r: coefficients: found \[1, 2, 3, 4, 5, 6\], "
+                                            r"expected 7 numbers"):
+        read_json(path, "law", "r")
