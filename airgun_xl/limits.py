@@ -169,3 +169,8 @@ def check_memory(needed, what, way_out):
 
         raise ResourceError(f"{what} needs about {needed / 2**30:,.2f} GB, more than the "
                             f"{available / 2**30:,.2f} GB available; expected {way_out}")
+
+
+#: The largest acceleration a recording may hold [kG] (10^9 g): past it a sample is no
+#: recorder's (a 1e200 spike would overflow the noise's square); refused, naming its time.
+MAX_RECORD_KG = 1e6

@@ -309,3 +309,104 @@ def test_the_reader_refuses_what_the_library_would_choke_on(tmp_path):
     with pytest.raises(AirgunXlError, match=r"r: coefficients: found \[1, 2, 3, 4, 5, 6\], "
                                             r"expected 7 numbers"):
         read_json(path, "law", "r")
+
+
+# -- 2. a campaign's summary that is one of its shots ---------------------------------------------
+
+def test_32_2_a_summary_that_is_an_input_shot_is_refused_before_any_shot(tmp_path, capsys):
+    import shutil
+
+    day = tmp_path / "day"
+    day.mkdir()
+    for name in ("shot_01.xlsx", "shot_02.xlsx"):
+        shutil.copy(TEMPLATE, day / name)
+    kept = (day / "shot_01.xlsx").read_bytes()
+    code = main(["fill", str(day), "--summary", str(day / "shot_01.xlsx"), "--force"])
+    one_line(capsys, code, "--summary: found", "one of the campaign's shots")
+    assert (day / "shot_01.xlsx").read_bytes() == kept
+    assert sorted(p.name for p in day.iterdir()) == ["shot_01.xlsx", "shot_02.xlsx"]
+    code = main(["fill", str(day), "--summary", str(day / "shot_02.out.xlsx")])
+    one_line(capsys, code, "the output of one of the campaign's shots")
+    assert sorted(p.name for p in day.iterdir()) == ["shot_01.xlsx", "shot_02.xlsx"]
+
+
+# -- 4, 8. an SRS the record cannot resolve, and a slow record's spectra ---------------------------
+
+def _csv(path, t, kg):
+    path.write_text("time [s],acceleration [kG]\n" + "\n".join(
+        f"{float(a)!r},{float(b)!r}" for a, b in zip(t, kg, strict=True)) + "\n")
+    return path
+
+
+def test_32_4_an_srs_row_below_what_the_record_resolves_is_refused_at_once(tmp_path, capsys):
+    """A 15 ms record and a requirement row at 0.01 Hz (it took 60 s and more to compute)."""
+    import time
+
+    import numpy as np
+
+    from airgun_xl.studies.acceptance import ideal
+
+    t = np.arange(0, 15e-3, 1e-5)
+    rec = _csv(tmp_path / "r.csv", t, ideal("half-sine", t - 5e-3, 12.0, 5e-3))
+    req = tmp_path / "req.csv"
+    req.write_text("frequency [Hz],srs [g]\n0.01,10\n1000,20000\n")
+    began = time.perf_counter()
+    code = main(["accept", str(TEMPLATE), str(rec), "--srs", str(req), "-o",
+                 str(tmp_path / "v.xlsx")])
+    one_line(capsys, code, "--srs: found a row at 0.01 Hz, below the 66.7 Hz the record's "
+                           "14.99 ms can resolve")
+    assert time.perf_counter() - began < 30  # a bound on the hang, not a speed test
+
+
+def test_32_8_a_record_at_500_hz_gets_its_srs_page_not_a_valueerror(tmp_path, capsys):
+    """A 20 ms half-sine sampled at 500 Hz (10 samples across it), 10 ms at rest each side."""
+    import numpy as np
+
+    from airgun_xl.studies.acceptance import ideal
+
+    t = np.arange(0, 40e-3, 2e-3)
+    rec = _csv(tmp_path / "slow.csv", t, ideal("half-sine", t - 10e-3, 12.0, 20e-3))
+    out = tmp_path / "v.xlsx"
+    code = main(["accept", str(TEMPLATE), str(rec), "--peak", "12kG:10%", "--duration",
+                 "20ms:10%", "-o", str(out)])
+    captured = capsys.readouterr()
+    assert code == 0 and out.exists() and "Traceback" not in captured.err
+    assert "from a library" not in captured.err  # no numpy warning either
+    assert "10 samples across the nominal duration 20 ms" in captured.err
+
+
+# -- 9, 14. design --confidence: its options checked before the Monte Carlo ----------------------
+
+def test_32_9_a_negative_seed_is_one_line(tmp_path, capsys):
+    code = main(["design", str(TEMPLATE), "--peak", "12kG:10%", "--confidence", "0.9", "--sd",
+                 "A28=1%", "--seed", "-1", "-o", str(tmp_path / "d.xlsx")])
+    one_line(capsys, code, "--seed: found -1, expected a whole number from 0")
+
+
+def test_32_14_an_existing_output_is_refused_before_the_monte_carlo(tmp_path, capsys):
+    import time
+
+    out = tmp_path / "d.xlsx"
+    out.write_bytes(b"kept")
+    began = time.perf_counter()
+    code = main(["design", str(TEMPLATE), "--peak", "12kG:10%", "--confidence", "0.9",
+                 "--sd", "A28=1%", "--shots", "100000", "-o", str(out)])
+    one_line(capsys, code, "already exists")
+    assert out.read_bytes() == b"kept"
+    assert time.perf_counter() - began < 20  # refused before 100,000 shots, not after
+
+
+# -- 16. a spike past any recorder's range ---------------------------------------------------------
+
+@pytest.mark.parametrize("command", ["accept", "compare-measured"])
+def test_32_16_a_1e200_spike_is_named_not_an_inf_noise(tmp_path, capsys, command):
+    import numpy as np
+
+    t = np.arange(0, 15e-3, 1e-5)
+    kg = np.where((t > 5e-3) & (t < 10e-3), 12 * np.sin(np.pi * (t - 5e-3) / 5e-3), 0.0)
+    kg[100] = 1e200
+    rec = _csv(tmp_path / "spike.csv", t, kg)
+    extra = ["--peak", "12kG:10%"] if command == "accept" else []
+    code = main([command, str(TEMPLATE), str(rec), *extra, "-o", str(tmp_path / "o.xlsx")])
+    line = one_line(capsys, code, "found 1e+200 kG at 1.0000 ms")
+    assert "inf" not in line

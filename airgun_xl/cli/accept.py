@@ -156,8 +156,9 @@ def report_data(time, kg, spec, verdict):
         lo, hi = required_f.min(), min(required_f.max(), top)
         grid = default_frequencies(lo, hi) if hi > lo else np.array([lo])
         frequencies = np.unique(np.concatenate([grid, required_f[required_f <= top]]))
-    else:
-        frequencies = default_frequencies(100.0, min(10_000.0, top))
+    else:  # 100 Hz to 10 kHz, or below a tenth of a slow record's rate
+        hi = min(10_000.0, top)
+        frequencies = default_frequencies(min(100.0, hi / 16), hi)
     levels = srs(kg, dt, frequencies, q)
     spectra = {"frequencies": frequencies, "srs": levels, "q": q,
                "pv": pseudo_velocity(frequencies, levels),

@@ -30,6 +30,22 @@ def parse_jobs(text):
     return jobs
 
 
+def _check_summary(summary, given, files):
+    """Refuse a summary path that is one of the campaign's shots (a folder lists it as one,
+    and --force would replace it) or one of its outputs (SHOT.out.xlsx), before any work."""
+    from ..campaign import shot_files
+
+    real = summary.resolve()
+    shots = {p.resolve() for p in shot_files(given)}
+    if real in shots:
+        raise OptionError(f"--summary: found {display(summary)}, one of the campaign's shots, "
+                          "expected a new file name for the campaign table")
+    outputs = {f.with_name(f.stem + ".out.xlsx").resolve() for f in files}
+    if real in outputs:
+        raise OptionError(f"--summary: found {display(summary)}, the output of one of the "
+                          "campaign's shots, expected a file name of its own")
+
+
 def run_batch(args, settings):
     from ..campaign import run_campaign, shot_files
     from . import _say, note, warn
@@ -43,6 +59,7 @@ def run_batch(args, settings):
                           "writes SHOT.out.xlsx beside each)")
     if summary is not None:
         check_output(summary, args.force, inputs=files)  # before any shot runs
+        _check_summary(summary, args.shots, files)
     if settings.crush_law not in ("workbook", "legacy"):  # a law name: refused before any run
         from ..archive.laws import load_law
 

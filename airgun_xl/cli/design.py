@@ -171,6 +171,12 @@ def run_spec(args):
                           "against (--sd A28=1.5%% --sd E40=5%%)".replace("%%", "%"))
     if args.confidence is None and sds:
         raise OptionError("--sd: found without --confidence, expected both")
+    if not 0 <= args.seed < 2**128:
+        raise OptionError(f"--seed: found {args.seed}, expected a whole number from 0 to "
+                          "2**128 - 1")
+    from ..transaction import check_output
+
+    check_output(design_output(args), args.force, inputs=[args.shot])  # before the study
     shot = Shot.from_workbook(args.shot)
     spec = resolve_spec(shot, args)
     if spec is None:
@@ -231,14 +237,19 @@ def run_spec(args):
     return code or written
 
 
+def design_output(args):
+    """The designed shot's workbook: -o, or SHOT.design.xlsx beside the shot."""
+    shot_path = Path(args.shot)
+    return Path(args.output) if args.output else shot_path.with_name(
+        shot_path.stem + ".design.xlsx")
+
+
 def _write_design(args, shot, design, requirement=None, spec=None, notes=()):
     from ..pipeline import Options, fill_workbook
     from . import note, warn
     from .progress import Progress
 
-    shot_path = Path(args.shot)
-    output = Path(args.output) if args.output else shot_path.with_name(
-        shot_path.stem + ".design.xlsx")
+    output = design_output(args)
     designed = with_cells(shot, design)  # its warnings go with the designed shot's figures
     designed = dataclasses.replace(designed, warnings=list(designed.warnings)
                                    + [w for w in design.warnings if w not in designed.warnings])

@@ -460,11 +460,18 @@ def srs_criterion(t: np.ndarray, kg: np.ndarray, spec: Specification) -> tuple[C
     q, lower_db, upper_db = spec.srs_q, spec.srs_lower_db, spec.srs_upper_db
     dt = float(t[1] - t[0])
     top = max(r.frequencies)
+    named = dict(spec.places).get("srs", f"the SRS requirement ({spec.source or 'options'})")
     if top > 0.1 / dt:
-        raise OptionError(f"the SRS requirement ({spec.source or 'options'}): found a row at "
+        raise OptionError(f"{named}: found a row at "
                           f"{top:,.0f} Hz, above a tenth of the record's {1 / dt:,.0f} "
                           f"samples a second, where the SRS is not computed; expected "
                           f"requirement rows up to {0.1 / dt:,.0f} Hz, or a faster record")
+    low, length = min(r.frequencies), float(t[-1] - t[0])
+    if low * length < 1:  # below one cycle over the record: not resolved, and costly
+        raise OptionError(f"{named}: found a row at {low:g} Hz, below the {1 / length:,.3g} "
+                          f"Hz the record's {length * 1e3:,.4g} ms can resolve (one cycle "
+                          f"over it); expected rows from {1 / length:,.3g} Hz, or a longer "
+                          "record")
     levels = srs(np.asarray(kg, dtype=float), dt, np.array(r.frequencies), q)
     with np.errstate(divide="ignore"):
         margins = 20 * np.log10(levels / np.array(r.levels_kg))
@@ -870,7 +877,9 @@ def equivalent_half_sine(t: np.ndarray, kg: np.ndarray, frequencies: np.ndarray,
     def least_peak(duration):
         n = int(math.ceil(duration / dt)) + 1
         unit = ideal("half-sine", np.arange(n) * dt, 1.0, duration)
-        ratio = target / srs(unit, dt, frequencies, q)
+        response = srs(unit, dt, frequencies, q)
+        with np.errstate(divide="ignore", invalid="ignore"):  # a half-sine between samples
+            ratio = np.where(response > 0, target / response, np.inf)
         k = int(np.argmax(ratio))
         return float(ratio[k]), float(frequencies[k])
 
@@ -884,6 +893,8 @@ def equivalent_half_sine(t: np.ndarray, kg: np.ndarray, frequencies: np.ndarray,
             else 1e-3
         durations = base * np.geomspace(0.1, 10.0, 49)
     durations = np.asarray(durations, dtype=float)
+    durations = durations[durations >= 2 * dt] if np.any(durations >= 2 * dt) else \
+        np.array([2 * dt])  # a half-sine the record's samples can draw
     peaks = [least_peak(d)[0] for d in durations]
     k = int(np.argmin(peaks))
     lo, hi = durations[max(k - 1, 0)], durations[min(k + 1, len(durations) - 1)]

@@ -292,6 +292,14 @@ def prepare(trace, cfc=None, anti_alias=None, dt_model=None):
     from .shock import check_cfc
 
     warnings = check_cfc(cfc, trace.dt) if cfc else []
+    huge = np.flatnonzero(~(np.abs(np.asarray(trace.accel_kg, dtype=float))
+                            <= limits.MAX_RECORD_KG))
+    if len(huge):
+        k = int(huge[0])
+        raise OptionError(f"{trace.name}: found {float(trace.accel_kg[k]):.4g} kG at "
+                          f"{float(trace.time[k]) * 1e3:.4f} ms ({len(huge):,} such sample"
+                          f"{'s' * (len(huge) != 1)}), expected a recording within "
+                          f"±{limits.MAX_RECORD_KG:.0e} kG (a recorder's range)")
     base = baseline(trace.accel_kg, trace.dt)
     if base.where == "none":
         warnings.append(f"{trace.name}: no {MIN_PRE_SAMPLES} samples at rest before or after "
@@ -311,8 +319,14 @@ def prepare(trace, cfc=None, anti_alias=None, dt_model=None):
                           f"{np.min(filtered):.4g} to {np.max(filtered):.4g} kG after its "
                           f"{base.offset:.4g} kG offset), expected the macro's sign, a "
                           "deceleration positive (try --sign -1)")
-    noise = (float(np.std(filtered[base.start:base.start + base.samples]))
-             if base.where != "none" else 0.0)
+    rest = filtered[base.start:base.start + base.samples] if base.where != "none" else \
+        filtered[:0]
+    with np.errstate(over="ignore", invalid="ignore"):
+        noise = float(np.std(rest)) if len(rest) else 0.0
+    if not math.isfinite(noise):  # a 1e200 spike: its square overflows
+        raise OptionError(f"{trace.name}: found {float(np.max(np.abs(rest))):.4g} kG in the "
+                          f"samples at rest {base.where} the pulse, too large for their noise "
+                          "to be measured, expected a recording within a recorder's range")
     fraction = max(IMPACT_FRACTION, NOISE_SIGMAS * noise / float(np.max(filtered)))
     if fraction > 0.5:
         raise OptionError(f"{trace.name}: the pre-trigger noise ({noise:.4g} kG, 1 sigma) is "
