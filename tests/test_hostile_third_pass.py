@@ -410,3 +410,57 @@ def test_32_16_a_1e200_spike_is_named_not_an_inf_noise(tmp_path, capsys, command
     code = main([command, str(TEMPLATE), str(rec), *extra, "-o", str(tmp_path / "o.xlsx")])
     line = one_line(capsys, code, "found 1e+200 kG at 1.0000 ms")
     assert "inf" not in line
+
+
+# -- 17. npTDMS's own log lines --------------------------------------------------------------------
+
+@pytest.mark.parametrize("damage", ["truncated", "garbage", "huge string length"])
+def test_32_17_a_broken_tdms_file_is_one_line_with_none_of_nptdms_log_lines(tmp_path, damage):
+    """A TDMS file written by npTDMS, then cut to its first 40 bytes, overwritten with
+    random bytes after its lead-in (seed 3), or given a 2**31-byte object path length."""
+    import numpy as np
+    from nptdms import ChannelObject, TdmsWriter
+
+    good = tmp_path / "good.tdms"
+    with TdmsWriter(str(good)) as writer:
+        writer.write_segment([ChannelObject("g", "accel", np.linspace(0, 1, 500),
+                                            properties={"wf_increment": 1e-5})])
+    data = bytearray(good.read_bytes())
+    if damage == "truncated":
+        data = data[:40]
+    elif damage == "garbage":
+        data[28:] = np.random.default_rng(3).integers(0, 256, len(data) - 28,
+                                                      dtype=np.uint8).tobytes()
+    else:
+        data[32:36] = (2**31).to_bytes(4, "little")
+    bad = tmp_path / "bad.tdms"
+    bad.write_bytes(bytes(data))
+    proc = subprocess.run([sys.executable, "-m", "airgun_xl", "compare-measured",
+                           str(TEMPLATE), str(bad), "-o", str(tmp_path / "c.xlsx")],
+                          capture_output=True, text=True, timeout=120)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1, proc.stderr
+    assert "bad.tdms" in lines[0] and "nptdms" not in proc.stderr.lower().replace(
+        "needs nptdms", "")
+
+
+# -- 13. a campaign names a failed shot once ------------------------------------------------------
+
+def test_32_13_a_campaign_names_a_failed_shot_once_and_a_bad_profile_before_any(tmp_path,
+                                                                                 capsys):
+    import shutil
+
+    day = tmp_path / "day"
+    day.mkdir()
+    shutil.copy(TEMPLATE, day / "a_good.xlsx")
+    (day / "b_bad.xlsx").write_bytes(b"not a workbook at all")
+    main(["fill", str(day)])
+    err = capsys.readouterr().err
+    line = next(x for x in err.splitlines() if "b_bad.xlsx" in x)
+    assert line.count("b_bad.xlsx") == 1, line
+    filled = (day / "a_good.out.xlsx").read_bytes()
+    bad = tmp_path / "p.json"
+    bad.write_text('{"peak": "12kg"}')
+    code = main(["fill", str(day), "--profile", str(bad), "--force"])
+    one_line(capsys, code, "did you mean kG?")  # once, before any shot
+    assert (day / "a_good.out.xlsx").read_bytes() == filled  # no shot was run again

@@ -73,8 +73,10 @@ def run_batch(args, settings):
 
     def said(row):  # each shot's outcome as it comes
         name = row["file"]
-        if row["status"] == "failed":
-            _say(f"airgun-xl: error: {name}: {row['message']}")
+        if row["status"] == "failed":  # named once, though the message may name it too
+            message = str(row["message"])
+            _say(f"airgun-xl: error: {message}" if message.startswith(f"{name}: ") else
+                 f"airgun-xl: error: {name}: {message}")
         elif row["status"] == "skipped":
             note([f"{name}: skipped, {row['output']} exists (--force overwrites it)"])
         else:

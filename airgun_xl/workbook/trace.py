@@ -313,7 +313,12 @@ def _tdms_table(path, channel):
                           "installed: pip install 'airgun-xl[tdms]'") from None
     import logging
 
-    logging.getLogger("nptdms").setLevel(logging.CRITICAL)  # its lines before our one (23.23)
+    from nptdms.log import log_manager
+
+    # npTDMS gives each of its modules a logger of its own level and a console handler: its
+    # lines would come before our one (23.23, 32.17); all of them, and any made later, quiet
+    log_manager.set_level(logging.CRITICAL + 1)
+    logging.getLogger("nptdms").setLevel(logging.CRITICAL + 1)
     shown = display(Path(path))
     data = read_bytes(path, EXPECTED_TDMS, "TDMS")
     try:
