@@ -119,6 +119,7 @@ SLOW_TESTS = {
     "test_the_reported_probability_agrees_with_an_independent_monte_carlo_of_2000_fills",
     "test_design_confidence_says_when_no_setting_reaches_it", "test_design_confidence_met_exits_0",
     "test_the_closed_form_critical_step_agrees_with_the_bisection",
+    "test_32_12_accept_judges_a_recording_of_1_2_million_samples",
     "test_the_short_version_agrees_with_formulas",
     # over half a second each, so that the rest stays under a minute on a busy VM
     "test_every_tenth_row_and_its_sidecar",

@@ -464,3 +464,29 @@ def test_32_13_a_campaign_names_a_failed_shot_once_and_a_bad_profile_before_any(
     code = main(["fill", str(day), "--profile", str(bad), "--force"])
     one_line(capsys, code, "did you mean kG?")  # once, before any shot
     assert (day / "a_good.out.xlsx").read_bytes() == filled  # no shot was run again
+
+
+# -- 12. accept on a recording longer than a sheet ------------------------------------------------
+
+def test_32_12_accept_judges_a_recording_of_1_2_million_samples(tmp_path, capsys):
+    """1,200,000 samples (past Excel's 1,048,576 rows) at 1 MHz: a 5 ms half-sine after 2 ms
+    of rest, then the rest of 1.2 s: judged on every sample, charted by each bucket's least
+    and largest (it was refused after judging, naming an option accept does not have)."""
+    import numpy as np
+    import openpyxl
+
+    from airgun_xl.studies.acceptance import ideal
+
+    t = np.arange(1_200_000) * 1e-6
+    kg = ideal("half-sine", t - 2e-3, 12.0, 5e-3)
+    rec = tmp_path / "long.csv"
+    rec.write_text("time [s],acceleration [kG]\n" + "\n".join(
+        f"{a!r},{b!r}" for a, b in zip(t.tolist(), kg.tolist(), strict=True)) + "\n")
+    out = tmp_path / "v.xlsx"
+    code = main(["accept", str(TEMPLATE), str(rec), "--peak", "12kG:10%", "--duration",
+                 "5ms:10%", "-o", str(out)])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    ws = openpyxl.load_workbook(out, read_only=True)["Pulse"]
+    said = str(next(ws.iter_rows(max_row=1, values_only=True)))
+    assert "of the record's 1,200,000 samples" in said and "every sample was judged" in said

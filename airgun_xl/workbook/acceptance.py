@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..units import KG_MS2, G
-from .charts import line_series, log_axis, nice_range, titled
+from ..engine.decimate import minmax_indices
+from .charts import POINT_BUDGET, line_series, log_axis, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
 from .report import axis, chart_size, not_printed, one_page, report_workbook
 from .sheets import write_about, write_number_columns, write_warnings, write_wrapped
@@ -145,14 +146,19 @@ def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=Non
 
         charts = wb.add_worksheet("Pulse")
         data = wb.add_worksheet("Pulse data", worksheet_class=ColumnsWorksheet)
-        t_ms = np.asarray(pulse["time"]) * 1e3
+        # a long record (2,000,000 samples) is charted by its every bucket's min and max:
+        # its peak and every feature wider than a bucket kept, within Excel's rows
+        kept = np.arange(len(pulse["time"]))
+        if len(kept) > POINT_BUDGET:
+            kept = minmax_indices(np.asarray(pulse["kg"], dtype=float), POINT_BUDGET)
+        t_ms = np.asarray(pulse["time"])[kept] * 1e3
         has_corridor = "upper" in pulse
         names = ["Time (ms)", "Record judged (kG)"]
-        columns = {0: t_ms, 1: np.asarray(pulse["kg"])}
+        columns = {0: t_ms, 1: np.asarray(pulse["kg"])[kept]}
         if has_corridor:
             names += ["Ideal pulse (kG)", "Corridor, upper (kG)", "Corridor, lower (kG)"]
             for col, key in ((2, "ideal"), (3, "upper"), (4, "lower")):
-                columns[col] = np.asarray(pulse[key])
+                columns[col] = np.asarray(pulse[key])[kept]
         data.write_row(0, 0, names, bold)
         write_number_columns(data, 1, columns)
         not_printed(data)
@@ -160,6 +166,10 @@ def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=Non
         values = np.concatenate([v[np.isfinite(v)] for v in shown])
         charts.insert_chart(1, 0, _pulse_chart(wb, len(t_ms), t_ms, values, has_corridor))
         charts.write_string(0, 0, f"Verdict: {verdict.word}", bold)
+        if len(kept) < len(pulse["time"]):
+            charts.write_string(0, 4, f"charted: {len(kept):,} of the record's "
+                                      f"{len(pulse['time']):,} samples, each bucket's least "
+                                      "and largest (every sample was judged)")
         one_page(charts, 26, CHART_COLS - 1, shot=shot, title="Pulse")
 
         srs_ws = wb.add_worksheet("SRS")
