@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..units import KG_MS2, G
 from ..engine.decimate import minmax_indices
+from ..units import KG_MS2, G
 from .charts import POINT_BUDGET, line_series, log_axis, nice_range, titled
 from .columns_sheet import ColumnsWorksheet
 from .report import axis, chart_size, not_printed, one_page, report_workbook
