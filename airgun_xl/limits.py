@@ -174,3 +174,8 @@ def check_memory(needed, what, way_out):
 #: The largest acceleration a recording may hold [kG] (10^9 g): past it a sample is no
 #: recorder's (a 1e200 spike would overflow the noise's square); refused, naming its time.
 MAX_RECORD_KG = 1e6
+
+#: The most SDOF filter steps an SRS criterion may take (requirement rows x record samples):
+#: about 2 s on one core. 2,000 rows over a 2,000,000-sample record would be 4e9 (a minute
+#: and more); refused before any is run, naming --srs.
+MAX_SRS_STEPS = 200_000_000

@@ -490,3 +490,25 @@ def test_32_12_accept_judges_a_recording_of_1_2_million_samples(tmp_path, capsys
     ws = openpyxl.load_workbook(out, read_only=True)["Pulse"]
     said = str(next(ws.iter_rows(max_row=1, values_only=True)))
     assert "of the record's 1,200,000 samples" in said and "every sample was judged" in said
+
+
+def test_32_4_an_srs_past_its_cost_cap_is_refused_before_it_is_computed(tmp_path, capsys):
+    """2,000 requirement rows over a 150,000-sample record: 3e8 filter steps, past the 2e8
+    cap (docs/security.md), refused at once naming --srs."""
+    import time
+
+    import numpy as np
+
+    from airgun_xl.studies.acceptance import ideal
+
+    t = np.arange(150_000) * 1e-6
+    rec = _csv(tmp_path / "r.csv", t, ideal("half-sine", t - 2e-3, 12.0, 5e-3))
+    req = tmp_path / "req.csv"
+    f = np.geomspace(100, 50_000, 2_000)
+    req.write_text("frequency [Hz],srs [g]\n" + "\n".join(f"{x!r},100" for x in f.tolist()))
+    began = time.perf_counter()
+    code = main(["accept", str(TEMPLATE), str(rec), "--srs", str(req), "-o",
+                 str(tmp_path / "v.xlsx")])
+    one_line(capsys, code, "--srs: found 2,000 rows over the record's 150,000 samples",
+             "expected at most 2e+08")
+    assert time.perf_counter() - began < 30  # refused, not computed (a bound, not a speed)

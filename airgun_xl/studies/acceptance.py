@@ -472,6 +472,13 @@ def srs_criterion(t: np.ndarray, kg: np.ndarray, spec: Specification) -> tuple[C
                           f"Hz the record's {length * 1e3:,.4g} ms can resolve (one cycle "
                           f"over it); expected rows from {1 / length:,.3g} Hz, or a longer "
                           "record")
+    from .. import limits
+
+    steps = len(r.frequencies) * len(kg)
+    if steps > limits.MAX_SRS_STEPS:  # the cost, estimated before any is run
+        raise OptionError(f"{named}: found {len(r.frequencies):,} rows over the record's "
+                          f"{len(kg):,} samples ({steps:.2g} filter steps), expected at most "
+                          f"{limits.MAX_SRS_STEPS:.2g}: fewer rows, or a shorter record")
     levels = srs(np.asarray(kg, dtype=float), dt, np.array(r.frequencies), q)
     with np.errstate(divide="ignore"):
         margins = 20 * np.log10(levels / np.array(r.levels_kg))
