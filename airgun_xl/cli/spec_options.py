@@ -4,16 +4,15 @@ design, accept): a profile, then the fields, each overriding the shot's Specific
 Every value is read by the specification's grammar (:data:`airgun_xl.specification.KEYS`),
 the one the profile and the sheet use; a value an option gives overrides the sheet's and the
 profile's even when it equals the default (``--time-slack 0%``)."""
-from ..specification import DURATION_DEFS, PLACEMENTS, SHAPES
+from ..specification import DURATION_DEFS, OPTIONS, PLACEMENTS, SHAPES
 
-#: The options with the grammar keys they give (a quantity's option gives its tolerance too).
-QUANTITY_OPTIONS = (("peak", "--peak"), ("duration", "--duration"),
-                    ("velocity_change", "--velocity-change"))
-PLAIN_OPTIONS = (("shape", "--shape"), ("corridor", "--corridor"),
-                 ("time_slack", "--time-slack"), ("dv_window", "--dv-window"),
-                 ("monitor", "--monitor"), ("duration_def", "--duration-def"),
-                 ("decay", "--decay"), ("placement", "--placement"), ("record", "--record"),
-                 ("srs_q", "--srs-q"), ("srs_outside", "--srs-outside"))
+#: The options with the grammar keys they give, from the one table
+#: (:data:`airgun_xl.specification.OPTIONS`): a quantity's option gives its tolerance too
+#: (``--peak 12kG:10%``), ``--srs-tol`` gives the two dB sides, every other option one key.
+QUANTITY_OPTIONS = tuple((key, option) for key, option in OPTIONS.items()
+                         if f"{key}_tolerance" in OPTIONS)
+PLAIN_OPTIONS = tuple((key, option) for key, option in OPTIONS.items()
+                      if option not in dict(QUANTITY_OPTIONS).values() and option != "--srs-tol")
 
 
 def add_spec_options(p):

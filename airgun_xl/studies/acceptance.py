@@ -175,6 +175,7 @@ class Verdict:
     onset: float | None = None  # [s], the ideal pulse's start where placed
     window: tuple[float, float] | None = None  # [s], the span monitored
     record: tuple[np.ndarray, np.ndarray] | None = None  # (t [s], kg) of the record judged
+    span: tuple[float, float] = (math.nan, math.nan)  # [s], the velocity change's window
 
     @property
     def passed(self) -> bool:
@@ -555,6 +556,7 @@ def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
                       float(row["onset"]) if math.isfinite(row["onset"]) else None,
                       (float(m_lo), float(m_hi)) if math.isfinite(m_lo) and math.isfinite(m_hi)
                       else None)
+    verdict.span = (float(lo), float(hi))
     verdict.definitions += verdict.sources()
     if not criteria:
         verdict.warnings.append("the specification gives no criterion: nothing was judged")
@@ -759,7 +761,7 @@ def noise_could_flip(verdict: Verdict, t: np.ndarray, kg: np.ndarray, spec: Spec
     level = DURATION_LEVEL * peak
     near = np.abs(kg - level) < 0.05 * peak
     steep = float(np.median(slope[near])) if near.any() else math.inf
-    lo, hi = judge_rows(t, kg, spec)["span"][0]
+    lo, hi = verdict.span  # the velocity change's window, as judged
     n_dv = max(1, int(round((hi - lo) / dt))) if math.isfinite(hi - lo) else len(kg)
     effects = {"peak": sigma * shown_unit(spec, "peak")[1],  # in the criterion's unit
                "duration": (math.sqrt(2) * sigma / steep * shown_unit(spec, "duration")[1]
