@@ -269,9 +269,9 @@ def refine_law(pairs, law, integrator="legacy", degree=DEGREE):
 
     Returns
     -------
-    (CrushLaw, int, numpy.ndarray, numpy.ndarray)
-        The law, the runs it took, the nodes [m/s] and the standard errors of the law's values
-        there [-] (from the Jacobian, :func:`standard_errors`).
+    (CrushLaw, int, numpy.ndarray, numpy.ndarray, numpy.ndarray)
+        The law, the runs it took, the nodes [m/s], the standard errors of the law's values
+        there [-] and each shot's share in them (nodes x shots; :func:`error_budget`).
     """
     from scipy.optimize import least_squares
 
@@ -294,8 +294,10 @@ def refine_law(pairs, law, integrator="legacy", degree=DEGREE):
     scale = np.concatenate([np.abs(x0[:len(nodes)]), np.full(len(pairs), 0.1)])
     fit = least_squares(residuals, x0, bounds=(lo, hi), x_scale=scale, diff_step=1e-4,
                         max_nfev=150)
+    errors, shares = error_budget(fit, residual_blocks([rec for _, rec in pairs]), residuals,
+                                  scale)
     return (law_through(nodes, fit.x[:len(nodes)], law.v_range), evaluations[0], nodes,
-            standard_errors(fit)[:len(nodes)])
+            errors[:len(nodes)], shares[:len(nodes)])
 
 
 def correlation_time(r):
@@ -313,22 +315,150 @@ def correlation_time(r):
     return float(max(1.0, 1 + 2 * tail.sum()))
 
 
-def standard_errors(fit):
-    """Standard errors of a least-squares fit's parameters from its Jacobian: the square roots
-    of the diagonal of s^2 (J^T J)^-1, s^2 = 2 cost / (residuals - parameters), widened by the
-    residuals' :func:`correlation_time` (correlated residuals, as a filter leaves them, count
-    as fewer). A singular J^T J (a parameter the residuals do not see) gives an infinite
-    error."""
-    J = np.asarray(fit.jac, dtype=float)
+#: The standard error of a median of n samples of Gaussian noise sigma is this times
+#: sigma / sqrt(n) (sqrt(pi / 2)): the baseline removed from a recording is such a median.
+MEDIAN_SE = float(np.sqrt(np.pi / 2))
+
+
+@dataclass(frozen=True)
+class Block:
+    """One shot's rows of the L2 residuals (:func:`_objective_residuals`), for the error
+    budget (:func:`error_budget`).
+
+    Attributes
+    ----------
+    rows : int
+        Residuals of this shot (its measured pulse above 10 % of its peak).
+    acf : numpy.ndarray
+        Autocorrelation of white noise through the recording's CFC filter at lags 0, 1, ...
+        [-] (just [1.0] unfiltered): the correlation its noise has whatever a short record's
+        estimate says.
+    offset : float
+        Standard error of the baseline removed from the recording, in residual units
+        (divided by its peak and by sqrt(rows), as the residuals are) [-].
+    """
+
+    rows: int
+    acf: np.ndarray
+    offset: float
+
+    @property
+    def tau(self):
+        """The filter's integrated autocorrelation time [samples]: 1 + 2 sum of acf[1:]."""
+        return float(1 + 2 * np.sum(self.acf[1:]))
+
+
+def filter_acf(cfc, dt):
+    """The autocorrelation [-] at lags 0, 1, ... of white noise through the phaseless CFC
+    filter at step ``dt`` [s] (the impulse response's own, normalised; lags past 1e-6 of
+    the peak dropped); [1.0] without a filter."""
+    if not cfc:
+        return np.ones(1)
+    from .shock import cfc_filter
+
+    n = 2 * int(max(2000, 40 / (cfc * dt))) + 1
+    impulse = np.zeros(n)
+    impulse[n // 2] = 1.0
+    h = cfc_filter(impulse, dt, cfc)
+    acf = np.correlate(h, h, "full")[n - 1:]
+    acf /= acf[0]
+    keep = np.flatnonzero(np.abs(acf) > 1e-6)
+    return acf[:keep[-1] + 1]
+
+
+def residual_blocks(recs):
+    """Each recording's :class:`Block`: the rows :func:`_objective_residuals` gives it, its
+    filter's noise correlation and its baseline's standard error (MEDIAN_SE sigma / sqrt(n) of
+    the samples at rest; none when the recording has none, which it warns of)."""
+    out = []
+    for rec in recs:
+        measured = np.asarray(rec.filtered, dtype=float)
+        peak = float(np.max(measured))
+        rows = int(np.sum(measured >= 0.1 * peak))
+        base = rec.base
+        known = base.samples > 0 and np.isfinite(base.noise)
+        offset = MEDIAN_SE * base.noise / np.sqrt(base.samples) if known else 0.0
+        out.append(Block(rows, filter_acf(rec.cfc, rec.trace.dt),
+                         float(offset / (peak * np.sqrt(max(rows, 1))))))
+    return out
+
+
+def _correlated(Js, acf):
+    """J^T R J for noise of autocorrelation ``acf`` (R its Toeplitz matrix)."""
+    out = Js.T @ Js
+    for lag in range(1, min(len(acf), len(Js))):
+        cross = Js[lag:].T @ Js[:-lag]
+        out += acf[lag] * (cross + cross.T)
+    return out
+
+
+#: The step of the Jacobian the errors are computed from, relative to each parameter (or its
+#: scale): the residuals are piecewise linear on the model's 1 us grid, so the fit's own
+#: forward differences at 1e-4 can land on a kink (a node's error came out 0.46 % where
+#: steps of 3e-4 to 1e-2, forward or central, all give 1.2-1.3 %).
+JACOBIAN_STEP = 3e-3
+
+
+def error_budget(fit, blocks, residuals=None, scale=None):
+    """Standard errors of a least-squares fit's parameters, and each shot's share of each
+    parameter's variance.
+
+    The Jacobian is taken afresh at the solution (``residuals``, forward differences of
+    :data:`JACOBIAN_STEP` times each parameter or its ``scale``, scipy.optimize.approx_fprime)
+    when ``residuals`` is given; else the fit's own.
+
+    The covariance is the sandwich H M H, H = (J^T J)^-1, over the shots' blocks of rows
+    (:class:`Block`), which are independent of one another:
+
+    - each shot's noise, s_i^2 J_i^T R_i J_i: its own residual variance s_i^2 (the shots'
+      residuals are scaled by their peaks and lengths, so one pooled s^2 understates the
+      shot with the fewest samples), and R_i the correlation its filter gives white noise
+      (a scalar would overstate it where the Jacobian lives in fewer samples than the
+      filter's length, as on a fast shot's rise), times any further correlation of its
+      residuals (:func:`correlation_time` over the filter's, at least 1);
+    - its baseline's error, a constant under all its rows: (J_i^T 1) (J_i^T 1)^T o_i^2.
+
+    A singular J^T J (a parameter the residuals do not see) gives infinite errors.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        The standard errors (one a parameter), and the shares [-] (parameters x shots, each
+        row summing to 1) of each shot in each parameter's variance: the shots that pin it.
+    """
+    r = np.asarray(fit.fun, dtype=float)
+    if residuals is not None:
+        from scipy.optimize import approx_fprime
+
+        x = np.asarray(fit.x, dtype=float)
+        size = np.maximum(np.abs(x), np.abs(scale) if scale is not None else 0.0)
+        step = JACOBIAN_STEP * np.where(size > 0, size, 1.0)
+        J = np.asarray(approx_fprime(x, residuals, step), dtype=float).reshape(len(r), len(x))
+    else:
+        J = np.asarray(fit.jac, dtype=float)
     m, n = J.shape
-    dof = max(m - n, 1)
-    s2 = 2 * float(fit.cost) / dof * correlation_time(fit.fun)
     try:
-        cov = np.linalg.inv(J.T @ J) * s2
-        out = np.sqrt(np.clip(np.diag(cov), 0, None))
+        H = np.linalg.inv(J.T @ J)
     except np.linalg.LinAlgError:
-        out = np.full(n, np.inf)
-    return np.where(np.isfinite(out), out, np.inf)
+        return np.full(n, np.inf), np.full((n, len(blocks)), np.nan)
+    parts = np.zeros((len(blocks), n))
+    start = 0
+    for k, block in enumerate(blocks):
+        rows = slice(start, start + block.rows)
+        start += block.rows
+        Js, rs = J[rows], r[rows]
+        dof = max(block.rows - n * block.rows / m, 1.0)
+        s2 = float(rs @ rs) / dof * max(correlation_time(rs) / block.tau, 1.0)
+        G = H @ Js.T
+        noise = H @ _correlated(Js, block.acf) @ H
+        parts[k] = s2 * np.diag(noise) + (block.offset * G.sum(axis=1)) ** 2
+    if start != m:  # the blocks describe other residuals: a fault of ours, not the data's
+        raise ValueError(f"error budget: {start} rows in the blocks, {m} residuals")
+    variance = parts.sum(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        shares = (parts / variance).T
+    errors = np.sqrt(np.clip(variance, 0, None))
+    return np.where(np.isfinite(errors), errors, np.inf), shares
 
 
 def _objective_residuals(aligned, objective):
@@ -394,7 +524,7 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
     evaluations = [0]
 
     def shots(x):
-        values = dict(zip(names, x, strict=True))
+        values = dict(zip(names, x[:len(names)], strict=True))
         out = []
         for p, _ in pairs:
             changes = {}
@@ -407,23 +537,36 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
             out.append(p.replace(**changes))
         return out
 
-    def residuals(x, objective="l2"):
+    steps = np.array([rec.trace.dt for _, rec in pairs])
+
+    def residuals(x, objective="l2", nudges=None):
         evaluations[0] += 1
-        aligned = [align(_run(p, integrator), trace)
-                   for p, (_, trace) in zip(shots(x), pairs, strict=True)]
+        nudges = x[len(names):] if nudges is None else nudges
+        aligned = [align(_run(p, integrator), rec, nudge * dt)
+                   for p, (_, rec), nudge, dt in zip(shots(x), pairs, nudges, steps,
+                                                     strict=True)]
         return _objective_residuals(aligned, objective)
 
-    x0 = np.clip(x0, lo, hi)
-    scale = np.where(np.asarray(x0) > 0, np.abs(x0), 0.01)
-    fit = least_squares(residuals, x0, bounds=(lo, hi), x_scale=scale, diff_step=1e-4,
-                        xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=200)
-    x, errors, cost = fit.x, standard_errors(fit), float(fit.cost)
+    # the values, and each shot's alignment nudged within 2 samples of the threshold's (a
+    # crossing on a noisy rise is early on average: left fixed, it biased E40 by 0.6 of its
+    # standard error)
+    k = len(pairs)
+    start_x = np.concatenate([np.clip(x0, lo, hi), np.zeros(k)])
+    scale = np.concatenate([np.where(start_x[:len(names)] > 0, np.abs(start_x[:len(names)]),
+                                     0.01), np.full(k, 0.1)])
+    fit = least_squares(residuals, start_x, bounds=(np.concatenate([lo, np.full(k, -2.0)]),
+                                               np.concatenate([hi, np.full(k, 2.0)])),
+                        x_scale=scale, diff_step=1e-4, xtol=1e-10, ftol=1e-10, gtol=1e-10,
+                        max_nfev=200)
+    x, cost, nudges = fit.x[:len(names)], float(fit.cost), fit.x[len(names):]
+    errors = error_budget(fit, residual_blocks([rec for _, rec in pairs]), residuals,
+                          scale)[0][:len(names)]
     if objective == "iso18571":
         # the rating is jagged in the parameters (its DTW and phase search move in steps), so
         # a finite-difference slope can point the wrong way: a derivative-free search (Powell,
-        # bounded) from the L2 fit; the L2 fit's standard errors stand for it
+        # bounded) from the L2 fit, its alignment kept; the L2 fit's standard errors stand
         def worse(y):
-            return float(np.sum(residuals(y, "iso18571")))
+            return float(np.sum(residuals(y, "iso18571", nudges)))
 
         found = minimize(worse, x, method="Powell", bounds=list(zip(lo, hi, strict=True)),
                          options={"xtol": 1e-4, "ftol": 1e-6, "maxfev": 200})
@@ -459,7 +602,9 @@ class Calibration:
     bounds: dict = field(default_factory=dict)  # (low, high) of each fitted value
     law_nodes: np.ndarray | None = None  # [m/s] where the law's standard errors are
     law_errors: np.ndarray | None = None  # [-] standard errors of the law's values there
+    law_shares: np.ndarray | None = None  # [-] each shot's share in them (nodes x shots)
     recordings: list = field(default_factory=list)  # each shot's measured Recording
+    law_intervals: list = field(default_factory=list)  # NodeInterval of each law node
     warnings: list = field(default_factory=list)
     notes: list = field(default_factory=list)  # said with the figures; no verdict on them
 
@@ -590,12 +735,12 @@ def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objecti
 
     before = [score(align(_run(p, integrator), r)) for p, r in zip(params, recs, strict=True)]
     counter["runs"] += len(params)
-    law_cal, nodes, law_errors = None, None, None
+    law_cal, nodes, law_errors, law_shares = None, None, None, None
     if law:
         law_cal = calibrate_law(pairs, cfc, degree, integrator)
         counter["runs"] += len(law_cal.iterations) * len(pairs)
-        refined, evaluations, nodes, law_errors = refine_law(pairs, law_cal.law, integrator,
-                                                             degree)
+        refined, evaluations, nodes, law_errors, law_shares = refine_law(
+            pairs, law_cal.law, integrator, degree)
         counter["runs"] += evaluations * len(pairs)
         params = [p.replace(crush_law=refined) for p in params]
         pairs = list(zip(params, recs, strict=True))
@@ -611,7 +756,7 @@ def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objecti
     after = [score(a) for a in aligned]
     cal = Calibration(params, law_cal, fitted, start, before, after, aligned,
                       counter["runs"], time.perf_counter() - started, errors, bounds, nodes,
-                      law_errors, recs)
+                      law_errors, law_shares, recs)
     for rec, run in zip(recs, runs, strict=True):  # the same runs, cross-checked
         cal.warnings += [f"{rec.trace.name}: {w}" for w in rec.warnings]
         ok = np.isfinite(run.accel_kg)
@@ -619,7 +764,117 @@ def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objecti
         cal.warnings += [f"{rec.trace.name}: {w}" for w in said]
     found, cal.notes = verdict(cal, cfc, objective, params[0])
     cal.warnings += found
+    if law_errors is not None:
+        cal.law_intervals = node_intervals(cal, integrator)
     return cal
+
+
+#: Two-sided 95 % quantile of the normal distribution (scipy.stats.norm.ppf(0.975)).
+Z95 = 1.959963984540054
+
+#: A law node whose 95 % interval is wider than this (relative, each side) is weakly pinned.
+WEAK_PIN = 0.02
+
+#: A shot whose share of a node's variance reaches this is named as pinning it.
+PINNING_SHARE = 0.2
+
+
+@dataclass
+class NodeInterval:
+    """The law's value at one of its nodes, with its 95 % interval and who pins it.
+
+    Attributes
+    ----------
+    velocity : float
+        The node [m/s].
+    value, error : float
+        The fitted law there, and its standard error [-] (:func:`error_budget`).
+    shares : list of (int, float, float)
+        (shot number, impact speed [m/s], share of the node's variance [-]) of the shots
+        that pin it (share at least :data:`PINNING_SHARE`), largest first.
+    suggested : float or None
+        For a weakly pinned node: the impact speed [m/s] of the shot that would pin it best
+        (:func:`pinning_speed`).
+    """
+
+    velocity: float
+    value: float
+    error: float
+    shares: list
+    suggested: float | None = None
+
+    @property
+    def half_width(self):
+        """The 95 % interval's half width, relative to the value [-]."""
+        return Z95 * self.error / abs(self.value) if self.value else float("inf")
+
+    @property
+    def weak(self):
+        return not self.half_width <= WEAK_PIN
+
+    @property
+    def low(self):
+        return self.value - Z95 * self.error
+
+    @property
+    def high(self):
+        return self.value + Z95 * self.error
+
+    def pinned_by(self):
+        return ", ".join(f"shot {k} ({v:.1f} m/s, {share:.0%})" for k, v, share in self.shares)
+
+    def words(self):
+        text = (f"crush law at {self.velocity:.1f} m/s: {self.value:.4f} +/- "
+                f"{self.half_width:.1%} (95 %), weakly pinned (over +/- {WEAK_PIN:.0%}); "
+                f"pinned by {self.pinned_by() or 'no shot in particular'}")
+        if self.suggested is not None:
+            text += f"; a shot at about {self.suggested:.0f} m/s would pin it best"
+        return text
+
+
+def pinning_speed(p, law, velocity, width, integrator="legacy"):
+    """The impact speed [m/s] of the shot that would pin the law best at ``velocity`` [m/s]:
+    of speeds from ``velocity`` to 1.6 times it, the slowest whose pulse dwells within
+    ``width`` / 2 of it, loading with at least half its peak force (past the rise, before the
+    end), for at least 95 % of the longest such dwell. Runs ``p`` with ``law`` at each."""
+    from ..errors import AirgunXlError
+
+    candidates = velocity + width / 2 + np.linspace(0.0, 0.6 * velocity, 25)
+    dwell = np.zeros(len(candidates))
+    for k, v0 in enumerate(candidates):
+        try:
+            run = _run(p.replace(v31=v0 + p.v1, v32=v0 + p.v1, v33=v0 + p.v1, crush_law=law),
+                       integrator)
+        except AirgunXlError:  # a speed the law cannot run at is no suggestion
+            continue
+        h = run.history
+        t, force = h.time[2:], h.force[2:]
+        v = np.interp(t, h.time[1:-1], (h.v31 - h.v1)[1:-1])
+        near = (np.abs(v - velocity) <= width / 2) & (force >= 0.5 * np.max(force))
+        dwell[k] = float(np.sum(np.gradient(t)[near]))
+    if not np.any(dwell > 0):
+        return None
+    return float(candidates[np.flatnonzero(dwell >= 0.95 * dwell.max())[0]])
+
+
+def node_intervals(cal, integrator="legacy"):
+    """Each law node's :class:`NodeInterval`, with the shots that pin it and, for a weakly
+    pinned one, the impact speed that would pin it best."""
+    law = cal.params[0].crush_law
+    nodes = np.asarray(cal.law_nodes, dtype=float)
+    speeds = [p.v31 - p.v1 for p in cal.params]
+    spacing = np.diff(nodes)
+    out = []
+    for k, v in enumerate(nodes):
+        row = cal.law_shares[k] if cal.law_shares is not None else ()
+        shares = sorted(((i + 1, speeds[i], float(x)) for i, x in enumerate(row)
+                         if np.isfinite(x) and x >= PINNING_SHARE), key=lambda s: -s[2])
+        node = NodeInterval(float(v), float(law(v)), float(cal.law_errors[k]), shares)
+        if node.weak:
+            width = float(min(spacing[max(k - 1, 0)], spacing[min(k, len(spacing) - 1)]))
+            node.suggested = pinning_speed(cal.params[0], law, float(v), width, integrator)
+        out.append(node)
+    return out
 
 
 def synthetic_measurement(p, dt=1e-5, noise=0.01, ringing_hz=8000.0, ringing=0.1, seed=0,
