@@ -97,6 +97,16 @@ def run(args):
         print(f"  crush law: {'converged' if lc.converged else 'NOT converged'} in "
               f"{len(lc.iterations)} iterations (last change {lc.iterations[-1].change:.2%}), "
               f"then least squares; valid {lo:.1f} to {hi:.1f} m/s (the samples' span)")
+        print("  crush law at its nodes, 95 % intervals (noise, baselines and alignment; not "
+              "model error):")
+        for node in cal.law_intervals:
+            line = (f"    {node.velocity:6.1f} m/s: {node.value:.4f} ({node.low:.4f} to "
+                    f"{node.high:.4f}, +/- {node.half_width:.1%})")
+            if node.weak:
+                line += f" WEAKLY PINNED by {node.pinned_by() or 'no shot in particular'}"
+                if node.suggested is not None:
+                    line += f"; a shot at about {node.suggested:.0f} m/s would pin it best"
+            print(line)
     for name, value in cal.fitted.items():
         print(f"  {name}: {cal.start[name]:.6g} -> {value:.6g} +/- {cal.errors[name]:.3g} "
               f"(1 standard error; 95 %: {value - 1.96 * cal.errors[name]:.6g} to "

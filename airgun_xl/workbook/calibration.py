@@ -90,6 +90,39 @@ def _pulse_chart(wb, a):
     return chart
 
 
+def _node_table(wb, ws, style, row, nodes):
+    """The law at its nodes with their 95 % intervals, a weakly pinned one flagged (red) in
+    its row and named below with the shots that pin it and the speed that would; returns the
+    next free row."""
+    if not nodes:
+        return row
+    ws.write_string(row, 0, "Crush law at its nodes, 95 % intervals (noise, baselines and "
+                            "alignment; not model error)", style.bold)
+    row += 1
+    ws.write_row(row, 0, ["Node velocity (m/s)", "Law (-)", "95 % low (-)", "95 % high (-)",
+                          "+/- (95 %)", "Pinned"], style.header)
+    ws.set_row(row, 30)
+    num = style.of("fraction")
+    flag = wb.add_format({"bold": True, "font_color": "#9C0006"})
+    for node in nodes:
+        row += 1
+        ws.write_number(row, 0, node.velocity, style.of("m/s"))
+        for col, value in ((1, node.value), (2, node.low), (3, node.high)):
+            if math.isfinite(value):
+                ws.write_number(row, col, value, num)
+            else:
+                ws.write_string(row, col, "not identified", flag)
+        if math.isfinite(node.half_width):
+            ws.write_number(row, 4, node.half_width, style.of("%"))
+        ws.write_string(row, 5, "WEAKLY" if node.weak else "yes", flag if node.weak else None)
+    weak = [n.words() for n in nodes if n.weak]
+    row += 1
+    if weak:
+        row = write_warnings(wb, ws, row, weak, 5, line_chars=95,
+                             heading="Weakly pinned law nodes (over +/- 2 %)") + 1
+    return row + 1
+
+
 def write_calibration(path, shot, cal, files, options, force=False):
     """Write the calibrated workbook at ``path`` (atomically); returns the copy's warnings."""
     params = cal.params[0]
@@ -155,6 +188,7 @@ def write_calibration(path, shot, cal, files, options, force=False):
             ws.write_number(row, 1, law.v_range[0], num)
             ws.write_number(row, 2, law.v_range[1], num)
             row += 2
+            row = _node_table(wb, ws, style, row, cal.law_intervals)
         if cal.fitted:
             ws.write_row(row, 0, ["Fitted (unit)", "Start", "Fitted", "Change",
                                   "Standard error", "At a bound"], style.header)
