@@ -12,8 +12,6 @@ from __future__ import annotations
 import os
 from typing import TYPE_CHECKING
 
-__version__ = "0.1.0"
-
 from .errors import (
     AirgunXlError,
     ArchiveError,
@@ -27,6 +25,7 @@ from .errors import (
     StabilityError,
     WorkbookError,
 )
+from .version import __version__
 
 if TYPE_CHECKING:
     from .params import ShotParams

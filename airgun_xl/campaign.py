@@ -20,6 +20,7 @@ import os
 import time
 from pathlib import Path
 
+from .crush_law import law_name
 from .errors import AirgunXlError, OptionError
 from .specification import Specification
 from .transaction import Interrupted, display
@@ -198,13 +199,6 @@ def row_of(path, output, filled, entry=None):
         row.update(filtered_peak_kg=s.filtered_peak_kg, pulse_duration=s.pulse_duration,
                    max_crush=s.max_crush, final_length=s.final_length)
     return row
-
-
-def law_name(law):
-    """How a record names the law a run used."""
-    if law.is_legacy:
-        return "legacy (Eq. 8)"
-    return f"fitted ({law.source})" if law.source else "fitted"
 
 
 def _failed(path, output, status, message):

@@ -99,3 +99,10 @@ def crush_factor(v, law=LEGACY_LAW):
         Crush factor [-], at least 1.
     """
     return law(v)
+
+
+def law_name(law):
+    """How a record (an archive entry, a campaign's row) names the law a run used."""
+    if law.is_legacy:
+        return "legacy (Eq. 8)"
+    return f"fitted ({law.source})" if law.source else "fitted"

@@ -6,7 +6,6 @@ import dataclasses
 import time
 from pathlib import Path
 
-from . import __version__
 from .archive import Archive
 from .archive.entry import prepare_entry
 from .engine.summary import summarize
@@ -15,6 +14,7 @@ from .limits import check_memory, fill_bytes
 from .models import apply_model
 from .studies.check import after_run, before_run, quirk_fired, unloading_diverged
 from .transaction import Publication, check_output, display
+from .version import __version__
 from .workbook.sidecar import SIDECAR_SUFFIXES, render_history, sidecar_path
 from .workbook.writer import render_workbook
 

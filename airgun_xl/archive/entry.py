@@ -6,10 +6,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
-from ..campaign import law_name
 from ..cells import CELLS
+from ..crush_law import law_name
 from ..transaction import display
+from ..version import __version__
 from ..workbook.sidecar import have_parquet, render_history
 from .store import safe_name
 

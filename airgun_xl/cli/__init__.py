@@ -14,6 +14,9 @@ import warnings
 
 from ..errors import AirgunXlError
 from ..transaction import SIGNALS, Interrupted, note_signal, on_signal, reset_signals
+from .messages import _WARNED, _say, note, warn
+
+__all__ = ["main", "note", "warn"]
 
 
 @contextlib.contextmanager
@@ -49,16 +52,6 @@ def _signals(restore=True):
         for s, h in saved.items():
             signal.signal(s, h if restore else signal.SIG_IGN)
         sys.unraisablehook = hook
-
-
-def _say(text):
-    """One line to stderr, whatever the file names in it hold."""
-    from .progress import clear_line
-
-    stream = sys.stderr
-    clear_line(stream)  # a progress bar's line
-    encoding = getattr(stream, "encoding", None) or "utf-8"
-    print(text.encode(encoding, "backslashreplace").decode(encoding, "replace"), file=stream)
 
 
 def _interrupt_behind(exc):
@@ -146,22 +139,3 @@ def main(argv=None):
     except BrokenPipeError:  # e.g. `airgun-xl history | head`
         sys.stdout = open(os.devnull, "w")
         return 0
-
-
-_WARNED: set = set()
-
-
-def note(messages):
-    """Print notices (what a run will cost, before it starts), one line each, to stderr."""
-    for message in messages:
-        _say(f"airgun-xl: note: {message}")
-
-
-def warn(messages):
-    """Print warnings, one line each, to stderr; a warning already given by this command is
-    not repeated (design warns about its solution, then the fill of it does)."""
-    for message in messages:
-        line = f"airgun-xl: warning: {message}"
-        if line not in _WARNED:
-            _WARNED.add(line)
-            _say(line)

@@ -56,7 +56,7 @@ def run(args):
     from ..studies.measured import prepare
     from ..transaction import check_output
     from ..workbook.trace import input_file, read_trace
-    from . import warn
+    from .messages import warn
     from .spec_options import resolve_spec
 
     shot_path = Path(args.shot)

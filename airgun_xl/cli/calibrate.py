@@ -117,7 +117,7 @@ def run(args):
     for text in cal.notes:
         print(f"  note: {text}")
     if cal.warnings:
-        from . import warn
+        from .messages import warn
 
         warn(cal.warnings)
         print(f"  verdict: NOT TRUSTED ({len(cal.warnings)} warning"

@@ -48,7 +48,7 @@ def _check_summary(summary, given, files):
 
 def run_batch(args, settings):
     from ..campaign import run_campaign, shot_files
-    from . import _say, note, warn
+    from .messages import _say, note, warn
     from .progress import CountBar
 
     jobs = parse_jobs(args.jobs)

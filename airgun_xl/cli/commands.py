@@ -2,8 +2,8 @@
 import argparse
 import re
 
-from .. import __version__
 from ..errors import OptionError
+from ..version import __version__
 from . import (
     accept,
     archive,

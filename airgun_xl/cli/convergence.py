@@ -30,7 +30,7 @@ def run(args):
     from ..shot import Shot
     from ..studies.convergence import default_ladder, ladder, parse_duration
     from ..workbook.convergence import write_convergence
-    from . import warn
+    from .messages import warn
 
     shot = Shot.from_workbook(args.shot)
     integrators = [n.strip() for n in args.integrator.split(",") if n.strip()]

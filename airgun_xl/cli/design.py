@@ -246,7 +246,7 @@ def design_output(args):
 
 def _write_design(args, shot, design, requirement=None, spec=None, notes=()):
     from ..pipeline import Options, fill_workbook
-    from . import note, warn
+    from .messages import note, warn
     from .progress import Progress
 
     output = design_output(args)

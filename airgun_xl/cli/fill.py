@@ -150,7 +150,7 @@ def run_one(path, settings):
     """One shot, as fill always did: its warnings and notes on the terminal, a progress bar,
     its figures printed."""
     from ..campaign import fill_one
-    from . import note, warn
+    from .messages import note, warn
     from .progress import Progress
 
     output, filled, root = fill_one(path, settings, warn, note, Progress.for_rows)

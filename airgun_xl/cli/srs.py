@@ -42,7 +42,7 @@ def run(args):
     )
     from ..transaction import check_output
     from ..workbook.srs import write_srs
-    from . import warn
+    from .messages import warn
 
     if args.cfc is not None and args.cfc not in CFC_CLASSES:
         cfc_coefficients(args.cfc, 1.0)  # its one-line error, before the run

@@ -122,7 +122,7 @@ def run(args):
               f"{stats['p5']:.4f}-{stats['p95']:.4f} kG")
     flagged, cells = result.flagged()
     if flagged:
-        from . import warn
+        from .messages import warn
 
         warn([f"{flagged:,} of {total:,} shots have warnings, naming "
               + ", ".join(f"{cell} ({n:,} shots)" for cell, n in sorted(cells.items()))

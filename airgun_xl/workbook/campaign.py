@@ -6,7 +6,7 @@ from ..campaign import TABLE, TABLE_TITLE
 from .charts import nice_range
 from .report import Style, axis, chart_size, one_page, report_workbook
 from .sheets import write_warnings
-from .writer import PROPERTIES
+from .xlsx import PROPERTIES
 
 #: Widths (characters) of the table's text columns.
 TEXT_WIDTHS = {"file": 28, "status": 12, "output": 28, "entry": 18, "created": 20,

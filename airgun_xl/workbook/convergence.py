@@ -5,7 +5,7 @@ from ..errors import OutputError
 from ..studies.convergence import QUANTITIES
 from ..transaction import Publication, display
 from .report import Style, chart_size, one_page
-from .writer import close_workbook, new_workbook
+from .xlsx import close_workbook, new_workbook
 
 COLORS = ("#1f4e79", "#c00000", "#548235")
 

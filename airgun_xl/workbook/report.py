@@ -22,7 +22,7 @@ run alone (the same run gives the same file).
 import contextlib
 from dataclasses import dataclass
 
-from .. import __version__
+from ..version import __version__
 
 #: A4 in xlsxwriter's paper codes; Letter printers scale it.
 A4 = 9
@@ -203,10 +203,10 @@ def report_workbook(path, force=False, inputs=()):
     ------
     xlsxwriter.Workbook
         With the project's options and fixed properties
-        (:func:`~airgun_xl.workbook.writer.new_workbook`).
+        (:func:`~airgun_xl.workbook.xlsx.new_workbook`).
     """
     from ..transaction import atomic_path, check_output
-    from .writer import close_workbook, new_workbook
+    from .xlsx import close_workbook, new_workbook
 
     check_output(path, force, inputs=inputs)
     with atomic_path(path, force) as tmp:

@@ -22,31 +22,22 @@ Then, as :class:`airgun_xl.outputs.Outputs` selects: Summary, Charts, Tracked, S
 ChartData, and the input's Outputs block. A run longer than the sheets may hold writes every
 N-th row (N in the Summary) and, by default, its full history to a sidecar file.
 """
-import datetime
 import math
 
 import numpy as np
-import xlsxwriter
 from xlsxwriter.utility import xl_rowcol_to_cell
 
 from ..cells import PARAMETER_COLUMNS
 from ..engine.summary import SPECTRUM_MAX_HZ, summarize
-from ..errors import OutputError
 from ..outputs import SHEET_NAME, Outputs
 from ..transaction import atomic_path, check_output, display
 from .charts import add_charts, series_data
-from .columns_sheet import ColumnsWorksheet, fast_deflate
+from .columns_sheet import ColumnsWorksheet
 from .formula_eval import Evaluator, FormulaFailure
 from .law_sheet import SHEET_NAME as LAW_SHEET
 from .law_sheet import write_law_sheet
 from .report import not_printed, one_page
-from .safe_text import (
-    BOOLEAN_FORMAT,
-    WORKBOOK_OPTIONS,
-    SafeWorksheet,
-    copyable_formula,
-    sheet_title,
-)
+from .safe_text import copyable_formula, sheet_title
 from .sheets import (
     Ref,
     variant_name,
@@ -57,16 +48,7 @@ from .sheets import (
     write_summary,
     write_tracked,
 )
-
-#: Fixed document properties, so the same run gives the same bytes.
-PROPERTIES = {
-    "title": "ArtSim results",
-    "subject": "Air gun impact simulation (ARL-TR-3559)",
-    "author": "airgun-xl",
-    "company": "",
-    "comments": "Written by airgun-xl",
-    "created": datetime.datetime(2005, 8, 1),
-}
+from .xlsx import close_workbook, new_workbook
 
 #: Header text per 0-based column index, as the macro writes it (P is ours).
 HEADERS = {
@@ -75,25 +57,6 @@ HEADERS = {
     15: "Plastic Wave Front", 17: "Time", 18: "Acceleration (m/s^2)", 19: "Velocity (m/s)",
     20: "Acceleration (kG's)", 26: "Time", 27: "Filtered Acceleration",
 }
-
-
-class _Workbook(xlsxwriter.Workbook):
-    worksheet_class = SafeWorksheet  # every sheet's strings are text (safe_text)
-
-    def add_worksheet(self, name=None, worksheet_class=None):
-        ws = super().add_worksheet(name, worksheet_class)
-        if getattr(self, "_boolean_format", None) is None:
-            self._boolean_format = self.add_format({"num_format": BOOLEAN_FORMAT})
-        ws.boolean_format = self._boolean_format
-        return ws
-
-
-def new_workbook(path):
-    """An xlsxwriter Workbook with the project's fixed options and properties; strings are
-    never turned into formulas, links or numbers (:mod:`airgun_xl.workbook.safe_text`)."""
-    wb = _Workbook(str(path), dict(WORKBOOK_OPTIONS, in_memory=True))
-    wb.set_properties(PROPERTIES)
-    return wb
 
 
 #: The sheets a fill adds after sheet 1, by their fixed names.
@@ -286,20 +249,6 @@ def print_outputs_block(ws, block, shot):
         ws.set_column(col - 1, col - 1, min(max(chars + 2, 6), 120))
     one_page(ws, max(r for r, _ in block) - 1, max(c for _, c in block) - 1, shot=shot,
              title="Outputs")
-
-
-def close_workbook(wb, path):
-    """Close (package) an xlsxwriter Workbook at deflate level 1; a full disk, a file-size
-    limit or any other failure to write becomes one :class:`OutputError` line."""
-    from xlsxwriter.exceptions import XlsxFileError
-
-    try:
-        with fast_deflate():
-            wb.close()
-    except OSError as exc:
-        raise OutputError(f"{display(path)}: cannot be written ({exc.strerror or exc})") from None
-    except XlsxFileError as exc:
-        raise OutputError(f"{display(path)}: cannot be written ({exc})") from None
 
 
 def write_workbook(result, path, force=False, outputs=Outputs(), summary=None, info=None,

@@ -1,0 +1,1 @@
+"""Workbooks: reading the untrusted ones, and writing each command's."""
