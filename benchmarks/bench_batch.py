@@ -25,7 +25,7 @@ def benches(repeat, tmp):
 
     import airgun_xl
     from airgun_xl.engine import _artsim
-    from airgun_xl.engine.batch import run_batch
+    from airgun_xl.engine.batch import N_FINALS, run_batch
     from airgun_xl.engine.integrators import displacement_bound, kernel_params, run_legacy
 
     p = airgun_xl.load(TEMPLATE).params
@@ -37,7 +37,8 @@ def benches(repeat, tmp):
         halves = np.array_split(np.arange(SHOTS), threads)
 
         def work(index):
-            t, y, f = np.empty(rows), np.empty((len(index), rows)), np.empty((len(index), 8))
+            t, y = np.empty(rows), np.empty((len(index), rows))
+            f = np.empty((len(index), N_FINALS))
             _artsim.batch_kernel(matrix[index], rows, 0, 3, t, y, f, lanes)
 
         with ThreadPoolExecutor(threads) as pool:
