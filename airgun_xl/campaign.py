@@ -5,9 +5,7 @@ files in it) as its own transaction: its workbook, sidecar and archive entry are
 together or not at all. :func:`run_campaign` runs the shots in worker processes (``--jobs``);
 a worker fills many shots, so its start-up is paid once. A bad shot gets its one line and the
 others go on. Ctrl-C stops the batch: finished shots stay, the running ones clean up their
-temp files, the rest are not started. A worker killed under a shot (SIGKILL, the
-out-of-memory killer) loses that shot only: its row says "lost", and the pool (pebble's)
-starts a new worker for the others.
+temp files, the rest are not started.
 
 :class:`FillSettings` is what the command line asks of every shot (one declaration, pickled
 to the workers); :func:`fill_one` fills one shot with it; :data:`TABLE` names the columns of
@@ -235,8 +233,6 @@ def fill_task(path, settings):
     path = Path(path)
     output = Path(settings.output) if settings.output else default_output(path)
     warnings: list = []
-    if _STOP is not None and _STOP.is_set():  # the batch was stopped before this shot began
-        return _failed(path, output, "interrupted", "not started: the campaign was stopped")
     if not settings.force and os.path.lexists(output):  # filled before: not run again
         return _failed(path, output, "skipped", f"{display(output)}: already exists "
                                                 "(--force overwrites it)")
@@ -254,37 +250,6 @@ def fill_task(path, settings):
                                                f"{exc}); please report it")
     entry = filled.entry.ref if filled.entry is not None else None
     return row_of(path, output, filled, entry)
-
-
-def _lost(path, settings, error):
-    """The row of a shot whose worker process died under it (a signal such as SIGKILL, or
-    the operating system's out-of-memory killer): nothing of it was published, and the
-    temp files it left in its output's folder are removed."""
-    from .transaction.locks import folder_lock
-    from .transaction.publication import recover
-
-    path = Path(path)
-    output = Path(settings.output) if settings.output else default_output(path)
-    code = getattr(error, "exitcode", None)
-    if isinstance(code, int) and code < 0:
-        import signal
-
-        try:
-            how = f"killed by {signal.Signals(-code).name}"
-        except ValueError:
-            how = f"killed by signal {-code}"
-    elif code is not None:
-        how = f"ended abruptly with exit status {code}"
-    else:
-        how = f"lost ({type(error).__name__}: {error})"
-    folder = output.parent if output.parent.is_dir() else None
-    if folder is not None:
-        import contextlib
-
-        with contextlib.suppress(OSError), folder_lock(folder):
-            recover(folder)  # the dead worker's temps and journal, if any
-    return _failed(path, output, "lost", f"its worker process was {how} before the shot was "
-                                         "published; nothing of it was kept (fill it again)")
 
 
 # -- the parent side ---------------------------------------------------------------------
@@ -319,45 +284,30 @@ def run_campaign(files, settings, jobs, on_row=None):
             raise
         return rows
     import multiprocessing
-    from concurrent.futures import FIRST_COMPLETED, wait
-
-    from pebble import ProcessPool
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
     context = multiprocessing.get_context("spawn")  # as on Windows and macOS
     stop = context.Event()
-    # pebble, unlike concurrent.futures, fails only the task whose worker died (its future
-    # raises ProcessExpired) and starts a new worker: the other shots go on.
-    pool = ProcessPool(min(jobs, len(files)), initializer=_worker_init, initargs=(stop,),
-                       context=context)
-    futures: dict = {}
-    stopped = None
+    pool = ProcessPoolExecutor(min(jobs, len(files)), context, _worker_init, (stop,))
+    futures = {}
     try:
-        try:
-            for k, path in enumerate(files):
-                futures[pool.schedule(fill_task, (str(path), settings))] = k
-        except Interrupted as exc:  # the scheduled shots return at once, not started
-            stop.set()
-            stopped = exc
-        while True:
-            try:
-                pending = [f for f, k in futures.items() if rows[k] is None]
-                if not pending:
-                    break
-                done, _ = wait(pending, return_when=FIRST_COMPLETED)
-                for future in done:
-                    k = futures[future]
-                    try:
-                        rows[k] = future.result()
-                    except Exception as exc:  # noqa: BLE001 - ProcessExpired, or a row
-                        rows[k] = _lost(files[k], settings, exc)  # that could not come back
-                    on_row(rows[k])
-            except Interrupted as exc:  # the running shots stop at their next stage and
-                stop.set()  # clean up; the others return at once, not started
-                stopped = exc
-    finally:
-        pool.close()
-        pool.join()
-    if stopped is not None:
-        stopped.rows = [r for r in rows if r is not None]
-        raise stopped
+        futures = {pool.submit(fill_task, str(path), settings): k
+                   for k, path in enumerate(files)}
+        pending = set(futures)
+        while pending:
+            done, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for future in done:
+                rows[futures[future]] = future.result()
+                on_row(rows[futures[future]])
+    except Interrupted as exc:
+        stop.set()  # the running shots stop at their next stage and clean up
+        for future in futures:
+            future.cancel()
+        pool.shutdown(wait=True, cancel_futures=True)
+        for future, k in futures.items():
+            if rows[k] is None and future.done() and not future.cancelled():
+                rows[k] = future.result()
+        exc.rows = [r for r in rows if r is not None]
+        raise
+    pool.shutdown(wait=True)
     return rows
