@@ -5,7 +5,9 @@ files in it) as its own transaction: its workbook, sidecar and archive entry are
 together or not at all. :func:`run_campaign` runs the shots in worker processes (``--jobs``);
 a worker fills many shots, so its start-up is paid once. A bad shot gets its one line and the
 others go on. Ctrl-C stops the batch: finished shots stay, the running ones clean up their
-temp files, the rest are not started.
+temp files, the rest are not started. A worker killed under a shot (SIGKILL, the
+out-of-memory killer) loses that shot only: its row says "lost", and the shots the broken
+pool took down with it are filled again by a new pool.
 
 :class:`FillSettings` is what the command line asks of every shot (one declaration, pickled
 to the workers); :func:`fill_one` fills one shot with it; :data:`TABLE` names the columns of
@@ -19,7 +21,7 @@ import time
 from pathlib import Path
 
 from .crush_law import law_name
-from .errors import AirgunXlError, OptionError
+from .errors import AirgunXlError, CampaignError, OptionError
 from .specification import Specification
 from .transaction import Interrupted, display
 
@@ -208,15 +210,20 @@ def _failed(path, output, status, message):
 # -- the worker side ---------------------------------------------------------------------
 
 _STOP = None  # the batch's stop event, in a worker
+_STARTED = None  # the batch's shared array: who started each shot, and how it ended
+
+#: ``_STARTED[k]`` when shot k's worker returned after publishing it, or without publishing
+#: it (0: not started; a positive value: the pid of the worker filling it now).
+PUBLISHED, UNPUBLISHED = -1, -2
 
 
-def _worker_init(stop):
+def _worker_init(stop, started=None):
     """A worker ignores Ctrl-C (the whole process group gets it) and stops at the next stage
     when the parent sets ``stop``: its fill's publication then cleans up."""
     import signal
 
-    global _STOP
-    _STOP = stop
+    global _STOP, _STARTED
+    _STOP, _STARTED = stop, started
     for name in ("SIGINT", "SIGTERM", "SIGHUP"):
         if hasattr(signal, name):
             signal.signal(getattr(signal, name), signal.SIG_IGN)
@@ -227,12 +234,24 @@ def _check_stop(stage):
         raise Interrupted(2)
 
 
-def fill_task(path, settings):
-    """Fill one shot of a batch; return its table row (never raises for the shot's own
-    faults: they are its row's status)."""
+def fill_task(path, settings, k=None):
+    """Fill one shot of a batch (shot ``k`` of the shared array, when the batch has one);
+    return its table row (never raises for the shot's own faults: they are its row's
+    status)."""
+    if _STARTED is not None and k is not None:
+        _STARTED[k] = os.getpid()
+    row = _fill_task(path, settings)
+    if _STARTED is not None and k is not None:
+        _STARTED[k] = PUBLISHED if row["status"] == "filled" else UNPUBLISHED
+    return row
+
+
+def _fill_task(path, settings):
     path = Path(path)
     output = Path(settings.output) if settings.output else default_output(path)
     warnings: list = []
+    if _STOP is not None and _STOP.is_set():  # the batch was stopped before this shot began
+        return _failed(path, output, "interrupted", "not started: the campaign was stopped")
     if not settings.force and os.path.lexists(output):  # filled before: not run again
         return _failed(path, output, "skipped", f"{display(output)}: already exists "
                                                 "(--force overwrites it)")
@@ -250,6 +269,35 @@ def fill_task(path, settings):
                                                f"{exc}); please report it")
     entry = filled.entry.ref if filled.entry is not None else None
     return row_of(path, output, filled, entry)
+
+
+def _lost(path, settings, pid):
+    """The row of a shot whose worker process (``pid``) died under it (a signal such as
+    SIGKILL, or the operating system's out-of-memory killer): nothing of it was published,
+    and the temp files it left in its output's folder are removed."""
+    import contextlib
+
+    from .transaction.locks import folder_lock
+    from .transaction.publication import recover
+
+    path = Path(path)
+    output = Path(settings.output) if settings.output else default_output(path)
+    if output.parent.is_dir():
+        with contextlib.suppress(OSError), folder_lock(output.parent):
+            recover(output.parent)  # the dead worker's temps and journal, if any
+    return _failed(path, output, "lost", f"its worker process (pid {pid}) died before the shot "
+                                         "was published (killed, or out of memory); nothing "
+                                         "of it was kept (fill it again)")
+
+
+def _unreported(path, settings):
+    """The row of a shot published by a worker the broken pool took down before its row
+    came back: the workbook is complete, its figures are not in this table."""
+    path = Path(path)
+    output = Path(settings.output) if settings.output else default_output(path)
+    return _failed(path, output, "skipped", f"{display(output)}: filled by this run, but its "
+                                            "row was lost when another worker died (its "
+                                            "figures are in the workbook)")
 
 
 # -- the parent side ---------------------------------------------------------------------
@@ -284,30 +332,74 @@ def run_campaign(files, settings, jobs, on_row=None):
             raise
         return rows
     import multiprocessing
-    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
     context = multiprocessing.get_context("spawn")  # as on Windows and macOS
+    todo = list(range(len(files)))
+    while todo:  # a round a pool; a new round only after a worker died under a shot
+        lost = _pool_round(context, files, settings, jobs, todo, rows, on_row)
+        todo = [k for k in todo if rows[k] is None]
+        if todo and not lost:  # no shot lost, none finished: the workers die as they start
+            raise CampaignError(f"{len(todo)} of {len(files)} shots were not filled: the "
+                                "worker processes died before they started a shot")
+    return rows
+
+
+def _pool_round(context, files, settings, jobs, todo, rows, on_row):
+    """Fill the shots ``todo`` in one pool; return how many were lost with their worker.
+
+    When a worker dies, concurrent.futures fails every shot left in its pool. The shared
+    array tells them apart: the dead worker's shot still holds its pid (lost, its temps
+    removed); the others' workers were told to stop, and their shots are filled by the next
+    round (or kept, when one was published before its row could come back).
+    """
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    from concurrent.futures.process import BrokenProcessPool
+
     stop = context.Event()
-    pool = ProcessPoolExecutor(min(jobs, len(files)), context, _worker_init, (stop,))
-    futures = {}
+    started = context.Array("q", len(files), lock=False)
+    pool = ProcessPoolExecutor(min(jobs, len(todo)), context, _worker_init, (stop, started))
+    futures: dict = {}
+    broken = False
     try:
-        futures = {pool.submit(fill_task, str(path), settings): k
-                   for k, path in enumerate(files)}
+        futures = {pool.submit(fill_task, str(files[k]), settings, k): k for k in todo}
         pending = set(futures)
         while pending:
             done, pending = wait(pending, return_when=FIRST_COMPLETED)
             for future in done:
-                rows[futures[future]] = future.result()
-                on_row(rows[futures[future]])
+                k = futures[future]
+                try:
+                    rows[k] = future.result()
+                except BrokenProcessPool:
+                    if not broken:  # the others stop at their next stage and clean up
+                        broken = True
+                        stop.set()
+                    continue
+                if broken and rows[k]["status"] == "interrupted":  # stopped by us: the
+                    rows[k] = None  # next round fills it
+                    continue
+                on_row(rows[k])
     except Interrupted as exc:
         stop.set()  # the running shots stop at their next stage and clean up
         for future in futures:
             future.cancel()
         pool.shutdown(wait=True, cancel_futures=True)
         for future, k in futures.items():
-            if rows[k] is None and future.done() and not future.cancelled():
+            if rows[k] is None and future.done() and not future.cancelled() \
+                    and future.exception() is None:
                 rows[k] = future.result()
         exc.rows = [r for r in rows if r is not None]
         raise
     pool.shutdown(wait=True)
-    return rows
+    lost = 0
+    for k in todo:
+        if rows[k] is not None:
+            continue
+        if started[k] > 0:  # started, and its worker never came back
+            rows[k] = _lost(files[k], settings, started[k])
+            lost += 1
+        elif started[k] == PUBLISHED:
+            rows[k] = _unreported(files[k], settings)
+        else:
+            continue  # not started, or stopped unpublished: the next round fills it
+        on_row(rows[k])
+    return lost

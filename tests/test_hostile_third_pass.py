@@ -8,6 +8,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 from conftest import TEMPLATE
@@ -512,3 +513,53 @@ def test_32_4_an_srs_past_its_cost_cap_is_refused_before_it_is_computed(tmp_path
     one_line(capsys, code, "--srs: found 2,000 rows over the record's 150,000 samples",
              "expected at most 2e+08")
     assert time.perf_counter() - began < 30  # refused, not computed (a bound, not a speed)
+
+
+def test_32_10_a_worker_killed_by_sigkill_loses_its_shot_only(tmp_path):
+    """SIGKILL the worker filling a shot of six (two jobs) while its workbook is staged (the
+    temp file names its owner's pid): that shot is named as lost in one line, the five others
+    are filled, the summary is written with the lost row, exit 2, no traceback, and no temp
+    file of the dead worker is left."""
+    import re
+    import signal
+    import time
+
+    import openpyxl
+    from conftest import template_with
+
+    day = tmp_path / "day"
+    day.mkdir()
+    for k in range(6):
+        template_with(day, A28=150.0 + 10 * k, A29=150.0 + 10 * k,
+                      A30=150.0 + 10 * k).rename(day / f"s{k}.xlsx")
+    summary = tmp_path / "day.xlsx"
+    proc = subprocess.Popen([sys.executable, "-m", "airgun_xl", "fill", str(day), "--jobs", "2",
+                             "--summary", str(summary)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    owner = re.compile(r"^\.(s\d)\.out\.xlsx\.(\d+)\.\d+-[0-9a-f]{16}\.airgun-xl-tmp$")
+    deadline = time.monotonic() + 120
+    killed = None
+    while killed is None and proc.poll() is None:  # polled, not slept
+        assert time.monotonic() < deadline
+        for path in day.iterdir():
+            m = owner.match(path.name)
+            if m:
+                os.kill(int(m[2]), signal.SIGKILL)
+                killed = m[1]
+                break
+        else:
+            time.sleep(0.005)
+    out, err = proc.communicate(timeout=300)
+    assert killed is not None, (out, err)
+    assert proc.returncode == 2, (out, err)
+    assert "Traceback" not in err and "BrokenProcessPool" not in err
+    lost = [line for line in err.splitlines() if ": lost: " in line]
+    assert len(lost) == 1 and "died before the shot was published" in lost[0], err
+    name = re.search(r"error: (\S+\.xlsx): lost", lost[0])[1]
+    filled = sorted(p.name for p in day.glob("*.out.xlsx"))
+    assert len(filled) == 5 and Path(name).name.replace(".xlsx", ".out.xlsx") not in filled
+    assert "6 shots: 5 filled, 0 failed, 1 lost, 0 skipped" in out
+    assert "1 of 6 shots lost with their worker (each said above)" in err
+    rows = list(openpyxl.load_workbook(summary, read_only=True)["Shots"].values)
+    assert sum(1 for r in rows if "lost" in r) == 1
+    assert [p.name for p in day.iterdir() if ".airgun-xl-" in p.name] == []

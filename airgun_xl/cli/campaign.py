@@ -73,15 +73,17 @@ def run_batch(args, settings):
 
     def said(row):  # each shot's outcome as it comes
         name = row["file"]
-        if row["status"] == "failed":  # named once, though the message may name it too
+        if row["status"] in ("failed", "lost"):  # named once, though the message may name it
             message = str(row["message"])
+            if row["status"] == "lost":
+                message = f"lost: {message}"
             _say(f"airgun-xl: error: {message}" if message.startswith(f"{name}: ") else
                  f"airgun-xl: error: {name}: {message}")
         elif row["status"] == "skipped":
             note([f"{name}: skipped, {row['output']} exists (--force overwrites it)"])
         else:
             warn([f"{name}: {w}" for w in row["warnings"]])
-        bar.update(row["status"] == "failed")
+        bar.update(row["status"] in ("failed", "lost"))
 
     try:
         rows = run_campaign(files, settings, min(jobs, len(files)), said)
@@ -95,14 +97,16 @@ def run_batch(args, settings):
     finally:
         bar.close()
     seconds = time.perf_counter() - started
-    counts = {s: sum(r["status"] == s for r in rows) for s in ("filled", "failed", "skipped")}
+    counts = {s: sum(r["status"] == s for r in rows)
+              for s in ("filled", "failed", "lost", "skipped")}
+    lost = f"{counts['lost']} lost, " if counts["lost"] else ""
     for row in rows:
         if row["status"] == "filled":
             print(f"{row['file']} -> {row['output']}: peak {row['peak_kg']:.5f} kG at "
                   f"{row['time_of_peak'] * 1e3:.4f} ms"
                   + (f", {row['warning_count']} warnings" if row["warning_count"] else "")
                   + (f", archived as {row['entry']}" if row.get("entry") else ""))
-    print(f"{len(files)} shots: {counts['filled']} filled, {counts['failed']} failed, "
+    print(f"{len(files)} shots: {counts['filled']} filled, {counts['failed']} failed, {lost}"
           f"{counts['skipped']} skipped, in {seconds:.2f} s with {min(jobs, len(files))} "
           f"job{'s' * (min(jobs, len(files)) > 1)} ({seconds / len(files):.2f} s a shot)")
     if summary is not None:
@@ -110,10 +114,13 @@ def run_batch(args, settings):
 
         write_campaign(summary, rows, f"Campaign: {len(files)} shots filled by airgun-xl "
                                       f"({counts['filled']} filled, {counts['failed']} "
-                                      f"failed, {counts['skipped']} skipped)", args.force,
+                                      f"failed, {lost}{counts['skipped']} skipped)", args.force,
                        label=summary.name)
         print(f"wrote {summary}: one row a shot, the peak against v0")
-    if counts["failed"]:
-        raise CampaignError(f"{counts['failed']} of {len(files)} shots failed (each said "
-                            "above); the others were filled")
+    if counts["failed"] or counts["lost"]:
+        failed, lost_ = counts["failed"], counts["lost"]
+        what = (f"{failed} of {len(files)} shots failed"
+                + (f" and {lost_} lost with their worker" if lost_ else "")) if failed else \
+            f"{lost_} of {len(files)} shots lost with their worker"
+        raise CampaignError(f"{what} (each said above); the others were filled")
     return 0
