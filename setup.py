@@ -23,6 +23,6 @@ def extension(name, source):
 
 setup(
     ext_modules=[extension("airgun_xl.engine._artsim", "airgun_xl/engine/_artsim.c"),
-                 extension("airgun_xl.workbook._sheet_xml", "airgun_xl/workbook/_sheet_xml.c")],
+                 extension("airgun_xl.xlsx._sheet_xml", "airgun_xl/xlsx/_sheet_xml.c")],
     options={"bdist_wheel": {"py_limited_api": "cp311"}},
 )

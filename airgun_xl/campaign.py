@@ -10,8 +10,8 @@ out-of-memory killer) loses that shot only: its row says "lost", and the shots t
 pool took down with it are filled again by a new pool.
 
 :class:`FillSettings` is what the command line asks of every shot (one declaration, pickled
-to the workers); :func:`fill_one` fills one shot with it; :data:`TABLE` names the columns of
-the campaign table (``fill --summary`` and ``history -o``).
+to the workers); :func:`fill_one` fills one shot with it. The campaign table (``fill
+--summary`` and ``history -o``) is :mod:`airgun_xl.reports.campaign`'s.
 """
 from __future__ import annotations
 
@@ -30,15 +30,13 @@ from .transaction import Interrupted, display
 DERIVED_SUFFIXES = (".out.xlsx", ".sweep.xlsx", ".srs.xlsx", ".design.xlsx", ".measured.xlsx",
                     ".calibrated.xlsx", ".convergence.xlsx")
 
-#: The title (document properties) of a campaign table: left out of a folder too, whatever
-#: its name.
-TABLE_TITLE = "airgun-xl campaign table"
-
 
 def is_campaign_table(path):
     """Whether ``path`` is a campaign table airgun-xl wrote (its core properties' title); a
     file that is not a readable workbook is not (it fails as a shot, on its own line)."""
     import zipfile
+
+    from .reports.campaign import TABLE_TITLE
 
     try:
         with zipfile.ZipFile(path) as z:
@@ -161,29 +159,6 @@ def fill_one(path, settings, warn, note=None, progress_for=None, started=None):
         if close is not None:
             close()
     return output, filled, root
-
-
-#: The campaign table, one row a shot: (heading, key, quantity code of
-#: :data:`airgun_xl.workbook.report.QUANTITIES` or None for text).
-TABLE = (
-    ("Shot", "file", None), ("v0 (m/s)", "v0", "m/s"), ("Peak (kG)", "peak_kg", "kG"),
-    ("Filtered peak (kG)", "filtered_peak_kg", "kG"), ("Time of peak (ms)", "time_of_peak", "s"),
-    ("Pulse (ms)", "pulse_duration", "s"), ("Max crush (m)", "max_crush", "m"),
-    ("Final length (m)", "final_length", "m"), ("Warnings", "warning_count", "count"),
-    ("Predicted verdict", "verdict", None), ("Status", "status", None),
-    ("Output", "output", None),
-)
-
-
-#: ``history -o``: the campaign table of an archive's runs.
-HISTORY_TABLE = (
-    ("Entry", "file", None), ("Created (UTC)", "created", None), ("v0 (m/s)", "v0", "m/s"),
-    ("Peak (kG)", "peak_kg", "kG"), ("Filtered peak (kG)", "filtered_peak_kg", "kG"),
-    ("Time of peak (ms)", "time_of_peak", "s"), ("Pulse (ms)", "pulse_duration", "s"),
-    ("Max crush (m)", "max_crush", "m"), ("Final length (m)", "final_length", "m"),
-    ("Warnings", "warning_count", "count"), ("Integrator", "integrator", None),
-    ("Crush law", "crush_law", None),
-)
 
 
 def row_of(path, output, filled, entry=None):

@@ -14,7 +14,7 @@ import numpy as np
 from . import limits
 from .cells import CELLS
 from .errors import WorkbookError
-from .workbook import guard
+from .readers import guard
 
 #: Default tolerance: Calc and Excel keep 15 significant digits.
 DEFAULT_RTOL = 1e-12
@@ -48,7 +48,7 @@ def _number(v):
 
 def _first_sheet(path):
     """The first sheet's values as a float grid, its text cells, and the raw bytes; every cap
-    of :mod:`airgun_xl.workbook.guard` is checked before python-calamine runs."""
+    of :mod:`airgun_xl.readers.guard` is checked before python-calamine runs."""
     import io
 
     from python_calamine import CalamineWorkbook

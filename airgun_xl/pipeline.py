@@ -12,11 +12,11 @@ from .engine.summary import summarize
 from .errors import AirgunXlError, StabilityError
 from .limits import check_memory, fill_bytes
 from .models import apply_model
+from .reports.fill import render_workbook
+from .reports.sidecar import SIDECAR_SUFFIXES, render_history, sidecar_path
 from .studies.check import after_run, before_run, quirk_fired, unloading_diverged
 from .transaction import Publication, check_output, display
 from .version import __version__
-from .workbook.sidecar import SIDECAR_SUFFIXES, render_history, sidecar_path
-from .workbook.writer import render_workbook
 
 
 @dataclasses.dataclass

@@ -114,7 +114,7 @@ class Result:
 
     def write(self, path: str | os.PathLike[str], force: bool = False,
               **options: Any) -> list[str]:
-        """Write the workbook (see :func:`airgun_xl.workbook.writer.write_workbook`)."""
-        from .workbook.writer import write_workbook
+        """Write the workbook (see :func:`airgun_xl.reports.fill.write_workbook`)."""
+        from .reports.fill import write_workbook
 
         return write_workbook(self, path, force=force, **options)

@@ -52,7 +52,7 @@ class Shot:
     Parameters
     ----------
     params : ShotParams
-    source : airgun_xl.workbook.reader.Source or None
+    source : airgun_xl.readers.shot_workbook.Source or None
         The workbook the parameters were read from; None for a shot built in code.
     warnings : list of str
         What reading the workbook found worth saying (e.g. stale cached formula values).
@@ -76,7 +76,7 @@ class Shot:
             A :class:`~airgun_xl.errors.CellError` naming the cell, or a
             :class:`~airgun_xl.errors.WorkbookError` for the file.
         """
-        from .workbook.reader import read_params, read_spec
+        from .readers.shot_workbook import read_params, read_spec
 
         params, source, warnings = read_params(path, read_law)
         spec, found = read_spec(source)

@@ -5,7 +5,7 @@ It is declared once here, as :class:`Specification`; it comes from three sources
 
 - a tolerance profile, a JSON file the lab names and edits (:func:`load_profile`; the
   package's ``profiles/`` folder holds the examples);
-- the shot workbook's ``Specification`` sheet (:mod:`airgun_xl.workbook.spec_sheet`), which the
+- the shot workbook's ``Specification`` sheet (:mod:`airgun_xl.readers.spec_sheet`), which the
   template writes empty;
 - command-line options (``--peak 12kG:10%``...).
 

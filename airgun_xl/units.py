@@ -8,6 +8,8 @@ from .errors import OptionError
 
 G = 9.80665  # standard gravity [m/s^2]
 KG_MS2 = 9800.0  # the macro's kG: a / 9800 (so 1 kG = 9800 m/s^2, not 1000 g)
+#: The macro's kG in standard g [g/kG]: shock labs give spectra in g.
+G_PER_KG = KG_MS2 / G
 
 _PEAK = {"kg": 1.0, "g": G / KG_MS2, "m/s2": 1 / KG_MS2, "m/s^2": 1 / KG_MS2,
          "m/s²": 1 / KG_MS2}

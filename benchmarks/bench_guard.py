@@ -34,7 +34,7 @@ def bench_reading(repeat, tmp):
     import airgun_xl
     from airgun_xl.diff import read_results
     from airgun_xl.outputs import Outputs
-    from airgun_xl.workbook import guard
+    from airgun_xl.readers import guard
 
     def fill_guard():
         data, _ = guard.read_input(TEMPLATE)

@@ -42,9 +42,9 @@ def benches(repeat, tmp):
 
     import airgun_xl
     from airgun_xl.cli import main
+    from airgun_xl.readers.recording import read_trace
     from airgun_xl.studies.calibrate import calibrate
     from airgun_xl.studies.recorder import Recorder
-    from airgun_xl.workbook.trace import read_trace
 
     p = airgun_xl.load(TEMPLATE).params.replace(delta=1e-6)
     truth = _truth_law()

@@ -29,8 +29,8 @@ def recordings(shot, changes, seed, shots=tuple(zip(SPEEDS, RATES, strict=True))
     """Each (speed, rate)'s run with ``changes`` through the recorder model (seed + its
     index), read with the recorder's axis reversed (as --sign -1)."""
     import airgun_xl
+    from airgun_xl.readers.recording import Trace
     from airgun_xl.studies.recorder import Recorder
-    from airgun_xl.workbook.trace import Trace
 
     out = []
     for i, (v, rate) in enumerate(shots):

@@ -397,7 +397,7 @@ def test_a_verdict_whose_workbook_fails_is_not_archived(tmp_path, recording, mon
     taken back, with the archive folder this command created; the command is one line, exit
     2."""
     from airgun_xl.errors import OutputError
-    from airgun_xl.workbook import acceptance as writer
+    from airgun_xl.reports import acceptance as writer
 
     def fail(*args, **kwargs):
         raise OutputError("v.xlsx: cannot be written (made to fail)")

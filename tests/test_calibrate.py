@@ -13,8 +13,8 @@ from numpy.polynomial import Polynomial
 import airgun_xl
 from airgun_xl.cli import main
 from airgun_xl.crush_law import LEGACY_LAW, CrushLaw
+from airgun_xl.readers.recording import read_trace
 from airgun_xl.studies.calibrate import calibrate, synthetic_measurement
-from airgun_xl.workbook.trace import read_trace
 
 SHOT = airgun_xl.load(TEMPLATE).params
 SPEEDS = (243.53532, 180.0)  # shot A, and a slower shot: the report combined two shots

@@ -12,8 +12,8 @@ import pytest
 from conftest import TEMPLATE, template_with, write_trace_csv
 
 from airgun_xl.archive import Archive
-from airgun_xl.campaign import TABLE
 from airgun_xl.cli import main
+from airgun_xl.reports.campaign import TABLE
 
 SPEEDS = {"a": 243.53532, "b": 200.0, "c": 150.0}
 

@@ -15,8 +15,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import airgun_xl
-from airgun_xl.workbook import formula_eval
-from airgun_xl.workbook.formula_eval import Evaluator, SheetView, arithmetic
+from airgun_xl.readers import formula_eval
+from airgun_xl.readers.formula_eval import Evaluator, SheetView, arithmetic
 
 CELLS = ["A1", "B2", "C3", "$D$4", "e5"]
 POSITIONS = [(1, 1), (2, 2), (3, 3), (4, 4), (5, 5)]

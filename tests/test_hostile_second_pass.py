@@ -59,7 +59,7 @@ def test_23_18_a_channel_name_with_brackets_keeps_its_unit(tmp_path, capsys, nam
     with nptdms.TdmsWriter(str(tmp_path / "n.tdms")) as writer:
         writer.write_segment([nptdms.ChannelObject("Recorder", name, _pulse(), properties={
             "wf_increment": 1e-5, "wf_start_offset": 0.0, "unit_string": "g"})])
-    from airgun_xl.workbook.trace import read_trace
+    from airgun_xl.readers.recording import read_trace
 
     trace = read_trace(tmp_path / "n.tdms")
     assert trace.units == ("s", "g")

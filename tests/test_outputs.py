@@ -14,8 +14,8 @@ from conftest import TEMPLATE, column, sheet_values
 import airgun_xl
 from airgun_xl.cli import main
 from airgun_xl.outputs import SHEET_DATA_ROWS, Outputs
-from airgun_xl.workbook import sidecar as sidecar_module
-from airgun_xl.workbook.columns_sheet import ColumnsWorksheet
+from airgun_xl.reports import sidecar as sidecar_module
+from airgun_xl.xlsx.columns_sheet import ColumnsWorksheet
 
 
 @pytest.fixture(scope="module")

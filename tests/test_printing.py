@@ -1,7 +1,7 @@
 """Issue 10: output a test engineer reads and prints.
 
 The page counts come from LibreOffice's PDF export, which prints every sheet: report sheets on
-one page each, data sheets not at all (airgun_xl/workbook/report.py).
+one page each, data sheets not at all (airgun_xl/xlsx/report.py).
 """
 import re
 import shutil

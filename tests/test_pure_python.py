@@ -13,7 +13,7 @@ def test_pure_fill_matches_the_macro(tmp_path):
     two legacy cases equals the macro's output to the legacy rule (1e-12 of each column)."""
     env = dict(os.environ, AIRGUN_XL_PURE="1")
     probe = subprocess.run([sys.executable, "-c", "from airgun_xl.engine import kernel; "
-                            "from airgun_xl.workbook import sheet_xml; "
+                            "from airgun_xl.xlsx import sheet_xml; "
                             "print(kernel.COMPILED, sheet_xml.COMPILED)"], env=env,
                            capture_output=True, text=True, check=True)
     assert probe.stdout.strip() == "False False"

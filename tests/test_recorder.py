@@ -11,11 +11,11 @@ from numpy.polynomial import Polynomial
 import airgun_xl
 from airgun_xl.cli import main
 from airgun_xl.crush_law import LEGACY_LAW, CrushLaw
+from airgun_xl.readers.recording import read_trace
 from airgun_xl.studies.calibrate import calibrate, correlation_time
 from airgun_xl.studies.measured import baseline
 from airgun_xl.studies.recorder import Recorder
 from airgun_xl.units import KG_MS2, G
-from airgun_xl.workbook.trace import read_trace
 
 SHOT = airgun_xl.load(TEMPLATE).params.replace(delta=1e-6)
 SPEEDS = (243.53532, 200.0, 150.0)

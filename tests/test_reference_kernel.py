@@ -71,9 +71,9 @@ def test_batch_bit_for_bit(integrator):
 
 
 def test_sheet_xml_python_twin_writes_the_same_text():
-    from airgun_xl.workbook import sheet_xml
+    from airgun_xl.xlsx import sheet_xml
 
-    compiled_xml = pytest.importorskip("airgun_xl.workbook._sheet_xml")
+    compiled_xml = pytest.importorskip("airgun_xl.xlsx._sheet_xml")
     rng = np.random.default_rng(5)
     values = np.concatenate([rng.normal(size=200) * 10.0 ** rng.integers(-300, 300, 200),
                              [0.0, -0.0, 5e-324, 1.7976931348623157e308, 0.1, 1e-5, 123456.0]])
@@ -123,9 +123,9 @@ def test_the_twins_refuse_the_same_inputs_and_never_write_out_of_bounds(case):
 def test_the_sheet_xml_twins_refuse_the_same_inputs():
     """The Python render_cells took int64 arrays and long column names, which the C one
     refuses: now both refuse them, with the same message."""
-    from airgun_xl.workbook import sheet_xml
+    from airgun_xl.xlsx import sheet_xml
 
-    compiled_xml = pytest.importorskip("airgun_xl.workbook._sheet_xml")
+    compiled_xml = pytest.importorskip("airgun_xl.xlsx._sheet_xml")
     for column, values in (("A" * 9, np.zeros(3)), ("A", np.zeros(3, dtype=np.int64)),
                            ("A", np.zeros((3, 2))[:, 0])):
         said = [_refusal(lambda f=f: f(column, 1, values))

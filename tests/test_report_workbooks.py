@@ -34,7 +34,7 @@ def workbooks(tmp_path_factory):
 
 def report_sheets(path):
     """[(sheet, (min_col, min_row, max_col, max_row))] of the sheets that print: a data
-    sheet's print area is the blank XFD1 (airgun_xl/workbook/report.py)."""
+    sheet's print area is the blank XFD1 (airgun_xl/xlsx/report.py)."""
     wb = openpyxl.load_workbook(path)
     out = []
     for ws in wb.worksheets:

@@ -313,9 +313,9 @@ def test_31_9_shot_as_prediction_exported_from_t_0_is_accepted_with_fills_verdic
     assert f"predicted: {word}" in filled
     s = combine(None, None, spec(**{"peak": "12kG:10%", "duration": "5ms:10%",
                                     "velocity_change": "240m/s:10%"}))
+    from airgun_xl.readers.recording import read_trace
     from airgun_xl.studies.acceptance import predicted_verdict
     from airgun_xl.studies.measured import prepare
-    from airgun_xl.workbook.trace import read_trace
 
     rec = prepare(read_trace(str(path)), None, anti_alias="none")
     assert rec.base.where in ("none", "after") and rec.base.offset == 0.0

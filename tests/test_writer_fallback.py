@@ -5,7 +5,7 @@ import pytest
 from conftest import TEMPLATE
 
 from airgun_xl.cli import main
-from airgun_xl.workbook import columns_sheet
+from airgun_xl.xlsx import columns_sheet
 
 
 def _cells(path):

@@ -8,9 +8,9 @@ import numpy as np
 
 from ..cells import CELLS
 from ..crush_law import law_name
+from ..reports.sidecar import have_parquet, render_history
 from ..transaction import display
 from ..version import __version__
-from ..workbook.sidecar import have_parquet, render_history
 from .store import safe_name
 
 LIBRARIES = ("numpy", "pandas", "openpyxl", "xlsxwriter", "formulas", "python-calamine",

@@ -51,11 +51,11 @@ def run(args):
     import dataclasses
 
     from ..errors import OptionError
+    from ..readers.recording import input_file, read_trace
     from ..shot import Shot
     from ..studies.acceptance import judge_record
     from ..studies.measured import prepare
     from ..transaction import check_output
-    from ..workbook.trace import input_file, read_trace
     from .messages import warn
     from .spec_options import resolve_spec
 
@@ -91,7 +91,7 @@ def run(args):
              ("Units read", f"time {trace.units[0]}, acceleration {trace.units[1]}"),
              ("Record judged", verdict.definitions[0].removeprefix("record judged: ")),
              ("Baseline", rec.base.words()), ("Verdict", verdict.word)]
-    from ..workbook.acceptance import write_acceptance
+    from ..reports.acceptance import write_acceptance
 
     # the verdict's record first, taken back if the workbook is not published: a failure or
     # a signal leaves neither

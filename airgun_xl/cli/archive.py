@@ -193,8 +193,7 @@ def run_history(args):
                 print(printable(f"  {v['shot']}@{v['version']:<6} {v['verdict']:<5} "
                                 f"{v['created']}  {v['recording']}"))
     if args.output:
-        from ..campaign import HISTORY_TABLE
-        from ..workbook.campaign import write_campaign
+        from ..reports.campaign import HISTORY_TABLE, write_campaign
 
         title = f"History of {display(archive.root)}: {len(rows)} runs"
         if where:

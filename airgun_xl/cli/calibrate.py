@@ -58,12 +58,12 @@ def _pairs(values):
 
 
 def run(args):
+    from ..readers.recording import input_file, read_trace
+    from ..reports.calibration import write_calibration
     from ..shot import Shot
     from ..studies.calibrate import calibrate, check_fit
     from ..studies.shock import CFC_CLASSES, cfc_coefficients
     from ..transaction import check_output
-    from ..workbook.calibration import write_calibration
-    from ..workbook.trace import input_file, read_trace
 
     files = _pairs(args.pairs)
     if args.cfc is not None and args.cfc not in CFC_CLASSES:

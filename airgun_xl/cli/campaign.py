@@ -110,7 +110,7 @@ def run_batch(args, settings):
           f"{counts['skipped']} skipped, in {seconds:.2f} s with {min(jobs, len(files))} "
           f"job{'s' * (min(jobs, len(files)) > 1)} ({seconds / len(files):.2f} s a shot)")
     if summary is not None:
-        from ..workbook.campaign import write_campaign
+        from ..reports.campaign import write_campaign
 
         write_campaign(summary, rows, f"Campaign: {len(files)} shots filled by airgun-xl "
                                       f"({counts['filled']} filled, {counts['failed']} "

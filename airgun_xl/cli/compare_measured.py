@@ -33,13 +33,13 @@ def run(args):
     import numpy as np
 
     from ..models import apply_model
+    from ..readers.recording import input_file, read_trace
+    from ..reports.measured import write_comparison
     from ..shot import Shot
     from ..studies.check import after_run
     from ..studies.measured import ANTI_ALIAS_ORDER, compare
     from ..studies.shock import CFC_CLASSES, cfc_coefficients
     from ..transaction import check_output
-    from ..workbook.measured import write_comparison
-    from ..workbook.trace import input_file, read_trace
     from .messages import warn
 
     if args.cfc is not None and args.cfc not in CFC_CLASSES:

@@ -27,9 +27,9 @@ def add_parser(sub):
 
 
 def run(args):
+    from ..reports.convergence import write_convergence
     from ..shot import Shot
     from ..studies.convergence import default_ladder, ladder, parse_duration
-    from ..workbook.convergence import write_convergence
     from .messages import warn
 
     shot = Shot.from_workbook(args.shot)

@@ -110,9 +110,9 @@ def run(args):
 
 
 def run_srs(args):
+    from ..readers.recording import read_spectrum
     from ..shot import Shot
     from ..studies.design import solve_srs, variable
-    from ..workbook.trace import read_spectrum
 
     for flag, value in (("--scheduler", args.scheduler), ("--workers", args.workers),
                         ("--chunk", args.chunk)):

@@ -38,7 +38,7 @@ def _tolerance(option, text):
 
 def run(args):
     from ..diff import diff_workbooks, format_report
-    from ..workbook.diff_report import write_diff_report
+    from ..reports.diff_report import write_diff_report
 
     rtol, atol = _tolerance("--rtol", args.rtol), _tolerance("--atol", args.atol)
     if args.report:

@@ -76,7 +76,7 @@ def _ms(seconds):
 
 def print_summary(output, filled):
     from ..engine.summary import PULSE_FRACTION
-    from ..workbook.sheets import variant_name
+    from ..xlsx.sheets import variant_name
 
     result, s, stride, sidecar = filled.result, filled.summary, filled.stride, filled.sidecar
     lines = [f"wrote {output}: {result.rows:,} rows"
@@ -107,7 +107,7 @@ def print_summary(output, filled):
         lines.append(f"  full history in {sidecar}")
     v = filled.verdict
     if v is not None:
-        from ..workbook.sheets import flagged_figures
+        from ..xlsx.sheets import flagged_figures
 
         doubted = flagged_figures(filled.warnings).get("Peak acceleration (raw)")
         lines.append(f"  specification ({v.spec.source or 'options'}), predicted: {v.word}"

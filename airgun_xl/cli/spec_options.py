@@ -72,6 +72,7 @@ def options_spec(args):
     airgun_xl.errors.OptionError
         Naming the option and what it expects.
     """
+    from ..readers.recording import read_spectrum
     from ..specification import (
         ALIASES,
         KEYS,
@@ -83,7 +84,6 @@ def options_spec(args):
         spec_of_keys,
         typed_unit,
     )
-    from ..workbook.trace import read_spectrum
 
     parsed = {}
     for key, option in QUANTITY_OPTIONS:

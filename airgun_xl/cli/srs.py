@@ -31,6 +31,7 @@ def run(args):
     import numpy as np
 
     from ..models import apply_model
+    from ..reports.srs import write_srs
     from ..shot import Shot
     from ..studies.check import after_run, before_run
     from ..studies.shock import (
@@ -41,7 +42,6 @@ def run(args):
         srs,
     )
     from ..transaction import check_output
-    from ..workbook.srs import write_srs
     from .messages import warn
 
     if args.cfc is not None and args.cfc not in CFC_CLASSES:

@@ -44,10 +44,10 @@ def _progress_bar(total):
 
 
 def run(args):
+    from ..reports.sweep import write_sweep
     from ..shot import Shot
     from ..studies.sensitivity import sobol
     from ..studies.sweep import grid, monte_carlo, parse_sds, parse_vary, spread
-    from ..workbook.sweep import write_sweep
 
     shot = Shot.from_workbook(args.shot)
     varies = [parse_vary(v) for v in args.vary]

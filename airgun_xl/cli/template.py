@@ -12,7 +12,7 @@ def add_parser(sub):
 
 
 def run(args):
-    from ..workbook.template import write_template
+    from ..reports.template import write_template
 
     write_template(args.output, force=args.force)
     print(f"wrote {args.output}")

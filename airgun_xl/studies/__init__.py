@@ -5,5 +5,5 @@
 - :mod:`.design`: the v0 or geometry that gives a requested peak (and pulse);
 - :mod:`.sweep`: grids and Monte Carlo of many shots on the batch kernel.
 
-Their workbooks are written by :mod:`airgun_xl.workbook`; the CLI's subcommands call them.
+Their workbooks are written by :mod:`airgun_xl.reports`; the CLI's subcommands call them.
 """

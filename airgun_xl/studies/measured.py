@@ -412,7 +412,7 @@ def _figures(time, accel, impact):
 
 def compare(pred_time, pred_kg, trace, cfc=None, alignment="threshold", rigid=None,
             anti_alias="auto"):
-    """Score a predicted pulse against a measured :class:`~airgun_xl.workbook.trace.Trace`.
+    """Score a predicted pulse against a measured :class:`~airgun_xl.readers.recording.Trace`.
 
     Parameters
     ----------

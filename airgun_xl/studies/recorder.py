@@ -64,10 +64,10 @@ class Recorder:
 
     def record(self, result, seed=0, name="recorder"):
         """The recording of a run (a :class:`~airgun_xl.result.Result`) as a
-        :class:`~airgun_xl.workbook.trace.Trace` in kG, on the recorder's clock."""
+        :class:`~airgun_xl.readers.recording.Trace` in kG, on the recorder's clock."""
         from scipy.signal import butter, sosfilt
 
-        from ..workbook.trace import Trace
+        from ..readers.recording import Trace
 
         ok = np.isfinite(result.accel_kg)
         t_run, a_run = result.history.time[ok], result.accel_kg[ok]
@@ -94,7 +94,7 @@ class Recorder:
             decimal="."):
         """Write ``trace`` as a data-acquisition export: ``metadata`` lines (``# ...``) above
         a header with the units, the values in ``time_unit`` and ``accel_unit``."""
-        from ..workbook.trace import ACCEL_UNITS, TIME_UNITS
+        from ..readers.recording import ACCEL_UNITS, TIME_UNITS
 
         t = trace.time / TIME_UNITS[time_unit]
         a = trace.accel_kg / ACCEL_UNITS[accel_unit]

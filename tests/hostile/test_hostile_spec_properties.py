@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 from airgun_xl.cli import main
 from airgun_xl.cli.spec_options import options_spec
 from airgun_xl.errors import AirgunXlError
+from airgun_xl.readers.spec_sheet import ROWS, spec_from_cells
 from airgun_xl.specification import check, load_profile
-from airgun_xl.workbook.spec_sheet import ROWS, spec_from_cells
 
 TEXT = st.one_of(st.text(max_size=12), st.sampled_from([
     "12kG:10%", "12kG", "0.3ms:10%", "35m/s:-10%,+20%", "12kG:150%", ":10%", "12kG:",

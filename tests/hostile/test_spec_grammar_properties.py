@@ -20,6 +20,7 @@ from hypothesis import strategies as st
 
 from airgun_xl.cli.spec_options import PLAIN_OPTIONS, QUANTITY_OPTIONS, options_spec
 from airgun_xl.errors import AirgunXlError
+from airgun_xl.readers.spec_sheet import FIRST_ROW, ROWS, spec_from_cells
 from airgun_xl.specification import (
     CAPS,
     CFC_CLASSES,
@@ -39,7 +40,6 @@ from airgun_xl.specification import (
     spec_of_keys,
     value_of,
 )
-from airgun_xl.workbook.spec_sheet import FIRST_ROW, ROWS, spec_from_cells
 
 SETTINGS = settings(max_examples=150, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.function_scoped_fixture])

@@ -140,32 +140,3 @@ def _srs_rows(cells: dict) -> SrsRequirement | None:
 
 def _blank(value) -> bool:
     return value is None or (isinstance(value, str) and not value.strip())
-
-
-def write_spec_sheet(wb, shot=None):
-    """Add the sheet, empty, to an xlsxwriter workbook (the template's)."""
-    from .report import one_page
-
-    ws = wb.add_worksheet(SHEET_NAME)
-    bold = wb.add_format({"bold": True})
-    wrap = wb.add_format({"text_wrap": True, "valign": "top"})
-    ws.set_column(0, 0, 24)
-    ws.set_column(1, 1, 14)
-    ws.set_column(2, 2, 14)
-    ws.set_column(3, 3, 52)
-    ws.set_column(5, 6, 14)
-    for col, text in enumerate(("Field", "Value", "Unit", "Meaning")):
-        ws.write_string(0, col, text, bold)
-    ws.write_string(0, 5, "Frequency [Hz]", bold)
-    ws.write_string(0, 6, "SRS level [g]", bold)
-    for k, (name, label, meaning) in enumerate(ROWS):
-        row = FIRST_ROW - 1 + k
-        ws.write_string(row, 0, label)
-        ws.write_string(row, 2, UNITS_SHOWN[name] if name in UNITS_SHOWN else KEYS[name].unit)
-        ws.write_string(row, 3, meaning, wrap)
-    note_row = FIRST_ROW + len(ROWS)
-    ws.write_string(note_row, 0, "fill, design and accept read this sheet over a --profile; "
-                    "their options (--peak 12kG:10%...) override it field by field. A number "
-                    "is in the row's unit; text carries its own (12kG, 0.3ms, -3dB).")
-    one_page(ws, note_row, 6, shot=shot, title=SHEET_NAME)
-    return ws

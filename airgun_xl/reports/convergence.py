@@ -4,8 +4,8 @@ import math
 from ..errors import OutputError
 from ..studies.convergence import QUANTITIES
 from ..transaction import Publication, display
-from .report import Style, chart_size, one_page
-from .xlsx import close_workbook, new_workbook
+from ..xlsx.report import Style, chart_size, one_page
+from ..xlsx.workbook import close_workbook, new_workbook
 
 COLORS = ("#1f4e79", "#c00000", "#548235")
 
@@ -37,7 +37,7 @@ def write_convergence(ladders, path, force, shot, png=None):
     return figure is not None
 
 
-#: Quantity codes (:data:`airgun_xl.workbook.report.QUANTITIES`) of the figures' units.
+#: Quantity codes (:data:`airgun_xl.xlsx.report.QUANTITIES`) of the figures' units.
 _CODES = {"kG": "kG", "s": "s", "m": "m", "kg": "kg"}
 
 

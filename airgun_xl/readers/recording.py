@@ -2,7 +2,7 @@
 acceleration, with units from the header (``time [ms]``, ``accel (g)``, a TDMS channel's
 ``unit_string``) or given, every row checked; and a required shock response spectrum (CSV).
 
-The file is read like any untrusted input (:func:`airgun_xl.workbook.guard.read_bytes`: a
+The file is read like any untrusted input (:func:`airgun_xl.readers.guard.read_bytes`: a
 regular file, size capped). Each fault is one line naming the row: a row that is not two
 numbers, NaN, time that does not increase, a gap in a constant sample rate, too few samples,
 a unit that cannot be told.

@@ -8,7 +8,7 @@ are recomputed.
 .xlsx and .xlsm are read with openpyxl (formulas and cached values); .xls with python-calamine
 (cached values only, which Excel wrote and which are trusted).
 
-A workbook may come from anyone: :mod:`airgun_xl.workbook.guard` checks the file and the zip
+A workbook may come from anyone: :mod:`airgun_xl.readers.guard` checks the file and the zip
 before a parser runs, only the first :data:`~airgun_xl.limits.BLOCK_ROWS` rows are read, and
 only real formula cells (``<f>``) are formulas: a text cell that starts with ``=`` is text.
 """
@@ -42,7 +42,7 @@ CACHE_RTOL = 1e-12
 
 def rows_read(title):
     """How many rows of a sheet are read: the block's, or the Specification sheet's to the
-    end of its SRS rows (:data:`~airgun_xl.workbook.spec_sheet.LAST_ROW`)."""
+    end of its SRS rows (:data:`~airgun_xl.readers.spec_sheet.LAST_ROW`)."""
     return SPEC_LAST_ROW if title.upper() == SPEC_KEY else limits.BLOCK_ROWS
 
 
@@ -332,7 +332,7 @@ def sheet_values(source, key, title, label):
 
 def law_values(source):
     """The Crush law sheet's cells, evaluated (:func:`sheet_values`), for
-    :func:`~airgun_xl.workbook.law_sheet.law_from_cells`; and the warnings raised."""
+    :func:`~airgun_xl.readers.law_sheet.law_from_cells`; and the warnings raised."""
     return sheet_values(source, LAW_KEY, LAW_SHEET, "crush law")
 
 

@@ -162,7 +162,7 @@ def variant_name(result):
 
 
 def _summary_rows(result, summary, timings):
-    """(label, value in SI, quantity code of :data:`~airgun_xl.workbook.report.QUANTITIES`
+    """(label, value in SI, quantity code of :data:`~airgun_xl.xlsx.report.QUANTITIES`
     or "" for text, definition) per Summary row."""
     p = result.params
     s = summary

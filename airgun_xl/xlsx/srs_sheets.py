@@ -1,15 +1,12 @@
 """The shock response spectrum sheets: a log-log chart in g (with a requirement drawn over it
-when there is one) and its table; the ``srs`` workbook, and the SRS sheets of a design to a
-required spectrum."""
+when there is one) and its table. The ``srs`` workbook is made of them
+(:mod:`airgun_xl.reports.srs`), and so are the SRS sheets of a design to a required spectrum."""
 import numpy as np
 
-from ..units import KG_MS2, G
+from ..units import G_PER_KG
 from .charts import log_axis, titled
-from .report import Style, chart_size, one_page, report_workbook
+from .report import Style, chart_size, one_page
 from .sheets import write_about, write_warnings
-
-#: The macro's kG in standard g: shock labs give spectra in g.
-G_PER_KG = KG_MS2 / G
 
 #: The SRS sheet's column of the chart's data, right of its printed range.
 CHART_DATA_COL = 20
@@ -103,13 +100,3 @@ def add_srs_sheets(wb, frequencies, spectrum_kg, about, shot=None, requirement=N
     chart.set_size(chart_size(17, 26))
     ws.insert_chart(head + 1, 0, chart)
     one_page(ws, head + 28, 15, shot=shot, title=name)
-
-
-def write_srs(path, frequencies, spectrum, about, force=False, shot=None, requirement=None,
-              warnings=None):
-    """Write the SRS workbook (:func:`add_srs_sheets`): frequencies [Hz], the maximax response
-    [kG]; ``about`` is a list of (label, text) lines for the head of the sheet (shot, Q,
-    filter); ``warnings``, the run's, are listed under them."""
-    with report_workbook(path, force) as wb:
-        add_srs_sheets(wb, frequencies, spectrum, about, shot, requirement,
-                       warnings=warnings)

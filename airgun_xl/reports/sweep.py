@@ -5,10 +5,18 @@ from xlsxwriter.utility import xl_range_abs
 
 from ..cells import BY_ADDRESS
 from ..engine.batch import FIGURES
-from .charts import nice_range
-from .columns_sheet import ColumnsWorksheet
-from .report import Style, axis, chart_size, general_format, not_printed, one_page, report_workbook
-from .sheets import write_number_columns
+from ..xlsx.charts import nice_range
+from ..xlsx.columns_sheet import ColumnsWorksheet
+from ..xlsx.report import (
+    Style,
+    axis,
+    chart_size,
+    general_format,
+    not_printed,
+    one_page,
+    report_workbook,
+)
+from ..xlsx.sheets import write_number_columns
 
 FIGURE_HEADERS = {"peak_kg": "Peak (kG)", "time_of_peak": "Time of peak (s)",
                   "filtered_peak_kg": "Filtered peak (kG)",

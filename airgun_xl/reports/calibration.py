@@ -14,16 +14,12 @@ import numpy as np
 from ..crush_law import LEGACY_LAW
 from ..studies.calibrate import AT_BOUND
 from ..transaction import display
-from .charts import line_series, nice_range, titled
-from .columns_sheet import ColumnsWorksheet
-from .law_sheet import write_law_sheet
-from .report import Style, axis, chart_size, not_printed, one_page, report_workbook, shown
-from .sheets import write_about, write_number_columns, write_parameters, write_warnings
-from .writer import (
-    print_outputs_block,
-    sheet_names,
-    write_cells,
-)
+from ..xlsx.charts import line_series, nice_range, titled
+from ..xlsx.columns_sheet import ColumnsWorksheet
+from ..xlsx.law_sheet import write_law_sheet
+from ..xlsx.report import Style, axis, chart_size, not_printed, one_page, report_workbook, shown
+from ..xlsx.sheets import write_about, write_number_columns, write_parameters, write_warnings
+from ..xlsx.shot_sheets import print_outputs_block, sheet_names, write_cells
 
 #: Fitted name -> (parameter cell (row, col), ShotParams field).
 CELLS = {"E40": ((40, 5), "sigmay"), "E43": ((43, 5), "zeta")}

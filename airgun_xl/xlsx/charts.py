@@ -200,7 +200,7 @@ def add_charts(workbook, sheet, refs, data, max_time, labels=None, x_ranges=None
     workbook : xlsxwriter.Workbook
     sheet : xlsxwriter worksheet
     refs : dict
-        Series key -> :class:`airgun_xl.workbook.sheets.Ref` (where its cells are).
+        Series key -> :class:`airgun_xl.xlsx.sheets.Ref` (where its cells are).
     data : dict
         Series key -> full-resolution (x, y), for the axis ranges.
     max_time : float

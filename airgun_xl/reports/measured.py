@@ -4,11 +4,11 @@ import math
 
 import numpy as np
 
-from .charts import line_series, log_axis, nice_range, titled
-from .columns_sheet import ColumnsWorksheet
-from .report import axis, chart_size, not_printed, one_page, report_workbook
-from .sheets import write_about, write_number_columns, write_warnings
-from .srs import G_PER_KG
+from ..units import G_PER_KG
+from ..xlsx.charts import line_series, log_axis, nice_range, titled
+from ..xlsx.columns_sheet import ColumnsWorksheet
+from ..xlsx.report import axis, chart_size, not_printed, one_page, report_workbook
+from ..xlsx.sheets import write_about, write_number_columns, write_warnings
 
 ROWS = (("Peak acceleration", "peak_kg", "kG", 1.0, "0.000"),
         ("Time of peak, after impact", "time_of_peak", "ms", 1e3, "0.0000"),

@@ -33,7 +33,7 @@ class _Workbook(xlsxwriter.Workbook):
 
 def new_workbook(path):
     """An xlsxwriter Workbook with the project's fixed options and properties; strings are
-    never turned into formulas, links or numbers (:mod:`airgun_xl.workbook.safe_text`)."""
+    never turned into formulas, links or numbers (:mod:`airgun_xl.xlsx.safe_text`)."""
     wb = _Workbook(str(path), dict(WORKBOOK_OPTIONS, in_memory=True))
     wb.set_properties(PROPERTIES)
     return wb

@@ -17,9 +17,9 @@ legacy macro reads) cached values of .xlsx files without recalculating them.
 """
 from ..outputs import SHEET_NAME as OUTPUTS_SHEET
 from ..outputs import block_cells
-from .formula_eval import Evaluator, SheetView
-from .report import report_workbook
-from .spec_sheet import write_spec_sheet
+from ..readers.formula_eval import Evaluator, SheetView
+from ..xlsx.report import report_workbook
+from ..xlsx.spec_sheet import write_spec_sheet
 
 SHEET = "Sheet1"
 

@@ -5,14 +5,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..engine.decimate import minmax_indices
-from ..units import KG_MS2, G
-from .charts import POINT_BUDGET, line_series, log_axis, nice_range, titled
-from .columns_sheet import ColumnsWorksheet
-from .report import axis, chart_size, not_printed, one_page, report_workbook
-from .sheets import write_about, write_number_columns, write_warnings, write_wrapped
+from ..units import G_PER_KG
+from ..xlsx.charts import POINT_BUDGET, line_series, log_axis, nice_range, titled
+from ..xlsx.columns_sheet import ColumnsWorksheet
+from ..xlsx.report import axis, chart_size, not_printed, one_page, report_workbook
+from ..xlsx.sheets import write_about, write_number_columns, write_warnings, write_wrapped
 
 RECORD, IDEAL, LIMIT, REQUIRED = "#c00000", "#1f4e79", "#7f7f7f", "#000000"
-G_PER_KG = KG_MS2 / G
 
 #: Printed columns of the Verdict page, and a chart's width in columns.
 VERDICT_COLS, CHART_COLS = 8, 14

@@ -5,10 +5,10 @@ from pathlib import Path
 import numpy as np
 
 from ..engine.decimate import minmax_indices
-from .charts import nice_range
-from .columns_sheet import ColumnsWorksheet
-from .report import Style, axis, chart_size, one_page, report_workbook
-from .sheets import write_number_columns
+from ..xlsx.charts import nice_range
+from ..xlsx.columns_sheet import ColumnsWorksheet
+from ..xlsx.report import Style, axis, chart_size, one_page, report_workbook
+from ..xlsx.sheets import write_number_columns
 
 
 def write_diff_report(report, path, force=False):

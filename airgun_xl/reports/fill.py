@@ -30,15 +30,14 @@ from xlsxwriter.utility import xl_rowcol_to_cell
 from ..cells import PARAMETER_COLUMNS
 from ..engine.summary import SPECTRUM_MAX_HZ, summarize
 from ..outputs import SHEET_NAME, Outputs
+from ..readers.formula_eval import Evaluator, FormulaFailure
+from ..readers.law_sheet import SHEET_NAME as LAW_SHEET
 from ..transaction import atomic_path, check_output, display
-from .charts import add_charts, series_data
-from .columns_sheet import ColumnsWorksheet
-from .formula_eval import Evaluator, FormulaFailure
-from .law_sheet import SHEET_NAME as LAW_SHEET
-from .law_sheet import write_law_sheet
-from .report import not_printed, one_page
-from .safe_text import copyable_formula, sheet_title
-from .sheets import (
+from ..xlsx.charts import add_charts, series_data
+from ..xlsx.columns_sheet import ColumnsWorksheet
+from ..xlsx.law_sheet import write_law_sheet
+from ..xlsx.report import not_printed
+from ..xlsx.sheets import (
     Ref,
     variant_name,
     write_chart_data,
@@ -48,7 +47,8 @@ from .sheets import (
     write_summary,
     write_tracked,
 )
-from .xlsx import close_workbook, new_workbook
+from ..xlsx.shot_sheets import print_outputs_block, sheet_names, write_cells
+from ..xlsx.workbook import close_workbook, new_workbook
 
 #: Header text per 0-based column index, as the macro writes it (P is ours).
 HEADERS = {
@@ -59,19 +59,6 @@ HEADERS = {
 }
 
 
-#: The sheets a fill adds after sheet 1, by their fixed names.
-OUTPUT_SHEETS = ("Parameters", "Summary", "Charts", "Tracked", "Spectrum", "ChartData", "SRS",
-                 "SRS table", SHEET_NAME, LAW_SHEET)
-
-
-def sheet_names(source_title):
-    """Sheet 1's title (made valid) and the added sheets' names, renamed when sheet 1 already
-    has one of them (``Summary`` -> ``Summary (2)``)."""
-    first = sheet_title(source_title if source_title is not None else "Sheet1")
-    names = {"first": first}
-    for name in OUTPUT_SHEETS:
-        names[name] = sheet_title(name, taken=[first])
-    return names
 
 
 #: Sheet 1 result columns (0-based) -> (output group, History/Result attribute).
@@ -152,38 +139,6 @@ def _block_values(source, columns, rows, finals):
     return values, warnings
 
 
-def write_cells(ws, cells, values=None):
-    """Copy ``{(row, col): (value, formula)}`` cells (1-based) as they were; return warnings.
-
-    Formulas stay formulas, cached with ``values[(row, col)]``, unless they reach outside the
-    workbook (DDE, another file, a web call): those are written as their cached value. Text is
-    always written as text; numbers exactly.
-    """
-    values = values or {}
-    warnings = []
-    for (row, col), (cached, formula) in sorted(cells.items()):
-        r, c = row - 1, col - 1
-        if formula is not None and copyable_formula(formula):
-            value = values.get((row, col), cached)
-            ws.write_formula(r, c, formula, None, "" if value is None else value)
-            continue
-        if formula is not None:
-            warnings.append(f"{ws.get_name()}!{xl_rowcol_to_cell(r, c)}: the formula reaches "
-                            "outside the workbook (DDE, another file or a web call); written "
-                            "as its cached value")
-        if cached is None:
-            continue
-        if isinstance(cached, bool):
-            ws.write_boolean(r, c, cached)
-        elif isinstance(cached, (int, float)) and math.isfinite(cached):
-            ws.write_number_column(r, c, [cached])  # exact: xlsxwriter keeps 16 digits
-        elif isinstance(cached, (int, float)):
-            ws.write_number(r, c, cached)  # NaN/inf: written as an error cell
-        else:
-            ws.write_string(r, c, str(cached))  # text stays text, whatever it starts with
-    return warnings
-
-
 def _write_sheet1(wb, result, outputs, keep, stride, title):
     """Sheet 1: the parameter block and the macro's columns; returns (refs, warnings)."""
     source = result.shot.source
@@ -222,7 +177,7 @@ def _write_srs_sheets(wb, result, requirement, shot, name, warnings):
     SRS over the requirement's band (and at least 100 Hz-10 kHz), the requirement drawn
     over it."""
     from ..studies.shock import default_frequencies, srs
-    from .srs import add_srs_sheets
+    from ..xlsx.srs_sheets import add_srs_sheets
 
     frequencies, required, q = requirement
     pulse = result.accel_kg[np.isfinite(result.accel_kg)]
@@ -233,22 +188,6 @@ def _write_srs_sheets(wb, result, requirement, shot, name, warnings):
                           f"{frequencies[-1]:,.0f} Hz (design --target-srs)")]
     add_srs_sheets(wb, freqs, srs(pulse, result.params.delta, freqs, q), about, shot,
                    (frequencies, required), name, warnings)
-
-
-def print_outputs_block(ws, block, shot):
-    """The Outputs block on one page, its columns wide enough for their text (a label used
-    to run past the print area and be cut off)."""
-    widths: dict = {}
-    cells_in_row: dict = {}
-    for (row, _), (cached, _) in block.items():
-        cells_in_row[row] = cells_in_row.get(row, 0) + (cached is not None)
-    for (row, col), (cached, _) in block.items():
-        if cached is not None and cells_in_row[row] > 1:  # a row's lone note overflows
-            widths[col] = max(widths.get(col, 0), len(str(cached)))
-    for col, chars in widths.items():
-        ws.set_column(col - 1, col - 1, min(max(chars + 2, 6), 120))
-    one_page(ws, max(r for r, _ in block) - 1, max(c for _, c in block) - 1, shot=shot,
-             title="Outputs")
 
 
 def write_workbook(result, path, force=False, outputs=Outputs(), summary=None, info=None,

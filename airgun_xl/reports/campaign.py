@@ -2,11 +2,36 @@
 the peak against the impact speed, and every warning; one printed page."""
 import numpy as np
 
-from ..campaign import TABLE, TABLE_TITLE
-from .charts import nice_range
-from .report import Style, axis, chart_size, one_page, report_workbook
-from .sheets import write_warnings
-from .xlsx import PROPERTIES
+from ..xlsx.charts import nice_range
+from ..xlsx.report import Style, axis, chart_size, one_page, report_workbook
+from ..xlsx.sheets import write_warnings
+from ..xlsx.workbook import PROPERTIES
+
+#: The title (document properties) of a campaign table: left out of a folder too, whatever
+#: its name.
+TABLE_TITLE = "airgun-xl campaign table"
+
+#: The campaign table, one row a shot: (heading, key, quantity code of
+#: :data:`airgun_xl.xlsx.report.QUANTITIES` or None for text).
+TABLE = (
+    ("Shot", "file", None), ("v0 (m/s)", "v0", "m/s"), ("Peak (kG)", "peak_kg", "kG"),
+    ("Filtered peak (kG)", "filtered_peak_kg", "kG"), ("Time of peak (ms)", "time_of_peak", "s"),
+    ("Pulse (ms)", "pulse_duration", "s"), ("Max crush (m)", "max_crush", "m"),
+    ("Final length (m)", "final_length", "m"), ("Warnings", "warning_count", "count"),
+    ("Predicted verdict", "verdict", None), ("Status", "status", None),
+    ("Output", "output", None),
+)
+
+#: ``history -o``: the campaign table of an archive's runs.
+HISTORY_TABLE = (
+    ("Entry", "file", None), ("Created (UTC)", "created", None), ("v0 (m/s)", "v0", "m/s"),
+    ("Peak (kG)", "peak_kg", "kG"), ("Filtered peak (kG)", "filtered_peak_kg", "kG"),
+    ("Time of peak (ms)", "time_of_peak", "s"), ("Pulse (ms)", "pulse_duration", "s"),
+    ("Max crush (m)", "max_crush", "m"), ("Final length (m)", "final_length", "m"),
+    ("Warnings", "warning_count", "count"), ("Integrator", "integrator", None),
+    ("Crush law", "crush_law", None),
+)
+
 
 #: Widths (characters) of the table's text columns.
 TEXT_WIDTHS = {"file": 28, "status": 12, "output": 28, "entry": 18, "created": 20,

@@ -203,10 +203,10 @@ def report_workbook(path, force=False, inputs=()):
     ------
     xlsxwriter.Workbook
         With the project's options and fixed properties
-        (:func:`~airgun_xl.workbook.xlsx.new_workbook`).
+        (:func:`~airgun_xl.xlsx.workbook.new_workbook`).
     """
     from ..transaction import atomic_path, check_output
-    from .xlsx import close_workbook, new_workbook
+    from .workbook import close_workbook, new_workbook
 
     check_output(path, force, inputs=inputs)
     with atomic_path(path, force) as tmp:
