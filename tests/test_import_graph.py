@@ -1,14 +1,27 @@
 """Issue 34: one way through the house. The package's import graph, built by import-linter's
 graph library (grimp), has no cycle among the package's modules, counting imports made inside
 functions and leaving out only those under ``if TYPE_CHECKING:``; and every ``.py`` file of
-the package is a node of it (a folder without ``__init__.py`` would be left out)."""
+the package is a node of it (a folder without ``__init__.py`` would be left out).
+
+The layers contract in ``pyproject.toml`` holds (``lint-imports``), covers every package and
+top-level module, is the picture ``docs/layout.md`` draws, and fails when a layer imports up.
+"""
+import re
+import shutil
+import subprocess
+import sys
+import tomllib
+import warnings
 from pathlib import Path
 
 import pytest
 
 grimp = pytest.importorskip("grimp")
 
-PACKAGE = Path(__file__).resolve().parents[1] / "airgun_xl"
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "airgun_xl"
+CONFIG = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]
+LAYERS = next(c for c in CONFIG["contracts"] if c["type"] == "layers")["layers"]
 
 
 @pytest.fixture(scope="module")
@@ -49,8 +62,80 @@ def test_no_import_cycle_among_the_packages_modules(graph):
 
 def test_function_level_imports_are_counted(graph):
     """The graph sees an import made inside a function: shot.py reads a workbook through
-    workbook.reader only inside Shot.from_workbook."""
+    readers.shot_workbook only inside Shot.from_workbook."""
     details = graph.get_import_details(importer="airgun_xl.shot",
-                                       imported="airgun_xl.workbook.reader")
-    assert details and all(d["line_contents"].startswith("from .workbook.reader")
+                                       imported="airgun_xl.readers.shot_workbook")
+    assert details and all(d["line_contents"].startswith("from .readers.shot_workbook")
                            for d in details)
+
+
+def _lint_imports(cwd):
+    """``lint-imports`` (the console script beside this interpreter) run in ``cwd``."""
+    script = shutil.which("lint-imports", path=str(Path(sys.executable).parent))
+    assert script is not None, "import-linter is in the test extra"
+    return subprocess.run([script, "--no-cache"], cwd=cwd, capture_output=True, text=True,
+                          timeout=300)
+
+
+def test_lint_imports_keeps_every_contract():
+    done = _lint_imports(ROOT)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "0 broken" in done.stdout and "4 kept" in done.stdout, done.stdout
+
+
+def test_the_layers_contract_covers_every_package_and_top_level_module():
+    """Each child of ``airgun_xl`` (a package, or a module other than ``__init__``) is named
+    in exactly one layer."""
+    children = {p.stem for p in PACKAGE.glob("*.py") if p.stem != "__init__"}
+    children |= {p.name for p in PACKAGE.iterdir() if (p / "__init__.py").is_file()}
+    named = [n.strip() for layer in LAYERS for n in layer.split("|")]
+    assert sorted(named) == sorted(children)
+
+
+def test_docs_layout_draws_the_layers_the_contract_declares():
+    """docs/layout.md's layer table lists the contract's layers, top to bottom, with the
+    same siblings (and nothing the contract does not check)."""
+    text = (ROOT / "docs" / "layout.md").read_text()
+    rows = re.findall(r"^\| (\d+) \| ([^|]+) \|", text, flags=re.M)
+    drawn = [[n.strip(" `") for n in names.split(",")] for _, names in rows]
+    declared = [[n.strip() for n in layer.split("|")] for layer in LAYERS]
+    assert [sorted(d) for d in drawn] == [sorted(d) for d in declared]
+    assert [int(k) for k, _ in rows] == list(range(len(LAYERS), 0, -1))
+
+
+def test_the_contract_fails_when_a_reader_imports_up(tmp_path):
+    """The same contract on a copy of the package where the recording reader imports the
+    CLI: lint-imports names that import and exits 1 (the check can fail)."""
+    shutil.copytree(PACKAGE, tmp_path / "airgun_xl",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.so", "*.pyd"))
+    shutil.copy(ROOT / "pyproject.toml", tmp_path / "pyproject.toml")
+    reader = tmp_path / "airgun_xl" / "readers" / "recording.py"
+    reader.write_text(reader.read_text() + "\n\ndef _up():\n    from ..cli import main\n"
+                      "    return main\n")
+    done = _lint_imports(tmp_path)
+    assert done.returncode == 1, done.stdout
+    assert "airgun_xl.readers.recording -> airgun_xl.cli" in done.stdout
+    assert "the errors at the ground BROKEN" in done.stdout, done.stdout
+
+
+@pytest.mark.parametrize("old, new, name", [
+    ("trace", "airgun_xl.readers.recording", "read_trace"),
+    ("reader", "airgun_xl.readers.shot_workbook", "read_params"),
+    ("writer", "airgun_xl.reports.fill", "write_workbook"),
+])
+def test_the_old_paths_still_import_with_a_deprecation_warning(old, new, name):
+    """The three old paths a user may hold give the same objects as their new homes, and
+    warn (in a fresh interpreter: this one may have imported them already)."""
+    code = (f"import warnings; warnings.simplefilter('error', DeprecationWarning)\n"
+            f"try:\n    import airgun_xl.workbook.{old}\nexcept DeprecationWarning as w:\n"
+            f"    print(w)\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120)
+    assert done.stdout.strip() == (f"airgun_xl.workbook.{old} is deprecated and goes in the "
+                                   f"next release: import {new}"), done.stdout + done.stderr
+    import importlib
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        shim = importlib.import_module(f"airgun_xl.workbook.{old}")
+    assert getattr(shim, name) is getattr(importlib.import_module(new), name)
