@@ -1,7 +1,7 @@
 """Measured pulses (issue 12): compare-measured, srs and calibrate, timed, and the
 calibration's recovery of known parameters, printed as a table.
 
-    python benchmarks/bench_measured.py [--repeat N]
+    python benchmarks/bench_measured.py [--repeat N] [--quick]
 
 The "measured" pulses are recordings of the recorder model (studies/recorder.py: 20, 50 and
 30 kHz through a 4-pole anti-alias filter at fs/5, 3 % noise, +50 g offset, 1.5 ms
@@ -19,7 +19,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_fill import TEMPLATE, run_table, timed_once  # noqa: E402
+from bench_fill import TEMPLATE, judged, run_table, timed_once  # noqa: E402
 
 SPEEDS = (243.53532, 200.0, 150.0)
 RATES = (20_000.0, 50_000.0, 30_000.0)
@@ -90,7 +90,7 @@ def benches(repeat, tmp):
             [sys.executable, "-m", "airgun_xl", *argv, "--force", "-o", str(tmp / "c.xlsx")],
             capture_output=True))
         out.append((label, f"in-process {warm:.3f} s", f"fresh process {cold:.2f} s",
-                    f"target <= {target:g} s in-process: {'met' if warm <= target else 'NOT met'}"
+                    f"target <= {target:g} s in-process: {judged(warm <= target)}"
                     ))
 
     # recovery of known values from the recorder model's CSVs, as read by the commands

@@ -1,6 +1,6 @@
 """Speed of convergence, design and sweep, printed as a table.
 
-    python benchmarks/bench_tools.py [--repeat N]
+    python benchmarks/bench_tools.py [--repeat N] [--quick]
 
 Medians over N runs after a warm-up, with the machine they came from:
 - `airgun-xl convergence templates/shot_a.xlsx` (default ladder 0.5 us .. 5 ns) as a process;
