@@ -57,7 +57,7 @@ def test_sweep_cli_on_workers_writes_the_local_table(tmp_path, capsys):
     args = ["sweep", str(TEMPLATE), "--vary", "A28=100:260:9", "--vary", "E40=2.5e7:2.9e7:3"]
     assert main([*args, "-o", str(here)]) == 0
     assert main([*args, "-o", str(there), "--workers", "2", "--chunk", "4"]) == 0
-    read = [list(openpyxl.load_workbook(p, read_only=True).worksheets[0].iter_rows(
+    read = [list(openpyxl.load_workbook(p, read_only=True)["Sweep"].iter_rows(
         values_only=True)) for p in (here, there)]
     assert read[0] == read[1] and len(read[0]) > 27
 

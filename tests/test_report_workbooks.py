@@ -127,3 +127,41 @@ def test_the_fills_charts_are_in_the_summarys_units(workbooks):
     assert "Time (ms)" in text and "Time (s)" not in text
     assert "Force (kN)" in text and 'formatCode="#,##0,"' in text
     assert "Frequency (kHz)" in text
+
+
+#: Workbooks in the macro's layout: their parameter sheet stays first and active (the macro
+#: reads the active sheet, diff and fill the first one).
+MACRO_LAYOUT = {"fill", "design_srs", "design_confidence"}
+
+#: Every kind make_all writes.
+ALL_KINDS = set(KINDS) | {"accept", "accept_corridor", "design_confidence"}
+
+
+@pytest.mark.parametrize("kind", sorted(ALL_KINDS - MACRO_LAYOUT))
+def test_a_study_workbook_opens_on_its_first_report_page(workbooks, kind):
+    """Issue 35: the active sheet is a report page (one printed page, not the blank print
+    area of a data sheet), every report page comes before every data sheet but a shot's own
+    sheets, and no number on the active sheet is a General number past 7 digits."""
+    path = workbooks[kind]
+    wb = openpyxl.load_workbook(path)
+    printed = [ws.title for ws, _ in report_sheets(path)]
+    active = wb.active
+    assert active.title in printed, (kind, active.title, printed)
+    assert active.sheet_properties.pageSetUpPr.fitToPage
+    data = [ws.title for ws in wb.worksheets if ws.title not in printed]
+    shot_sheets = {wb.worksheets[0].title} if kind.startswith("calibrate") else set()
+    last_report = max(wb.sheetnames.index(t) for t in printed)
+    assert all(wb.sheetnames.index(t) > last_report for t in data if t not in shot_sheets), \
+        (kind, wb.sheetnames)
+    if not shot_sheets:
+        assert active.title == printed[0]
+    long = [(c.coordinate, c.value) for row in active.iter_rows() for c in row
+            if isinstance(c.value, float) and c.number_format == "General"
+            and significant_digits(c.value) > MAX_DIGITS]
+    assert long == [], (kind, long)
+
+
+@pytest.mark.parametrize("kind", sorted(MACRO_LAYOUT))
+def test_a_workbook_in_the_macros_layout_opens_on_its_parameter_sheet(workbooks, kind):
+    wb = openpyxl.load_workbook(workbooks[kind])
+    assert wb.active.title == wb.sheetnames[0] == "Sheet1"

@@ -4,7 +4,7 @@ Exit 0 on PASS, 3 on FAIL (:data:`FAIL_EXIT`), 2 for bad input."""
 from pathlib import Path
 
 from .recording_options import RECORDING_HELP, add_recording_options
-from .run_options import add_force, add_output
+from .run_options import SHOT_HELP, add_force, add_output
 from .spec_options import add_spec_options
 
 #: The exit status of a shot that fails its specification (2 stays for bad input).
@@ -19,7 +19,7 @@ def add_parser(sub):
                                    "sheet, a --profile, the options): peak, duration, velocity"
                                    " change, the corridor round the ideal pulse and the SRS; "
                                    "write the verdict workbook. Exit 0 on PASS, 3 on FAIL.")
-    p.add_argument("shot", metavar="SHOT.xlsx")
+    p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
     p.add_argument("recording", metavar="RECORDING", help="the recorded pulse: " + RECORDING_HELP)
     add_output(p, "verdict workbook", "SHOT.accept.xlsx")
     add_force(p)

@@ -2,7 +2,7 @@
 from pathlib import Path
 
 from .recording_options import RECORDING_HELP, add_recording_options
-from .run_options import add_force, add_output, add_run_options
+from .run_options import SHOT_HELP, add_force, add_output, add_run_options
 
 
 def add_parser(sub):
@@ -14,7 +14,7 @@ def add_parser(sub):
                                    "filter both alike (SAE J211), align them at the impact, "
                                    "and score the peak, its time, the pulse, the velocity "
                                    "change and their correlation.")
-    p.add_argument("shot", metavar="SHOT.xlsx")
+    p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
     p.add_argument("measured", metavar="MEASURED", help="the measured pulse: " + RECORDING_HELP)
     add_output(p, "scores and traces", "SHOT.measured.xlsx")
     add_force(p)

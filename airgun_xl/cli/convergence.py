@@ -5,7 +5,7 @@ from pathlib import Path
 from ..choices import INTEGRATORS
 from ..errors import OptionError
 from ..transaction import check_output
-from .run_options import add_force, add_output
+from .run_options import SHOT_HELP, add_force, add_output
 
 
 def add_parser(sub):
@@ -15,7 +15,7 @@ def add_parser(sub):
                                    "extrapolation and the observed order), recommend the "
                                    "coarsest time step that meets --rtol on the peak, and "
                                    "write a workbook and a PNG of error against run time.")
-    p.add_argument("shot", metavar="SHOT.xlsx")
+    p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
     p.add_argument("--levels", help="comma-separated time steps, e.g. 5us,2us,1us,500ns "
                                     "(default: the sheet's E2, then 1-2-5 steps down to 5ns)")
     p.add_argument("--integrator", default="legacy",

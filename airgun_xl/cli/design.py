@@ -9,17 +9,24 @@ from ..outputs import from_sheet
 from ..units import parse_duration, parse_peak
 from .cluster_options import add_cluster_options, cluster_runner
 from .fill import print_summary
-from .run_options import add_force, add_output, add_run_options
+from .run_options import SHOT_HELP, add_force, add_output, add_run_options
 from .spec_options import add_spec_options
 
 
 def add_parser(sub):
-    p = sub.add_parser("design", help="find the v0 or geometry that gives a requested peak",
-                       description="Solve for the value of one parameter (two with "
-                                   "--target-duration) that gives the requested peak "
-                                   "acceleration of the test item, and write the designed "
-                                   "shot as a filled workbook.")
-    p.add_argument("shot", metavar="SHOT.xlsx")
+    p = sub.add_parser("design", help="design a shot: to a target, to the middle of a "
+                                      "specification, or most likely to pass it",
+                       description="Design the shot and write it as a filled workbook, in one "
+                                   "of three modes. With --target-peak (and --target-duration) "
+                                   "or --target-srs: solve for the value of one parameter (two "
+                                   "with a duration) that gives the target. Without a target, "
+                                   "from a specification (the Specification sheet, a --profile "
+                                   "or the options): the setting at the middle of the "
+                                   "tolerances, whose smallest margin is largest. With "
+                                   "--confidence P and the shot-to-shot scatter (--sd): the "
+                                   "setting most likely to pass, its probability with a 95 % "
+                                   "interval, and exit 3 when no setting reaches P.")
+    p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
     target = p.add_mutually_exclusive_group()
     target.add_argument("--target-peak", metavar="PEAK",
                         help="requested peak: 12kG, 11750g or 1.2e5m/s2")

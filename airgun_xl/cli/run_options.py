@@ -5,6 +5,8 @@ from ..choices import INTEGRATORS, MODELS
 INTEGRATOR_HELP = ("legacy: ArtSim's scheme (the default); newmark: average-acceleration "
                    "Newmark, unconditionally stable for the OBR chain")
 MODEL_HELP = "4-mass: ArtSim (the default); rigid: the previous rigid-body model"
+#: The help of every subcommand's positional shot workbook.
+SHOT_HELP = "the shot's workbook, in the report's layout (.xlsx, .xlsm or .xls)"
 
 
 def add_integrator(p):

@@ -2,7 +2,7 @@
 from pathlib import Path
 
 from ..errors import OptionError
-from .run_options import add_force, add_output, add_run_options
+from .run_options import SHOT_HELP, add_force, add_output, add_run_options
 
 
 def add_parser(sub):
@@ -10,7 +10,7 @@ def add_parser(sub):
                        description="Run the shot and write the maximax shock response "
                                    "spectrum of the test item's acceleration (Smallwood's "
                                    "ramp-invariant filter), as a table and a log-log chart.")
-    p.add_argument("shot", metavar="SHOT.xlsx")
+    p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
     add_output(p, "the SRS workbook", "SHOT.srs.xlsx")
     add_force(p)
     p.add_argument("--q", type=float, default=10.0, help="quality factor (default 10: 5 %% "

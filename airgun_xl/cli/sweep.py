@@ -6,16 +6,19 @@ from .. import limits
 from ..errors import OptionError
 from ..transaction import check_output
 from .cluster_options import add_cluster_options, cluster_runner
-from .run_options import add_force, add_output, add_run_options
+from .run_options import SHOT_HELP, add_force, add_output, add_run_options
 
 
 def add_parser(sub):
-    p = sub.add_parser("sweep", help="run a grid of shots, or a Monte Carlo over uncertain "
-                                     "inputs",
-                       description="Evaluate a grid of shots (--vary, several make a grid) or "
-                                   "a Monte Carlo (--mc N with --sd) with the batch kernel on "
-                                   "both cores; write the headline figures per shot and charts.")
-    p.add_argument("shot", metavar="SHOT.xlsx")
+    p = sub.add_parser("sweep", help="run a grid of shots, a Monte Carlo or Sobol indices over "
+                                     "uncertain inputs",
+                       description="Evaluate a grid of shots (--vary; several make a grid), a "
+                                   "Monte Carlo (--mc N with --sd) or Sobol sensitivity indices "
+                                   "(--sobol N with --sd) with the batch kernel, on this "
+                                   "machine's cores or on a Dask cluster (--scheduler, "
+                                   "--workers); write the headline figures per shot, the "
+                                   "charts, and the spread or the indices.")
+    p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
     p.add_argument("--vary", action="append", metavar="CELL=LO:HI:N", default=[],
                    help="a parameter cell and its values, e.g. A28=100:260:161")
     p.add_argument("--mc", metavar="N", help="Monte Carlo: this many shots")

@@ -133,7 +133,12 @@ def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=Non
     """
     with report_workbook(path, force) as wb:
         bold = wb.add_format({"bold": True})
+        # the report pages first (the workbook opens on the Verdict), their data after them
         ws = wb.add_worksheet("Verdict")
+        charts = wb.add_worksheet("Pulse")
+        srs_ws = wb.add_worksheet("SRS")
+        data = wb.add_worksheet("Pulse data", worksheet_class=ColumnsWorksheet)
+        srs_data = wb.add_worksheet("SRS data", worksheet_class=ColumnsWorksheet)
         ws.set_column(0, 0, 34)
         ws.set_column(1, 6, 12)
         ws.set_column(7, 7, 60)
@@ -143,8 +148,6 @@ def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=Non
                              line_chars=160)
         one_page(ws, row, VERDICT_COLS - 1, shot=shot, title="Verdict")
 
-        charts = wb.add_worksheet("Pulse")
-        data = wb.add_worksheet("Pulse data", worksheet_class=ColumnsWorksheet)
         # a long record (2,000,000 samples) is charted by its every bucket's min and max:
         # its peak and every feature wider than a bucket kept, within Excel's rows
         kept = np.arange(len(pulse["time"]))
@@ -171,8 +174,6 @@ def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=Non
                                       "and largest (every sample was judged)")
         one_page(charts, 26, CHART_COLS - 1, shot=shot, title="Pulse")
 
-        srs_ws = wb.add_worksheet("SRS")
-        srs_data = wb.add_worksheet("SRS data", worksheet_class=ColumnsWorksheet)
         f = np.asarray(spectra["frequencies"])
         has_req = "required" in spectra
         names = ["Frequency (Hz)", "SRS (g)"]

@@ -129,6 +129,9 @@ def write_calibration(path, shot, cal, files, options, force=False):
         if not law.is_legacy:
             write_law_sheet(wb, law, names["Crush law"], shot=display(shot.source.path.name))
         ws = wb.add_worksheet("Calibration")
+        # the workbook opens on this page; the shot's sheet stays first, where fill reads it
+        # (the legacy macro reads the active sheet: select sheet 1 before running it here)
+        ws.activate()
         style = Style(wb)
         bold = style.bold
         pct = style.of("%")

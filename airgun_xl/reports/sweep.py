@@ -53,6 +53,14 @@ def write_sweep(result, path, force, stats=None, sensitivity=None, shot=None):
     Sensitivity sheet and its bar charts. ``shot`` names the input in the page headers."""
     with report_workbook(path, force) as wb:
         style = Style(wb)
+        # the report pages first (the workbook opens on the Charts), the data sheets after
+        family_data = _write_charts(wb, result, shot)
+        if stats is not None:
+            _write_spread(wb, result, stats, style, shot)
+            _write_band(wb, result, style, shot)
+        if sensitivity is not None:
+            _write_sensitivity(wb, sensitivity, style, shot)
+        _write_warnings(wb, result, style, shot)
         ws = wb.add_worksheet("Sweep", worksheet_class=ColumnsWorksheet)
         headers = ([_label(c) for c in result.cells]
                    + [FIGURE_HEADERS[f] for f in FIGURES]
@@ -72,13 +80,7 @@ def write_sweep(result, path, force, stats=None, sensitivity=None, shot=None):
             if found:
                 ws.write_string(r, len(headers) - 1, " | ".join(found))
         not_printed(ws)
-        _write_warnings(wb, result, style, shot)
-        _write_charts(wb, result, shot)
-        if stats is not None:
-            _write_spread(wb, result, stats, style, shot)
-            _write_band(wb, result, style, shot)
-        if sensitivity is not None:
-            _write_sensitivity(wb, sensitivity, style, shot)
+        _write_chart_data(wb, family_data)
 
 
 def families(result, i):
@@ -121,9 +123,10 @@ CHART_COLS, CHART_ROWS = 10, 22
 def _write_charts(wb, result, shot):
     """The Charts sheet: the peak against each input, two charts a row, on one page. A grid
     over two or more inputs draws a family of curves (their data on the not printed Chart
-    data sheet); samples draw a scatter."""
+    data sheet, written after the report pages by :func:`_write_chart_data` from the
+    ``[(col, header, x, peak)]`` this returns); samples draw a scatter."""
     charts = wb.add_worksheet("Charts")
-    data = None
+    data: list = []
     n, k = len(result.values), len(result.cells)
     peaks = result.figures[:, 0][np.isfinite(result.figures[:, 0])]
     plo, phi = nice_range(peaks, include_zero=True) if len(peaks) else (0.0, 1.0)
@@ -139,14 +142,9 @@ def _write_charts(wb, result, shot):
                               "marker": {"type": "circle", "size": 4}})
             chart.set_legend({"none": True})
         else:
-            if data is None:
-                data = wb.add_worksheet("Chart data", worksheet_class=ColumnsWorksheet)
-                not_printed(data)
             chart = wb.add_chart({"type": "scatter", "subtype": "straight_with_markers"})
             for m, (name, x, y) in enumerate(family):
-                data.write_string(0, col, f"{cell} ({name})")
-                data.write_string(0, col + 1, "Peak (kG)")
-                write_number_columns(data, 1, {col: x, col + 1: y})
+                data.append((col, f"{cell} ({name})", x, y))
                 color = FAMILY_COLORS[m % len(FAMILY_COLORS)]
                 chart.add_series({"name": name, "categories": ["Chart data", 1, col, len(x), col],
                                   "values": ["Chart data", 1, col + 1, len(x), col + 1],
@@ -168,6 +166,19 @@ def _write_charts(wb, result, shot):
                         + (" (one curve per level of another input)" if data else ""))
     one_page(charts, 1 + -(-k // 2) * CHART_ROWS, 2 * CHART_COLS - 1, shot=shot,
              title="Charts")
+    return data
+
+
+def _write_chart_data(wb, family_data):
+    """The Chart data sheet of a grid's families of curves (none for samples)."""
+    if not family_data:
+        return
+    data = wb.add_worksheet("Chart data", worksheet_class=ColumnsWorksheet)
+    not_printed(data)
+    for col, header, x, y in family_data:
+        data.write_string(0, col, header)
+        data.write_string(0, col + 1, "Peak (kG)")
+        write_number_columns(data, 1, {col: x, col + 1: y})
 
 
 FAMILY_COLORS = ("#1f4e79", "#c00000", "#548235", "#7f6000", "#7030a0", "#00b0f0",
