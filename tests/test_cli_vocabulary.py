@@ -44,3 +44,36 @@ def test_design_describes_its_three_modes():
 def test_sweep_describes_sobol_and_not_a_fixed_core_count():
     text = " ".join(SUBPARSERS[("sweep",)].format_help().split())
     assert "Sobol" in text and "both cores" not in text
+
+
+def test_sign_is_written_1_or_minus_1(capsys):
+    """--sign shows and takes 1 or -1 (+1 and -1.0 read the same); anything else is one line
+    naming the option and what it expects."""
+    from airgun_xl.cli.recording_options import sign_value
+
+    assert [sign_value(t) for t in ("1", "+1", "-1", "-1.0")] == [1.0, 1.0, -1.0, -1.0]
+    assert "--sign 1|-1" in SUBPARSERS[("accept",)].format_usage()
+    from airgun_xl.cli import main
+
+    assert main(["compare-measured", "shot.xlsx", "rec.csv", "--sign", "2"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["airgun-xl: error: compare-measured: argument --sign: found '2', expected 1 "
+                   "or -1"]
+
+
+def test_a_monte_carlo_without_seed_repeats_and_prints_its_seed(tmp_path, capsys):
+    """sweep's default seed is 1: two runs without --seed draw the same shots, and the seed
+    is printed with the spread."""
+    import openpyxl
+    from conftest import TEMPLATE
+
+    from airgun_xl.cli import main
+
+    tables = []
+    for k in range(2):
+        out = tmp_path / f"mc{k}.xlsx"
+        assert main(["sweep", str(TEMPLATE), "--mc", "8", "--sd", "E40=3%", "-o", str(out)]) == 0
+        assert "(seed 1)" in capsys.readouterr().out
+        tables.append(list(openpyxl.load_workbook(out, read_only=True)["Sweep"].values))
+    assert tables[0] == tables[1] and len(tables[0]) == 9
+    assert len({row[0] for row in tables[0][1:]}) == 8  # eight different draws of E40

@@ -3,6 +3,19 @@
 anti-alias model."""
 
 
+def sign_value(text):
+    """``--sign``: 1 or -1 (``+1``, ``1.0`` and ``-1.0`` read the same) [-]."""
+    import argparse
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = None
+    if value not in (1.0, -1.0):
+        raise argparse.ArgumentTypeError(f"found {text!r}, expected 1 or -1")
+    return value
+
+
 def anti_alias_value(text):
     """``--anti-alias``: a frequency in Hz, ``auto`` or ``none`` (checked against the rates
     once they are known: studies.measured.check_anti_alias)."""
@@ -30,8 +43,9 @@ def add_recording_options(p, channel_help="TDMS only: the channel (default: the 
                    help=cfc_help or "filter both pulses: SAE J211 class 60, 180, 600 or 1000 "
                         "(refused where the filter is unstable, below 4.155 x the class in "
                         "samples a second; a warning below J211's 10 x)")
-    p.add_argument("--sign", type=float, default=1.0, choices=(1.0, -1.0),
-                   help="-1 when the recorder's axis is opposite to the macro's")
+    p.add_argument("--sign", type=sign_value, default=1.0, metavar="1|-1",
+                   help="1 (the default), or -1 when the recorder's axis is opposite to the "
+                        "macro's")
     p.add_argument("--time-unit", help="s, ms or us (default: from the header)")
     p.add_argument("--accel-unit", help="g, kG or m/s^2 (default: from the header); g is "
                                         "standard gravity, 9.80665 m/s^2")

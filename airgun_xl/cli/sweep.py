@@ -27,7 +27,9 @@ def add_parser(sub):
     p.add_argument("--sobol", metavar="N",
                    help="Sobol indices of the peak, pulse and crush to the --sd inputs "
                         "(SALib): N (a power of 2) x (inputs + 2) shots")
-    p.add_argument("--seed", type=int, default=None, help="random seed (Monte Carlo, Sobol)")
+    p.add_argument("--seed", type=int, default=1,
+                   help="seed of the Monte Carlo's and Sobol's draws (default 1, so that a "
+                        "run repeats; printed with the results)")
     add_run_options(p)
     add_output(p, "table and charts", "SHOT.sweep.xlsx")
     add_force(p)
@@ -122,7 +124,7 @@ def run(args):
             print(f"  peak from {peaks.min():.4f} to {peaks.max():.4f} kG over the grid")
     else:
         print(f"  peak {stats['mean']:.4f} kG mean, sd {stats['sd']:.4f}, 5-95% "
-              f"{stats['p5']:.4f}-{stats['p95']:.4f} kG")
+              f"{stats['p5']:.4f}-{stats['p95']:.4f} kG (seed {args.seed})")
     flagged, cells = result.flagged()
     if flagged:
         from .messages import warn
