@@ -345,3 +345,31 @@ def test_two_archives_created_at_once_both_succeed(tmp_path, monkeypatch):
     monkeypatch.setattr(store.os, "mkdir", late_mkdir)
     Archive(root, create=True)
     assert (root / store.MARKER).is_file()
+
+
+def test_compare_takes_diffs_atol_json_and_report(tmp_path, capsys):
+    """Issue 35: compare has diff's --atol, --json and --report. Two runs of one shot, legacy
+    and newmark: they differ at the default tolerance (exit 1), agree within an absolute
+    tolerance larger than any series (exit 0), the JSON says which, and the report workbook
+    names the two runs by entry."""
+    shot, archive = _short_shot(tmp_path), tmp_path / "archive"
+    for integrator in ("legacy", "newmark"):
+        assert main(["fill", str(shot), "-o", str(tmp_path / f"{integrator}.xlsx"), "--only",
+                     "summary", "--archive", str(archive), "--integrator", integrator]) == 0
+    capsys.readouterr()
+    compare = ["compare", "shot@1", "shot@2", "--archive", str(archive)]
+    assert main([*compare, "--json"]) == 1
+    found = json.loads(capsys.readouterr().out)
+    assert found["same"] is False and found["inputs"] == [] and found["atol"] == 0.0
+    assert {c["column"] for c in found["columns"]} >= {"y1", "y31", "accel_kg"}
+    assert main([*compare, "--atol", "1e30", "--json"]) == 0  # every series within 1e30
+    assert json.loads(capsys.readouterr().out)["same"] is True
+    report = tmp_path / "runs.xlsx"
+    assert main([*compare, "--report", str(report)]) == 1
+    ws = openpyxl.load_workbook(report)["Diff"]
+    assert (ws["A1"].value, ws["A2"].value) == ("shot@1", "shot@2")
+    assert "Rows (shot@1)" in [c.value for row in ws.iter_rows(max_row=8) for c in row]
+    assert main([*compare, "--report", str(report)]) == 2  # exists: --force replaces it
+    assert "--force" in capsys.readouterr().err
+    assert main([*compare, "--atol", "-1"]) == 2
+    assert "--atol: found '-1', expected a number >= 0" in capsys.readouterr().err

@@ -5,7 +5,7 @@ import sys
 from ..archive import ENV, Archive, archive_dir
 from ..transaction import display
 from ..untrusted_json import printable
-from .run_options import add_force
+from .run_options import ATOL_HELP, RTOL_HELP, add_force, tolerance
 
 
 def add_parser(sub):
@@ -40,8 +40,12 @@ def add_parser(sub):
     c.add_argument("entry1", metavar="ENTRY1", help="SHOT, SHOT@VERSION or #ID")
     c.add_argument("entry2", metavar="ENTRY2", help="SHOT, SHOT@VERSION or #ID")
     c.add_argument("--archive", metavar="DIR", help="the archive folder")
-    c.add_argument("--rtol", type=float, default=1e-12,
-                   help="relative to each series' largest magnitude (default 1e-12)")
+    c.add_argument("--rtol", default="1e-12", help=RTOL_HELP.replace("column", "series"))
+    c.add_argument("--atol", default="0", help=ATOL_HELP)
+    c.add_argument("--json", action="store_true", help="print the report as JSON, as diff does")
+    c.add_argument("--report", metavar="REPORT.xlsx",
+                   help="also write a workbook: the input cells that differ and the error table")
+    add_force(c, "REPORT.xlsx")
     c.set_defaults(run=run_compare)
     a = sub.add_parser("archive", help="archive maintenance: verify",
                        description=f"verify: finish what killed writers left, re-hash every "
@@ -274,13 +278,29 @@ def run_show(args):
 
 
 def run_compare(args):
+    rtol, atol = tolerance("--rtol", args.rtol), tolerance("--atol", args.atol)
+    if args.report:
+        from ..transaction import check_output
+
+        check_output(args.report, args.force)
     archive = _archive(args.archive)
     a, b = archive.get(args.entry1), archive.get(args.entry2)
-    print(f"{a.ref} vs {b.ref}")
     pa = {p["cell"]: p for p in a.load("params.json")}
     pb = {p["cell"]: p for p in b.load("params.json")}
     differing = [(c, pa[c]["label"], pa[c]["value"], pb[c]["value"]) for c in pa
                  if pa[c]["value"] != pb[c]["value"]]
+    from ..diff import diff_histories, format_report
+
+    report = diff_histories(a.ref, _history(a), b.ref, _history(b), rtol, atol)
+    report.inputs = differing  # the entries' parameter cells, compared above
+    if args.report:
+        from ..reports.diff_report import write_diff_report
+
+        write_diff_report(report, args.report, args.force)
+    if args.json:
+        print(json.dumps(report.as_dict(), indent=1, default=str))
+        return 0 if report.same else 1
+    print(f"{a.ref} vs {b.ref}")
     if differing:
         print(f"inputs differ (so the numbers may differ for that reason), {a.ref} vs "
               f"{b.ref}:")
@@ -288,11 +308,8 @@ def run_compare(args):
         print(f"  {cell} {label}: {x!r} vs {y!r}")
     if not differing:
         print(f"inputs: the {len(pa)} parameter cells agree")
-    from ..diff import diff_histories, format_report
-
-    report = diff_histories(a.ref, _history(a), b.ref, _history(b), args.rtol)
     print(format_report(report))
-    return 0 if report.same and not differing else 1
+    return 0 if report.same else 1
 
 
 def _history(entry):

@@ -1,8 +1,7 @@
 """``airgun-xl diff LEGACY NEW``: does the new engine give the legacy numbers?"""
 import json
 
-from ..errors import OptionError
-from .run_options import add_force
+from .run_options import ATOL_HELP, RTOL_HELP, add_force, tolerance
 
 DEFAULT_RTOL = 1e-12  # as airgun_xl.diff.DEFAULT_RTOL; the module loads only for a diff
 
@@ -15,10 +14,8 @@ def add_parser(sub):
     p.add_argument("legacy", metavar="LEGACY",
                    help="the workbook the macro filled (the reference)")
     p.add_argument("new", metavar="NEW", help="the workbook airgun-xl fill wrote")
-    p.add_argument("--rtol", default=str(DEFAULT_RTOL),
-                   help="relative to each column's largest magnitude (default 1e-12: Calc and "
-                        "Excel keep 15 digits)")
-    p.add_argument("--atol", default="0", help="absolute tolerance (default 0)")
+    p.add_argument("--rtol", default=str(DEFAULT_RTOL), help=RTOL_HELP)
+    p.add_argument("--atol", default="0", help=ATOL_HELP)
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.add_argument("--report", metavar="REPORT.xlsx",
                    help="also write a workbook: error table and the worst column's curves")
@@ -26,21 +23,11 @@ def add_parser(sub):
     p.set_defaults(run=run)
 
 
-def _tolerance(option, text):
-    try:
-        value = float(text)
-    except ValueError:
-        value = -1.0
-    if not value >= 0:
-        raise OptionError(f"{option}: found {text!r}, expected a number >= 0")
-    return value
-
-
 def run(args):
     from ..diff import diff_workbooks, format_report
     from ..reports.diff_report import write_diff_report
 
-    rtol, atol = _tolerance("--rtol", args.rtol), _tolerance("--atol", args.atol)
+    rtol, atol = tolerance("--rtol", args.rtol), tolerance("--atol", args.atol)
     if args.report:
         from ..transaction import check_output
 

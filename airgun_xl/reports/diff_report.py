@@ -16,8 +16,12 @@ def write_diff_report(report, path, force=False):
         style = Style(wb)
         ws = wb.add_worksheet("Diff")
         shot = f"{Path(report.legacy).name} vs {Path(report.new).name}"
-        ws.write_string(0, 0, f"LEGACY {report.legacy}", style.bold)
-        ws.write_string(1, 0, f"NEW {report.new}", style.bold)
+        # diff's two sides are LEGACY and NEW; compare's are two archived runs, by their refs
+        legacy, new = (("legacy", "new") if report.labels == ("LEGACY", "NEW")
+                       else tuple(report.labels))
+        prefix = ("LEGACY ", "NEW ") if legacy == "legacy" else ("", "")
+        ws.write_string(0, 0, f"{prefix[0]}{report.legacy}", style.bold)
+        ws.write_string(1, 0, f"{prefix[1]}{report.new}", style.bold)
         ws.write_string(2, 0, ("within tolerance" if report.same else "DIFFERENT")
                         + f" (rtol {report.rtol:g}, atol {report.atol:g})")
         row = 4
@@ -27,10 +31,10 @@ def write_diff_report(report, path, force=False):
                 row += 1
                 ws.write_row(row, 0, [addr, label, str(x), str(y)])
             row += 2
-        headers = ["Column", "Header", "Rows (legacy)", "Rows (new)", "Max abs error",
+        headers = ["Column", "Header", f"Rows ({legacy})", f"Rows ({new})", "Max abs error",
                    "Max relative error", "Rows outside", "First outside: row",
-                   "First outside: time (ms)", "First outside: legacy",
-                   "First outside: new"]
+                   "First outside: time (ms)", f"First outside: {legacy}",
+                   f"First outside: {new}"]
         ws.write_row(row, 0, headers, style.header)
         ws.set_row(row, 30)
         ws.set_column(0, 0, 13)
@@ -56,8 +60,8 @@ def write_diff_report(report, path, force=False):
                         style.number(ws, row, 7 + k, f[key], codes[k])
                     else:
                         ws.write_number(row, 7 + k, f[key], value)
-        for label, names in (("Only in legacy", report.only_legacy),
-                             ("Only in new", report.only_new)):
+        for label, names in ((f"Only in {legacy}", report.only_legacy),
+                             (f"Only in {new}", report.only_new)):
             if names:
                 row += 2
                 ws.write_string(row, 0, label, style.bold)
