@@ -145,7 +145,7 @@ def test_fitted_values_land_in_their_cells(tmp_path):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["x.xlsx"], "calibrate: found 1 files, expected pairs of SHOT.xlsx MEASURED.csv"),
+    (["x.xlsx"], "calibrate: found 1 files, expected pairs of SHOT.xlsx RECORDING"),
     (["{T}", "m.csv", "--fit", "E40,scale"], "--fit: found both E40 and scale"),
     (["{T}", "m.csv", "--fit", "zeta"], "--fit: found zeta, expected names from E40, E43"),
     (["{T}", "m.csv", "--degree", "7"], "--degree: found 7, expected 1 to 6"),

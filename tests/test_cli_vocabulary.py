@@ -77,3 +77,10 @@ def test_a_monte_carlo_without_seed_repeats_and_prints_its_seed(tmp_path, capsys
         tables.append(list(openpyxl.load_workbook(out, read_only=True)["Sweep"].values))
     assert tables[0] == tables[1] and len(tables[0]) == 9
     assert len({row[0] for row in tables[0][1:]}) == 8  # eight different draws of E40
+
+
+def test_a_recording_is_named_recording_in_every_command():
+    """accept, compare-measured and calibrate name their recording argument RECORDING."""
+    for words in (("accept",), ("compare-measured",), ("calibrate",)):
+        usage = SUBPARSERS[words].format_usage()
+        assert "RECORDING" in usage and "MEASURED" not in usage, usage

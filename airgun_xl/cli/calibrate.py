@@ -1,4 +1,4 @@
-"""``airgun-xl calibrate SHOT.xlsx MEASURED.csv [SHOT2.xlsx MEASURED2.csv ...]``: the model
+"""``airgun-xl calibrate SHOT.xlsx RECORDING [SHOT2.xlsx RECORDING2 ...]``: the model
 fitted to the shots that were fired."""
 import math
 from pathlib import Path
@@ -18,7 +18,7 @@ def add_parser(sub):
                                    "E40, E43 (zeta) or the law's scale by least squares. "
                                    "Writes the first shot's workbook with the fitted values "
                                    "and a Crush law sheet that fill runs.")
-    p.add_argument("pairs", nargs="+", metavar="SHOT.xlsx MEASURED.csv",
+    p.add_argument("pairs", nargs="+", metavar="SHOT.xlsx RECORDING",
                    help="each shot's workbook followed by its measured pulse (a CSV, "
                         "trace.xlsx:Sheet1!A:B or a TDMS file)")
     add_output(p, "the calibrated workbook", "SHOT.calibrated.xlsx")
@@ -53,7 +53,7 @@ UNTRUSTED = 3
 def _pairs(values):
     if len(values) % 2:
         raise OptionError(f"calibrate: found {len(values)} files, expected pairs of "
-                          "SHOT.xlsx MEASURED.csv")
+                          "SHOT.xlsx RECORDING")
     return [(values[i], values[i + 1]) for i in range(0, len(values), 2)]
 
 

@@ -1,4 +1,4 @@
-"""``airgun-xl compare-measured SHOT.xlsx MEASURED.csv``: the prediction against the test."""
+"""``airgun-xl compare-measured SHOT.xlsx RECORDING``: the prediction against the test."""
 from pathlib import Path
 
 from .recording_options import RECORDING_HELP, add_recording_options
@@ -15,7 +15,7 @@ def add_parser(sub):
                                    "and score the peak, its time, the pulse, the velocity "
                                    "change and their correlation.")
     p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
-    p.add_argument("measured", metavar="MEASURED", help="the measured pulse: " + RECORDING_HELP)
+    p.add_argument("measured", metavar="RECORDING", help="the measured pulse: " + RECORDING_HELP)
     add_output(p, "scores and traces", "SHOT.measured.xlsx")
     add_force(p)
     add_recording_options(p)

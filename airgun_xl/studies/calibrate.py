@@ -109,7 +109,7 @@ def _run_law(p, law, integrator):
     try:
         return _run(p.replace(crush_law=law), integrator)
     except (DivergenceError, StabilityError) as exc:
-        raise OptionError(f"MEASURED: the crush law fitted to the recordings makes the run "
+        raise OptionError(f"RECORDING: the crush law fitted to the recordings makes the run "
                           f"diverge ({str(exc).split(';')[0]}), expected measured pulses that "
                           "cover the crush of their shots (a longer record, the right --sign "
                           "and units)") from None
@@ -230,7 +230,7 @@ def calibrate_law(pairs, cfc=None, degree=DEGREE, integrator="legacy",
             errors.append(rms_error(a))
         v, x = np.concatenate(vs), np.concatenate(xs)
         if len(v) <= degree:  # before the range: no samples has no percentiles
-            raise OptionError(f"MEASURED: {len(v)} samples of the crush law where the run "
+            raise OptionError(f"RECORDING: {len(v)} samples of the crush law where the run "
                               "loads the mitigator and both pulses are above the noise, "
                               f"expected more than the law's degree ({degree}): measured "
                               "pulses that cover the crush of their shots")
