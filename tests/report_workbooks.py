@@ -60,7 +60,7 @@ def make_all(folder):
                           "E40,E43", "-o", str(out["calibrate_fit"])],
         "campaign": ["fill", str(day), "--jobs", "1", "--summary", str(out["campaign"]),
                      "--archive", str(folder / "archive")],
-        "history": ["history", str(folder / "archive"), "-o", str(out["history"])],
+        "history": ["history", "--archive", str(folder / "archive"), "-o", str(out["history"])],
         "accept": ["accept", str(shot), str(measured), "--sign", "-1", "--cfc", "1000",
                    "--peak", "9.5kG:15%", "--duration", "5ms:15%", "--velocity-change",
                    "240m/s:10%", "--srs", str(requirement), "--srs-tol", "-40dB,+40dB",

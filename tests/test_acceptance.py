@@ -310,7 +310,7 @@ def test_the_verdict_goes_into_the_archive(tmp_path, recording, capsys):
     assert record["recording_sha256"] == hashlib.sha256(recording.read_bytes()).hexdigest()
     assert record["tolerances"][0].startswith("peak: 8.55 to 10.45 kG")
     capsys.readouterr()
-    assert main(["history", str(archive)]) == 0
+    assert main(["history", "--archive", str(archive)]) == 0
     assert "verdicts (accept --archive):" in capsys.readouterr().out
     assert main(["archive", "verify", str(archive)]) == 0
 

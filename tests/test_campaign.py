@@ -135,18 +135,19 @@ def test_history_figures_where_and_output(tmp_path, capsys):
     archive = tmp_path / "archive"
     assert main(["fill", str(day), "--jobs", "1", "--archive", str(archive)]) == 0
     capsys.readouterr()
-    assert main(["history", str(archive), "--where", "E40=2.703e7"]) == 0
+    assert main(["history", "--archive", str(archive), "--where", "E40=2.703e7"]) == 0
     out = capsys.readouterr().out
     assert "peak kG" in out and "filt. kG" in out and "pulse ms" in out and "crush m" in out
     assert "a@1" in out and "lot2@1" not in out and "1 entry of 2 (--where)" in out
     table = tmp_path / "shots.xlsx"
-    assert main(["history", str(archive), "--where", "E40=2.8e7:3e7", "-o", str(table)]) == 0
+    assert main(["history", "--archive", str(archive), "--where", "E40=2.8e7:3e7", "-o",
+                 str(table)]) == 0
     ws = openpyxl.load_workbook(table)["Shots"]
     rows = [r for r in ws.iter_rows(min_row=4, values_only=True) if r[0] == "lot2@1"]
     entry = Archive(archive).get("lot2")
     assert len(rows) == 1 and rows[0][3] == entry.load("summary.json")["peak_kg"]
     assert rows[0][11] == "legacy (Eq. 8)"
-    assert main(["history", str(archive), "--where", "E99=1"]) == 2
+    assert main(["history", "--archive", str(archive), "--where", "E99=1"]) == 2
 
 
 def test_a_law_stored_and_run_by_name_equals_the_same_law_from_its_workbook(tmp_path,
@@ -179,7 +180,7 @@ def test_a_law_stored_and_run_by_name_equals_the_same_law_from_its_workbook(tmp_
     provenance = Archive(archive).get("shot").load("provenance.json")
     assert provenance["crush_law"]["name"] == "fitted (LOT-2026-07@1)"
     capsys.readouterr()
-    assert main(["history", str(archive)]) == 0
+    assert main(["history", "--archive", str(archive)]) == 0
     out = capsys.readouterr().out
     assert "LOT-2026-07@1" in out and "fitted on 1 shot" in out
     assert main(["fill", str(TEMPLATE), "--crush-law", "LOT-9", "--archive", str(archive),

@@ -6,6 +6,7 @@ import argparse
 import pytest
 
 from airgun_xl.cli.commands import build_parser
+from airgun_xl.cli.vocabulary import VOCABULARY, Alias
 
 
 def _subparsers(parser, prefix=()):
@@ -84,3 +85,68 @@ def test_a_recording_is_named_recording_in_every_command():
     for words in (("accept",), ("compare-measured",), ("calibrate",)):
         usage = SUBPARSERS[words].format_usage()
         assert "RECORDING" in usage and "MEASURED" not in usage, usage
+
+
+def _spellings(action):
+    longs = [o for o in action.option_strings if o.startswith("--")]
+    return longs or ([action.metavar] if isinstance(action.metavar, str) else [action.dest])
+
+
+@pytest.mark.parametrize("idea", sorted(VOCABULARY))
+def test_every_parser_spells_each_idea_the_one_way_or_by_a_declared_alias(idea):
+    """Walk every subcommand's parser: an argument stored where an idea is stored is spelt
+    the idea's one way, or by one of its declared aliases (an option alias through the Alias
+    action, which notes the new spelling), or is the positional subject of a command that the
+    table names. The one spelling is used somewhere."""
+    entry = VOCABULARY[idea]
+    used = set()
+    for words, parser in SUBPARSERS.items():
+        for action in parser._actions:
+            if action.dest not in entry.dests or isinstance(action, argparse._HelpAction):
+                continue
+            for spelt in _spellings(action):
+                used.add(spelt)
+                if spelt == entry.spelling:
+                    continue
+                if words[-1] in entry.subjects and not action.option_strings:
+                    continue
+                assert spelt in entry.aliases, (idea, words, spelt)
+                if spelt.startswith("-"):
+                    assert isinstance(action, Alias) and action.idea == idea, (words, spelt)
+                else:  # a positional alias: its help says it is the old spelling
+                    assert "old spelling of" in action.help, (words, spelt)
+    assert entry.spelling in used
+
+
+def test_an_option_spelt_one_way_means_one_idea():
+    """No option string is the spelling of two ideas, and no alias is an idea's spelling."""
+    spellings = [i.spelling for i in VOCABULARY.values()]
+    aliases = [a for i in VOCABULARY.values() for a in i.aliases]
+    assert len(set(spellings)) == len(spellings) and not set(spellings) & set(aliases)
+
+
+def test_an_old_spelling_still_works_and_says_the_new_one(tmp_path, capsys):
+    """--q stores Q where --srs-q does (srs, design), and history DIR finds the archive as
+    --archive DIR does; each notes its new spelling once on stderr."""
+    from conftest import TEMPLATE
+
+    from airgun_xl.cli import main
+
+    parser = SUBPARSERS[("srs",)]
+    assert parser.parse_args(["s.xlsx", "--q", "25"]).srs_q == 25.0
+    assert parser.parse_args(["s.xlsx", "--srs-q", "25"]).srs_q == 25.0
+    assert "write --srs-q" in capsys.readouterr().err
+    assert SUBPARSERS[("design",)].parse_args(["s.xlsx", "--q", "25"]).srs_q == "25"
+    archive = tmp_path / "archive"
+    assert main(["fill", str(TEMPLATE), "-o", str(tmp_path / "o.xlsx"), "--only", "summary",
+                 "--archive", str(archive)]) == 0
+    capsys.readouterr()
+    assert main(["history", str(archive), "--json"]) == 0
+    captured = capsys.readouterr()
+    assert "history DIR is the old spelling of history --archive DIR" in captured.err
+    old = captured.out
+    assert main(["history", "--archive", str(archive), "--json"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out == old and captured.err == ""
+    assert main(["history", str(archive), "--archive", str(tmp_path)]) == 2
+    assert "expected one archive" in capsys.readouterr().err

@@ -145,7 +145,7 @@ def test_32_7_and_11_a_bad_law_is_flagged_by_history_and_refused_by_fill(tmp_pat
     law(root)
     law(root, "GOOD")
     record_path(root).write_text(json.dumps(BAD_LAWS[name]))
-    assert main(["history", str(root)]) == 0
+    assert main(["history", "--archive", str(root)]) == 0
     out = capsys.readouterr().out
     assert "LOT@1" in out and "unreadable: " in out and "GOOD@1" in out
     code = main(["fill", str(TEMPLATE), "--crush-law", "LOT", "--archive", str(root), "-o",
@@ -227,7 +227,7 @@ def test_32_7_show_refuses_an_edited_summary_and_history_flags_it(entry, capsys,
         summary.write_text(json.dumps(EDITS[name](json.loads(kept))))
         code = main(["show", "shot@1", "--archive", str(root)])
         one_line(capsys, code, "shot@1: summary.json: ")
-        assert main(["history", str(root)]) == 0
+        assert main(["history", "--archive", str(root)]) == 0
         assert "unreadable: shot@1: summary.json" in capsys.readouterr().out
     finally:
         summary.write_bytes(kept)
@@ -256,7 +256,7 @@ def test_32_15_history_prints_no_escape_sequence_from_a_record(tmp_path, capsys)
     (folder / "v0001.json").write_text(json.dumps(
         {"shot": "shot\x1b[2J", "verdict": "PASS", "criteria": [], "created": "\x1b]0;x\x07",
          "recording": "r.csv\x1b[31m"}))
-    assert main(["history", str(tmp_path / "archive")]) == 0
+    assert main(["history", "--archive", str(tmp_path / "archive")]) == 0
     out = capsys.readouterr().out
     assert "\x1b" not in out and "\x07" not in out and "shot\\x1b[2J" in out
 

@@ -14,7 +14,9 @@ def add_parser(sub):
                        description=f"List archived runs with their key figures (peak, "
                                    f"filtered peak, pulse, crush, warnings, integrator, crush "
                                    f"law) and the archive's crush laws. {where}")
-    h.add_argument("dir", nargs="?", metavar="DIR", help="the archive folder")
+    h.add_argument("--archive", metavar="DIR", help="the archive folder")
+    h.add_argument("dir", nargs="?", metavar="DIR",
+                   help="old spelling of --archive DIR, kept one release")
     h.add_argument("--shot", metavar="NAME", help="only this shot's runs")
     h.add_argument("--since", metavar="DATE", help="only runs from this ISO date on, e.g. "
                                                    "2026-11-01")
@@ -159,7 +161,7 @@ def run_history(args):
     where = [parse_where(w) for w in args.where]
     if args.output:
         check_output(args.output, args.force)  # before reading the entries
-    archive = _archive(args.dir)
+    archive = _archive(_history_archive(args))
     rows = history_rows(archive.entries(args.shot, args.since), where)
     from ..archive.laws import list_laws
 
@@ -330,6 +332,22 @@ def _history(entry):
                            "expected an intact entry (see airgun-xl archive verify)") from None
     frame.columns = [c.split(" [")[0] for c in frame.columns]
     return {c: frame[c].to_numpy() for c in frame.columns}
+
+
+def _history_archive(args):
+    """history's archive: --archive, or the old positional DIR (noted)."""
+    if args.dir is None:
+        return args.archive
+    from .messages import note
+    from .vocabulary import old_spelling_note
+
+    if args.archive is not None and args.archive != args.dir:
+        from ..errors import OptionError
+
+        raise OptionError(f"--archive: found {args.archive!r} and the folder {args.dir!r}, "
+                          "expected one archive")
+    note([old_spelling_note("history DIR", "history --archive DIR")])
+    return args.dir
 
 
 def run_verify(args):

@@ -11,6 +11,7 @@ from .cluster_options import add_cluster_options, cluster_runner
 from .fill import print_summary
 from .run_options import SHOT_HELP, add_force, add_output, add_run_options
 from .spec_options import add_spec_options
+from .vocabulary import Alias
 
 
 def add_parser(sub):
@@ -33,8 +34,7 @@ def add_parser(sub):
     target.add_argument("--target-srs", metavar="REQ.csv",
                         help="required shock response spectrum (CSV: 'frequency [Hz],srs [g]'):"
                              " the least value whose SRS envelops it")
-    p.add_argument("--q", type=float, default=10.0,
-                   help="the SRS's quality factor, with --target-srs (default 10)")
+    p.add_argument("--q", dest="srs_q", metavar="Q", action=Alias, idea="SRS quality factor")
     p.add_argument("--accel-unit", help="the required SRS's unit, g, kG or m/s^2 (default: "
                                         "from its header)")
     p.add_argument("--target-duration", metavar="DURATION",
@@ -133,21 +133,33 @@ def run_srs(args):
     if len(names) != 1:
         raise OptionError("--vary: found two parameters, expected one with --target-srs")
     var = variable(names[0])
-    if not args.q > 0.5:
-        raise OptionError(f"--q: found {args.q!r}, expected a quality factor above 0.5")
+    q = _srs_q(args.srs_q)
     bounds = _range(args.range) if args.range else None
     frequencies, required = read_spectrum(args.target_srs, args.accel_unit)
     shot = Shot.from_workbook(args.shot)
     started = time.perf_counter()
-    design = solve_srs(shot.params, frequencies, required, var, args.q, args.integrator,
+    design = solve_srs(shot.params, frequencies, required, var, q, args.integrator,
                        args.model, bounds)
     print(f"{var.cell}{'..A30' if var.cell == 'A28' else ''} = {design.values[0]:.6g} "
           f"{var.unit}")
-    print(f"  its SRS (Q = {args.q:g}) envelops the {len(frequencies)} required levels with a "
+    print(f"  its SRS (Q = {q:g}) envelops the {len(frequencies)} required levels with a "
           f"least margin of {design.margin:+.2%}, at {design.governing_hz:,.0f} Hz")
     print(f"  peak {design.peak_kg:.5f} kG, pulse {design.duration * 1e3:.4f} ms; "
           f"{design.evaluations} simulations in {time.perf_counter() - started:.2f} s")
-    return _write_design(args, shot, design, (frequencies, required, args.q))
+    return _write_design(args, shot, design, (frequencies, required, q))
+
+
+def _srs_q(text):
+    """--srs-q with --target-srs: the SRS's quality factor (default 10) [-]."""
+    if text is None:
+        return 10.0
+    try:
+        q = float(text)
+    except ValueError:
+        q = float("nan")
+    if not 0.5 < q < 1e6:
+        raise OptionError(f"--srs-q: found {text!r}, expected a quality factor above 0.5")
+    return q
 
 
 def run_spec(args):

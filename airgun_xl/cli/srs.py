@@ -3,6 +3,7 @@ from pathlib import Path
 
 from ..errors import OptionError
 from .run_options import SHOT_HELP, add_force, add_output, add_run_options
+from .vocabulary import Alias
 
 
 def add_parser(sub):
@@ -13,8 +14,10 @@ def add_parser(sub):
     p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
     add_output(p, "the SRS workbook", "SHOT.srs.xlsx")
     add_force(p)
-    p.add_argument("--q", type=float, default=10.0, help="quality factor (default 10: 5 %% "
-                                                         "damping)")
+    p.add_argument("--srs-q", type=float, default=10.0, metavar="Q",
+                   help="quality factor (default 10: 5 %% damping)")
+    p.add_argument("--q", type=float, dest="srs_q", metavar="Q", action=Alias,
+                   idea="SRS quality factor")
     p.add_argument("--cfc", type=int, help="filter the pulse first: SAE J211 class 60, 180, "
                                            "600 or 1000")
     p.add_argument("--from", dest="lo", type=float, default=100.0, metavar="HZ",
@@ -69,14 +72,14 @@ def run(args):
     if args.cfc is not None:
         pulse = cfc_filter(pulse, dt, args.cfc)
     freqs = default_frequencies(args.lo, args.hi)
-    spectrum = srs(pulse, dt, freqs, args.q)
-    about = [("Shot", str(args.shot)), ("Quality factor Q", f"{args.q:g}"),
+    spectrum = srs(pulse, dt, freqs, args.srs_q)
+    about = [("Shot", str(args.shot)), ("Quality factor Q", f"{args.srs_q:g}"),
              ("Filter", f"CFC {args.cfc}" if args.cfc else "none"),
              ("Model, integrator", f"{args.model}, {args.integrator}")]
     write_srs(output, freqs, spectrum, about, args.force, shot=shot_path.name,
               warnings=warnings)
     k = int(np.argmax(spectrum))
     print(f"wrote {output}: SRS at {len(freqs)} frequencies, {args.lo:g}-{args.hi:g} Hz, "
-          f"Q = {args.q:g}; largest {spectrum[k]:.4f} kG at {freqs[k]:,.0f} Hz")
+          f"Q = {args.srs_q:g}; largest {spectrum[k]:.4f} kG at {freqs[k]:,.0f} Hz")
     warn(warnings)
     return 0

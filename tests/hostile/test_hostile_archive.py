@@ -31,7 +31,7 @@ def test_a_foreign_folder_is_never_written_or_cleaned(tmp_path, capsys):
     refused(capsys, ["archive", "verify", home], tmp_path, naming=["not an airgun-xl archive"])
     refused(capsys, ["fill", SHOT, "-o", out, "--archive", home], tmp_path,
             naming=["not an airgun-xl archive"])
-    refused(capsys, ["history", home], tmp_path, naming=["not an airgun-xl archive"])
+    refused(capsys, ["history", "--archive", home], tmp_path, naming=["not an airgun-xl archive"])
     refused(capsys, ["show", "x", "--archive", home], tmp_path, naming=["not an airgun-xl"])
     refused(capsys, ["compare", "a", "b", "--archive", home], tmp_path, naming=["not an"])
     assert not out.exists()  # refused before the run, so no workbook either
@@ -39,8 +39,8 @@ def test_a_foreign_folder_is_never_written_or_cleaned(tmp_path, capsys):
 
 def test_a_missing_archive_is_not_created_by_reading_it(tmp_path, capsys):
     gone = tmp_path / "no" / "such" / "dir"
-    for argv in (["archive", "verify", gone], ["history", gone], ["show", "x", "--archive",
-                                                                    gone]):
+    for argv in (["archive", "verify", gone], ["history", "--archive", gone],
+                 ["show", "x", "--archive", gone]):
         refused(capsys, argv, tmp_path, naming=["no such archive"])
     assert not (tmp_path / "no").exists()
     refused(capsys, ["fill", SHOT, "-o", tmp_path / "o.xlsx", "--archive", gone], tmp_path,
