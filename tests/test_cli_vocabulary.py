@@ -150,3 +150,43 @@ def test_an_old_spelling_still_works_and_says_the_new_one(tmp_path, capsys):
     assert captured.out == old and captured.err == ""
     assert main(["history", str(archive), "--archive", str(tmp_path)]) == 2
     assert "expected one archive" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("words", [("srs",), ("compare-measured",), ("calibrate",),
+                                   ("accept",)], ids=" ".join)
+def test_the_filter_is_cfc_n_or_none_in_every_command(words, capsys):
+    """--cfc takes a J211 class or none (no filter: as if not given, but said), and anything
+    else is one line naming the option."""
+    parser = SUBPARSERS[words]
+    positionals = ["s.xlsx"] if words == ("srs",) else ["s.xlsx", "r.csv"]
+    given = parser.parse_args([*positionals, "--cfc", "none"])
+    assert given.cfc is None and given.cfc_given
+    assert parser.parse_args([*positionals, "--cfc", "600"]).cfc == 600
+    assert parser.parse_args(positionals).cfc is None
+    assert "--cfc N|none" in parser.format_usage()
+    with pytest.raises(Exception, match="--cfc: found 'x', expected a J211 class"):
+        parser.parse_args([*positionals, "--cfc", "x"])
+
+
+def test_accept_cfc_none_judges_the_unfiltered_record_or_refuses_a_conflict(tmp_path, capsys):
+    """accept --cfc none against a specification that judges CFC 1000 is refused in one line;
+    with a specification that says nothing of the record, the unfiltered record is judged."""
+    from conftest import TEMPLATE
+
+    from airgun_xl.cli import main
+
+    recording = TEMPLATE.parent / "shot_a_recording.csv"
+    base = ["accept", str(TEMPLATE), str(recording), "--sign", "-1", "--peak", "9.5kG:10%",
+            "-o", str(tmp_path / "a.xlsx")]
+    assert main([*base, "--cfc", "none", "--record", "cfc1000"]) == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        "airgun-xl: error: --cfc: found none, but the specification (options) judges the "
+        "record CFC 1000; expected one of them (or --record)"]
+    import re
+
+    peaks = {}
+    for name, extra in (("none", ["--cfc", "none"]), ("absent", []),
+                        ("1000", ["--cfc", "1000"])):
+        assert main([*base, *extra, "--force"]) in (0, 3)
+        peaks[name] = re.search(r"peak: ([\d.]+) kG", capsys.readouterr().out)[1]
+    assert peaks["none"] == peaks["absent"] != peaks["1000"]  # none: the unfiltered record

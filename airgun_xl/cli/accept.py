@@ -24,7 +24,8 @@ def add_parser(sub):
     add_output(p, "verdict workbook", "SHOT.accept.xlsx")
     add_force(p)
     add_recording_options(p, anti_alias=False, cfc_help=(
-        "the record judged: SAE J211 class 60, 180, 600 or 1000, as --record cfcN (refused "
+        "the record judged: SAE J211 class 60, 180, 600 or 1000, or none (unfiltered), as "
+        "--record cfcN or unfiltered (refused "
         "where the filter is unstable, below 4.155 x the class in samples a second; a warning"
         " below J211's 10 x)"))
     add_spec_options(p)
@@ -39,12 +40,14 @@ def judged_cfc(args, spec):
     from ..errors import OptionError
 
     given = spec.origin("record") not in (None, "default")
-    if args.cfc is not None and given and args.cfc != spec.cfc:
+    cfc_given = getattr(args, "cfc_given", False)  # --cfc none: the unfiltered record
+    if cfc_given and given and args.cfc != spec.cfc:
         judged = f"CFC {spec.cfc}" if spec.cfc else "unfiltered"
-        raise OptionError(f"--cfc: found {args.cfc}, but the specification "
+        found = args.cfc if args.cfc is not None else "none"
+        raise OptionError(f"--cfc: found {found}, but the specification "
                           f"({spec.origin('record')}) judges the record {judged}; expected "
                           "one of them (or --record)")
-    return args.cfc if args.cfc is not None else spec.cfc
+    return args.cfc if cfc_given else spec.cfc
 
 
 def run(args):

@@ -1,12 +1,32 @@
 """The options of a measured recording, defined once for every command that reads one
 (compare-measured, calibrate): its channel, units, sign, the CFC filter and the recorder's
 anti-alias model."""
+import argparse
+
+
+def cfc_value(text):
+    """``--cfc``: a SAE J211 class (checked where it is used, with its own message), or
+    ``none`` for no filter (None)."""
+    if text.strip().lower() == "none":
+        return None
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"found {text!r}, expected a J211 class (60, 180, "
+                                         "600 or 1000) or none") from None
+
+
+class CfcOption(argparse.Action):
+    """``--cfc N|none``: stores the class (None for none) and that the option was given, so
+    that accept's ``--cfc none`` judges the unfiltered record over a specification's class."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, values)
+        namespace.cfc_given = True
 
 
 def sign_value(text):
     """``--sign``: 1 or -1 (``+1``, ``1.0`` and ``-1.0`` read the same) [-]."""
-    import argparse
-
     try:
         value = float(text)
     except ValueError:
@@ -39,8 +59,9 @@ def add_recording_options(p, channel_help="TDMS only: the channel (default: the 
     """The recording's options; ``anti_alias`` False for a command with no prediction to put
     through the recorder's filter (accept: the option would be accepted and ignored)."""
     p.add_argument("--channel", metavar="GROUP/CHANNEL", help=channel_help)
-    p.add_argument("--cfc", type=int, default=None,
-                   help=cfc_help or "filter both pulses: SAE J211 class 60, 180, 600 or 1000 "
+    p.add_argument("--cfc", type=cfc_value, default=None, metavar="N|none", action=CfcOption,
+                   help=cfc_help or "filter both pulses: SAE J211 class 60, 180, 600 or 1000, "
+                        "or none (the default) "
                         "(refused where the filter is unstable, below 4.155 x the class in "
                         "samples a second; a warning below J211's 10 x)")
     p.add_argument("--sign", type=sign_value, default=1.0, metavar="1|-1",

@@ -2,6 +2,7 @@
 from pathlib import Path
 
 from ..errors import OptionError
+from .recording_options import CfcOption, cfc_value
 from .run_options import SHOT_HELP, add_force, add_output, add_run_options
 from .vocabulary import Alias
 
@@ -18,8 +19,9 @@ def add_parser(sub):
                    help="quality factor (default 10: 5 %% damping)")
     p.add_argument("--q", type=float, dest="srs_q", metavar="Q", action=Alias,
                    idea="SRS quality factor")
-    p.add_argument("--cfc", type=int, help="filter the pulse first: SAE J211 class 60, 180, "
-                                           "600 or 1000")
+    p.add_argument("--cfc", type=cfc_value, action=CfcOption, metavar="N|none",
+                   help="filter the pulse first: SAE J211 class 60, 180, 600 or 1000, or "
+                        "none (the default)")
     p.add_argument("--from", dest="lo", type=float, default=100.0, metavar="HZ",
                    help="lowest natural frequency (default 100)")
     p.add_argument("--to", dest="hi", type=float, default=10_000.0, metavar="HZ",
