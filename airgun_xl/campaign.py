@@ -112,6 +112,11 @@ def shot_files(paths, exclude=()):
     return out
 
 
+def _output(path, settings):
+    """Where a shot of the batch is written: -o, or SHOT.out.xlsx beside it."""
+    return Path(settings.output) if settings.output else default_output(Path(path))
+
+
 def fill_one(path, settings, warn, note=None, progress_for=None, started=None):
     """Fill the shot at ``path`` as ``settings`` ask; return (output path, Filled, archive
     root or None). ``progress_for(rows)`` makes the run's progress callback (told each stage;
@@ -123,7 +128,7 @@ def fill_one(path, settings, warn, note=None, progress_for=None, started=None):
     from .shot import Shot
 
     started = time.perf_counter() if started is None else started
-    output = Path(settings.output) if settings.output else default_output(path)
+    output = _output(path, settings)
     root = archive_dir(settings.archive, required=False)
     library = settings.crush_law not in ("workbook", "legacy")
     if library and root is None:
@@ -223,13 +228,13 @@ def fill_task(path, settings, k=None):
 
 def _fill_task(path, settings):
     path = Path(path)
-    output = Path(settings.output) if settings.output else default_output(path)
+    output = _output(path, settings)
     warnings: list = []
     if _STOP is not None and _STOP.is_set():  # the batch was stopped before this shot began
         return _failed(path, output, "interrupted", "not started: the campaign was stopped")
     if not settings.force and os.path.lexists(output):  # filled before: not run again
-        return _failed(path, output, "skipped", f"{display(output)}: already exists "
-                                                "(--force overwrites it)")
+        return _failed(path, output, "skipped", f"{display(output)} exists (--force "
+                                                "overwrites it)")
     try:
         output, filled, _ = fill_one(path, settings, warnings.extend, None,
                                      lambda rows: _check_stop)
@@ -256,7 +261,7 @@ def _lost(path, settings, pid):
     from .transaction.publication import recover
 
     path = Path(path)
-    output = Path(settings.output) if settings.output else default_output(path)
+    output = _output(path, settings)
     if output.parent.is_dir():
         with contextlib.suppress(OSError), folder_lock(output.parent):
             recover(output.parent)  # the dead worker's temps and journal, if any
@@ -269,9 +274,9 @@ def _unreported(path, settings):
     """The row of a shot published by a worker the broken pool took down before its row
     came back: the workbook is complete, its figures are not in this table."""
     path = Path(path)
-    output = Path(settings.output) if settings.output else default_output(path)
-    return _failed(path, output, "skipped", f"{display(output)}: filled by this run, but its "
-                                            "row was lost when another worker died (its "
+    output = _output(path, settings)
+    return _failed(path, output, "skipped", f"{display(output)} was filled by this run, but "
+                                            "its row was lost when another worker died (its "
                                             "figures are in the workbook)")
 
 

@@ -80,7 +80,7 @@ def run_batch(args, settings):
             _say(f"airgun-xl: error: {message}" if message.startswith(f"{name}: ") else
                  f"airgun-xl: error: {name}: {message}")
         elif row["status"] == "skipped":
-            note([f"{name}: skipped, {row['output']} exists (--force overwrites it)"])
+            note([f"{name}: skipped, {row['message']}"])  # exists, or its row was lost
         else:
             warn([f"{name}: {w}" for w in row["warnings"]])
         bar.update(row["status"] in ("failed", "lost"))
@@ -99,14 +99,14 @@ def run_batch(args, settings):
     seconds = time.perf_counter() - started
     counts = {s: sum(r["status"] == s for r in rows)
               for s in ("filled", "failed", "lost", "skipped")}
-    lost = f"{counts['lost']} lost, " if counts["lost"] else ""
+    lost_part = f"{counts['lost']} lost, " if counts["lost"] else ""
     for row in rows:
         if row["status"] == "filled":
             print(f"{row['file']} -> {row['output']}: peak {row['peak_kg']:.5f} kG at "
                   f"{row['time_of_peak'] * 1e3:.4f} ms"
                   + (f", {row['warning_count']} warnings" if row["warning_count"] else "")
                   + (f", archived as {row['entry']}" if row.get("entry") else ""))
-    print(f"{len(files)} shots: {counts['filled']} filled, {counts['failed']} failed, {lost}"
+    print(f"{len(files)} shots: {counts['filled']} filled, {counts['failed']} failed, {lost_part}"
           f"{counts['skipped']} skipped, in {seconds:.2f} s with {min(jobs, len(files))} "
           f"job{'s' * (min(jobs, len(files)) > 1)} ({seconds / len(files):.2f} s a shot)")
     if summary is not None:
@@ -114,13 +114,13 @@ def run_batch(args, settings):
 
         write_campaign(summary, rows, f"Campaign: {len(files)} shots filled by airgun-xl "
                                       f"({counts['filled']} filled, {counts['failed']} "
-                                      f"failed, {lost}{counts['skipped']} skipped)", args.force,
-                       label=summary.name)
+                                      f"failed, {lost_part}{counts['skipped']} skipped)",
+                       args.force, label=summary.name)
         print(f"wrote {summary}: one row a shot, the peak against v0")
     if counts["failed"] or counts["lost"]:
-        failed, lost_ = counts["failed"], counts["lost"]
+        failed, lost = counts["failed"], counts["lost"]
         what = (f"{failed} of {len(files)} shots failed"
-                + (f" and {lost_} lost with their worker" if lost_ else "")) if failed else \
-            f"{lost_} of {len(files)} shots lost with their worker"
+                + (f" and {lost} lost with their worker" if lost else "")) if failed else \
+            f"{lost} of {len(files)} shots lost with their worker"
         raise CampaignError(f"{what} (each said above); the others were filled")
     return 0
