@@ -373,3 +373,24 @@ def test_compare_takes_diffs_atol_json_and_report(tmp_path, capsys):
     assert "--force" in capsys.readouterr().err
     assert main([*compare, "--atol", "-1"]) == 2
     assert "--atol: found '-1', expected a number >= 0" in capsys.readouterr().err
+
+
+def test_an_archive_marked_by_another_fill_while_it_is_checked_is_adopted(tmp_path,
+                                                                          monkeypatch):
+    """The race test_two_processes_filling_at_once_lose_nothing met once in CI: one fill made
+    the folder, and the other found it unmarked, then (before its emptiness check) not empty,
+    because the first had just written the marker. The check now looks at the marker again:
+    here the marker appears between the two looks, as the other process would write it."""
+    import airgun_xl.archive.store as store
+
+    root = tmp_path / "archive"
+    root.mkdir()
+    real = os.scandir
+
+    def marked_meanwhile(path):
+        (root / store.MARKER).write_text('{"format": 1, "tool": "airgun-xl"}')
+        return real(path)
+
+    monkeypatch.setattr(store.os, "scandir", marked_meanwhile)
+    assert Archive(root, create=True).root == root
+    assert (root / store.MARKER).is_file()

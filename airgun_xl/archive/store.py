@@ -248,7 +248,9 @@ class Archive:
                 empty = not any(os.scandir(self.root))
             except OSError as exc:
                 raise ArchiveError(f"{shown}: cannot be read ({exc.strerror})") from None
-            if not (create and empty):
+            # a fill that created the folder a moment ago may have marked it since we looked
+            marked = (self.root / MARKER).is_file() or _is_index(self.root / INDEX)
+            if not (create and empty) and not marked:
                 raise ArchiveError(
                     f"{shown}: is not an airgun-xl archive (no {MARKER} or {INDEX}), expected "
                     + ("an archive, an empty folder or a new folder name" if create
