@@ -411,7 +411,7 @@ def _name(text: str, where: str, names: tuple, what: str) -> str:
     return value
 
 
-def parse_record(text: str, where: str = "--record") -> int:
+def parse_record(text: str, where: str = "record") -> int:
     """``unfiltered`` -> 0; ``cfc600`` or ``CFC 600`` -> 600."""
     value = str(text).strip().lower()
     match = re.fullmatch(r"cfc\s*(\d{1,5})", value)
@@ -597,7 +597,7 @@ OPTIONS = {"shape": "--shape", "peak": "--peak", "peak_tolerance": "--peak",
            "velocity_change_tolerance": "--velocity-change", "corridor": "--corridor",
            "time_slack": "--time-slack", "dv_window": "--dv-window",
            "monitor": "--monitor", "duration_def": "--duration-def", "decay": "--decay",
-           "record": "--record",
+           "record": "--cfc",
            "placement": "--placement", "srs_q": "--srs-q", "srs_lower_db": "--srs-tol",
            "srs_upper_db": "--srs-tol", "srs_outside": "--srs-outside"}
 

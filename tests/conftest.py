@@ -72,6 +72,22 @@ def write_trace_csv(path, trace):
     return path
 
 
+def command_options(command="fill", **given):
+    """The namespace ``command``'s real parser makes of option texts given by their dests
+    (``time_slack="10%"``), after stand-in positionals; ``record`` is the specification's
+    field as a sheet writes it (``cfc600``, ``unfiltered``), given as ``--cfc``."""
+    from airgun_xl.cli.commands import build_parser
+
+    if given.get("record") is not None:
+        record = given.pop("record").strip().lower()
+        given["cfc"] = "none" if record == "unfiltered" else record.removeprefix("cfc").strip()
+    argv = [f"--{dest.replace('_', '-')}={text}" for dest, text in given.items()
+            if text is not None]
+    positionals = ["s.xlsx", "r.csv"] if command in ("accept", "compare-measured",
+                                                      "calibrate") else ["s.xlsx"]
+    return build_parser().parse_args([command, *positionals, *argv])
+
+
 def template_with(tmp_path, **cells):
     """A copy of the template in ``tmp_path`` with some parameter cells changed (openpyxl)."""
     shot = tmp_path / "shot.xlsx"

@@ -169,8 +169,9 @@ def test_the_filter_is_cfc_n_or_none_in_every_command(words, capsys):
 
 
 def test_accept_cfc_none_judges_the_unfiltered_record_or_refuses_a_conflict(tmp_path, capsys):
-    """accept --cfc none against a specification that judges CFC 1000 is refused in one line;
-    with a specification that says nothing of the record, the unfiltered record is judged."""
+    """accept --cfc none with its old spelling --record cfc1000 is refused in one line (after
+    the old spelling's note). --cfc none judges the unfiltered record; without --cfc (and no
+    record on the sheet) the tool's default low-pass is judged, and said."""
     from conftest import TEMPLATE
 
     from airgun_xl.cli import main
@@ -179,14 +180,38 @@ def test_accept_cfc_none_judges_the_unfiltered_record_or_refuses_a_conflict(tmp_
     base = ["accept", str(TEMPLATE), str(recording), "--sign", "-1", "--peak", "9.5kG:10%",
             "-o", str(tmp_path / "a.xlsx")]
     assert main([*base, "--cfc", "none", "--record", "cfc1000"]) == 2
-    assert capsys.readouterr().err.strip().splitlines() == [
-        "airgun-xl: error: --cfc: found none, but the specification (options) judges the "
-        "record CFC 1000; expected one of them (or --record)"]
+    assert capsys.readouterr().err.strip().splitlines()[-1] == (
+        "airgun-xl: error: --record: found 1000, where --cfc gave none; expected the filter "
+        "once (--cfc)")
     import re
 
-    peaks = {}
+    peaks, judged = {}, {}
     for name, extra in (("none", ["--cfc", "none"]), ("absent", []),
-                        ("1000", ["--cfc", "1000"])):
+                        ("1000", ["--cfc", "1000"]), ("record", ["--record", "cfc1000"])):
         assert main([*base, *extra, "--force"]) in (0, 3)
-        peaks[name] = re.search(r"peak: ([\d.]+) kG", capsys.readouterr().out)[1]
-    assert peaks["none"] == peaks["absent"] != peaks["1000"]  # none: the unfiltered record
+        out = capsys.readouterr().out
+        peaks[name] = float(re.search(r"peak: ([\d.]+) kG", out)[1])
+        judged[name] = re.search(r"record judged: (.*)", out)[1]
+    assert judged["none"] == "unfiltered" and judged["absent"].startswith("the tool's default")
+    assert judged["1000"] == judged["record"] == "CFC 1000 (SAE J211), both ways"
+    # the unfiltered record keeps the ringing a low-pass takes off: its peak is the highest
+    assert peaks["none"] > max(peaks["absent"], peaks["1000"])
+    assert peaks["record"] == peaks["1000"]  # the old spelling, the same filter
+
+
+@pytest.mark.parametrize("words", [("fill",), ("design",), ("accept",)], ids=" ".join)
+def test_cfc_is_the_record_judged_in_every_command_that_judges(words):
+    """fill, design and accept take the specification's record as --cfc N|none (the field is
+    still 'record' on the sheet); --record is its old spelling, with a note."""
+    from airgun_xl.cli.spec_options import options_spec
+
+    parser = SUBPARSERS[words]
+    positionals = ["s.xlsx", "r.csv"] if words == ("accept",) else ["s.xlsx"]
+    spec = options_spec(parser.parse_args([*positionals, "--cfc", "600"]))
+    assert spec.cfc == 600 and spec.origin("record") == "options"
+    assert options_spec(parser.parse_args([*positionals, "--cfc", "none"])).cfc == 0
+    assert options_spec(parser.parse_args(positionals)) is None
+    with pytest.raises(Exception, match="--record: found 'cfc7', expected unfiltered or one "
+                                        "of 60, 180, 600, 1000"):
+        parser.parse_args([*positionals, "--record", "cfc7"])
+    assert "--cfc N|none" in parser.format_usage()

@@ -106,7 +106,8 @@ def test_srs_command_writes_the_spectrum_of_the_predicted_pulse(tmp_path, capsys
 
 
 @pytest.mark.parametrize("args,start", [
-    (["--cfc", "7"], "--cfc: found 7, expected one of 60, 180, 600, 1000"),
+    (["--cfc", "7"], "srs: argument --cfc: found '7', expected a J211 class (60, 180, 600 or "
+                        "1000) or none"),
     (["--from", "5000", "--to", "100"], "--from/--to: found 5000 and 100 Hz"),
 ])
 def test_srs_command_refuses_bad_options(tmp_path, capsys, args, start):

@@ -58,14 +58,11 @@ def accept(tmp_path, capsys, t, kg, *flags):
 
 def options(**given):
     """The specification option texts give, as the command line reads them (not merged)."""
-    import argparse
+    from conftest import command_options
 
     from airgun_xl.cli.spec_options import options_spec
 
-    names = ("profile", "shape", "peak", "duration", "velocity_change", "corridor",
-             "time_slack", "window", "dv_window", "monitor", "duration_def", "decay",
-             "placement", "record", "srs", "srs_tol", "srs_q", "srs_outside", "accel_unit")
-    return options_spec(argparse.Namespace(**{n: given.get(n) for n in names}))
+    return options_spec(command_options("accept", **given))
 
 
 def spec(**given):

@@ -5,7 +5,7 @@ from pathlib import Path
 
 from .recording_options import RECORDING_HELP, add_recording_options
 from .run_options import SHOT_HELP, add_force, add_output
-from .spec_options import add_spec_options
+from .spec_options import RECORD_HELP, add_spec_options
 
 #: The exit status of a shot that fails its specification (2 stays for bad input).
 FAIL_EXIT = 3
@@ -24,34 +24,16 @@ def add_parser(sub):
     add_output(p, "verdict workbook", "SHOT.accept.xlsx")
     add_force(p)
     add_recording_options(p, anti_alias=False, cfc_help=(
-        "the record judged: SAE J211 class 60, 180, 600 or 1000, or none (unfiltered), as "
-        "--record cfcN or unfiltered (refused "
-        "where the filter is unstable, below 4.155 x the class in samples a second; a warning"
-        " below J211's 10 x)"))
-    add_spec_options(p)
+        RECORD_HELP + ", over the sheet's and the profile's (refused where the filter is "
+        "unstable, below 4.155 x the class in samples a second; a warning below J211's 10 x)"))
+    add_spec_options(p, cfc=False)
     p.add_argument("--archive", metavar="DIR",
                    help="record the verdict in the archive (the verdict file of the shot's "
                         "next entry)")
     p.set_defaults(run=run)
 
 
-def judged_cfc(args, spec):
-    """The record judged: --cfc, or the specification's; both, and different: refused."""
-    from ..errors import OptionError
-
-    given = spec.origin("record") not in (None, "default")
-    cfc_given = getattr(args, "cfc_given", False)  # --cfc none: the unfiltered record
-    if cfc_given and given and args.cfc != spec.cfc:
-        judged = f"CFC {spec.cfc}" if spec.cfc else "unfiltered"
-        found = args.cfc if args.cfc is not None else "none"
-        raise OptionError(f"--cfc: found {found}, but the specification "
-                          f"({spec.origin('record')}) judges the record {judged}; expected "
-                          "one of them (or --record)")
-    return args.cfc if cfc_given else spec.cfc
-
-
 def run(args):
-    import dataclasses
 
     from ..errors import OptionError
     from ..readers.recording import input_file, read_trace
@@ -76,8 +58,7 @@ def run(args):
         raise OptionError(f"{args.shot}: its Specification sheet is empty and no option gives"
                           " a criterion; expected --peak, --duration, --velocity-change, --srs"
                           " or --profile")
-    cfc = judged_cfc(args, spec)
-    spec = dataclasses.replace(spec, cfc=cfc)
+    cfc = spec.cfc  # --cfc is the specification's record field, over the sheet's
     trace = read_trace(args.recording, args.time_unit, args.accel_unit, args.sign,
                        args.channel)
     from ..studies.shock import check_cfc

@@ -3,26 +3,71 @@
 anti-alias model."""
 import argparse
 
+from ..specification import CFC_CLASSES
+from .vocabulary import Alias
+
+#: What ``--cfc`` takes, said by every refusal of it.
+CFC_EXPECTED = "a J211 class (60, 180, 600 or 1000) or none"
+
 
 def cfc_value(text):
-    """``--cfc``: a SAE J211 class (checked where it is used, with its own message), or
-    ``none`` for no filter (None)."""
+    """``--cfc``: a SAE J211 class, or ``none`` for no filter (None)."""
     if text.strip().lower() == "none":
         return None
     try:
-        return int(text)
+        value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"found {text!r}, expected a J211 class (60, 180, "
-                                         "600 or 1000) or none") from None
+        value = None
+    if value not in CFC_CLASSES:
+        raise argparse.ArgumentTypeError(f"found {text!r}, expected {CFC_EXPECTED}")
+    return value
+
+
+def record_value(text):
+    """``--record`` (the old spelling of ``--cfc``): ``unfiltered`` or ``cfcN``, as the
+    Specification sheet writes the record judged."""
+    value = text.strip().lower().replace(" ", "")
+    if value == "unfiltered":
+        return None
+    if value.startswith("cfc") and value[3:].isdigit() and int(value[3:]) in CFC_CLASSES:
+        return int(value[3:])
+    raise argparse.ArgumentTypeError(f"found {text!r}, expected unfiltered or one of 60, 180,"
+                                     " 600, 1000 (cfc600)")
+
+
+def _given(namespace, option_string, value):
+    """Store the class, and which option gave it; the filter given by both its spellings,
+    differently, is refused (the last would otherwise win unseen)."""
+    from ..errors import OptionError
+
+    first = getattr(namespace, "cfc_given", None)
+    if first and first != option_string and getattr(namespace, "cfc", None) != value:
+        def shown(cfc):
+            return "none" if cfc is None else str(cfc)
+
+        raise OptionError(f"{option_string}: found {shown(value)}, where {first} gave "
+                          f"{shown(namespace.cfc)}; expected the filter once (--cfc)")
+    namespace.cfc = value
+    namespace.cfc_given = option_string
 
 
 class CfcOption(argparse.Action):
-    """``--cfc N|none``: stores the class (None for none) and that the option was given, so
-    that accept's ``--cfc none`` judges the unfiltered record over a specification's class."""
+    """``--cfc N|none``: stores the class (None for none) and which option gave it, so that
+    ``--cfc none`` judges the unfiltered record over a specification's class."""
 
     def __call__(self, parser, namespace, values, option_string=None):
-        setattr(namespace, self.dest, values)
-        namespace.cfc_given = True
+        _given(namespace, option_string or "--cfc", values)
+
+
+class RecordAlias(Alias):
+    """``--record unfiltered|cfcN``: the old spelling of ``--cfc``, kept one release."""
+
+    def __init__(self, option_strings, dest, **kwargs):
+        super().__init__(option_strings, dest, idea="recording's filter", **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        super().__call__(parser, argparse.Namespace(), values, option_string)  # the note
+        _given(namespace, option_string or "--record", values)
 
 
 def sign_value(text):

@@ -12,10 +12,19 @@ from ..specification import DURATION_DEFS, OPTIONS, PLACEMENTS, SHAPES
 QUANTITY_OPTIONS = tuple((key, option) for key, option in OPTIONS.items()
                          if f"{key}_tolerance" in OPTIONS)
 PLAIN_OPTIONS = tuple((key, option) for key, option in OPTIONS.items()
-                      if option not in dict(QUANTITY_OPTIONS).values() and option != "--srs-tol")
+                      if option not in dict(QUANTITY_OPTIONS).values()
+                      and option not in ("--srs-tol", "--cfc"))
+
+#: The help of the record judged, where ``--cfc`` is a field of the specification.
+RECORD_HELP = ("the record judged: a SAE J211 class (60, 180, 600 or 1000), or none for the "
+               "unfiltered record (the default); the Specification sheet's 'record' field")
 
 
-def add_spec_options(p):
+def add_spec_options(p, cfc=True):
+    """The specification's options; ``cfc`` False where the command's recording options
+    already give ``--cfc`` (accept), the record judged all the same."""
+    from .recording_options import CfcOption, RecordAlias, cfc_value, record_value
+
     g = p.add_argument_group("specification (override the shot's Specification sheet and the"
                              " profile, field by field)")
     g.add_argument("--profile", metavar="NAME|FILE.json",
@@ -51,8 +60,11 @@ def add_spec_options(p):
                         "10%% (the default)")
     g.add_argument("--placement", metavar="|".join(PLACEMENTS),
                    help="where the ideal pulse sits: least squares (default) or on the peak")
-    g.add_argument("--record", metavar="unfiltered|cfcN",
-                   help="the record judged: unfiltered (default) or a J211 class, cfc600")
+    if cfc:
+        g.add_argument("--cfc", type=cfc_value, default=None, metavar="N|none",
+                       action=CfcOption, help=RECORD_HELP)
+    g.add_argument("--record", type=record_value, metavar="unfiltered|cfcN", dest="cfc",
+                   action=RecordAlias)
     g.add_argument("--srs", metavar="REQ.csv",
                    help="an SRS requirement (CSV: 'frequency [Hz],srs [g]')")
     g.add_argument("--srs-tol", metavar="LO,HI", help="its tolerance in dB: -3dB,+6dB "
@@ -98,6 +110,8 @@ def options_spec(args):
         window = parse_window(args.window, "--window")
         for key in ALIASES["window"]:
             parsed.setdefault(key, window)
+    if getattr(args, "cfc_given", None):  # --cfc none: the unfiltered record, said
+        parsed["record"] = args.cfc or 0
     if getattr(args, "srs_tol", None) is not None:
         parsed["srs_lower_db"], parsed["srs_upper_db"] = parse_db_pair(args.srs_tol)
     srs = None
@@ -109,6 +123,8 @@ def options_spec(args):
     units = {key: typed_unit(getattr(args, key)) for key, _ in QUANTITY_OPTIONS
              if key in SHOWN_UNITS and getattr(args, key, None) is not None}
     places = {key: option for key, option in OPTIONS.items() if key in parsed}
+    if "record" in parsed:
+        places["record"] = args.cfc_given  # --cfc, or its old spelling as typed
     if getattr(args, "window", None) is not None:
         places.update({k: "--window" for k in ALIASES["window"] if k not in places or
                        getattr(args, k, None) is None})

@@ -40,8 +40,6 @@ def run(args):
     from ..shot import Shot
     from ..studies.check import after_run, before_run
     from ..studies.shock import (
-        CFC_CLASSES,
-        cfc_coefficients,
         cfc_filter,
         default_frequencies,
         srs,
@@ -49,8 +47,6 @@ def run(args):
     from ..transaction import check_output
     from .messages import warn
 
-    if args.cfc is not None and args.cfc not in CFC_CLASSES:
-        cfc_coefficients(args.cfc, 1.0)  # its one-line error, before the run
     if not (0 < args.lo < args.hi < float("inf")):
         raise OptionError(f"--from/--to: found {args.lo:g} and {args.hi:g} Hz, expected "
                           "0 < FROM < TO")

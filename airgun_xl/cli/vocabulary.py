@@ -39,7 +39,7 @@ VOCABULARY = {
     "archive folder": Idea("--archive", ("archive", "dir"), aliases=("DIR",),
                            subjects=("archive",)),
     "SRS quality factor": Idea("--srs-q", ("srs_q",), aliases=("--q",)),
-    "recording's filter": Idea("--cfc", ("cfc",)),
+    "recording's filter": Idea("--cfc", ("cfc",), aliases=("--record",)),
     "recording": Idea("RECORDING", ("recording", "measured")),
     "recording's sign": Idea("--sign", ("sign",)),
     "seed of the draws": Idea("--seed", ("seed",)),

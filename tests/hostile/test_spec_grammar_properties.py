@@ -15,9 +15,11 @@ import math
 from dataclasses import fields
 
 import pytest
+from conftest import command_options
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from airgun_xl.cli.commands import build_parser
 from airgun_xl.cli.spec_options import PLAIN_OPTIONS, QUANTITY_OPTIONS, options_spec
 from airgun_xl.errors import AirgunXlError
 from airgun_xl.readers.spec_sheet import FIRST_ROW, ROWS, spec_from_cells
@@ -186,6 +188,8 @@ def test_sources_agree_an_option_a_sheet_cell_and_a_profile_key(data, tmp_path):
             ns = namespace(**{nominal: texts[nominal] + (
                 f":{texts[f'{nominal}_tolerance']}" if f"{nominal}_tolerance" in texts
                 else "")})
+        elif key == "record":  # the command line's spelling: --cfc 600, --cfc none
+            ns = command_options("fill", record=texts[key])
         else:
             ns = namespace(**{key: texts[key]})
         by_option = options_spec(ns)
@@ -277,6 +281,27 @@ def test_any_random_value_of_a_sheet_cell_is_a_value_or_one_line_naming_the_cell
     except AirgunXlError as exc:
         line = str(exc)
         assert "\n" not in line and line.startswith(f"'Specification'!{cell} "), line
+
+
+@SETTINGS
+@given(command=st.sampled_from(["fill", "design", "accept", "srs", "compare-measured",
+                                "calibrate"]),
+       option=st.sampled_from(["--cfc", "--record"]), text=NOISE)
+def test_any_random_string_as_the_filter_is_a_class_or_one_line_naming_the_option(
+        command, option, text):
+    """--cfc (and its old spelling --record) in every command that takes it: a J211 class,
+    none, or one line naming the option and the text found."""
+    if option == "--record" and command not in ("fill", "design", "accept"):
+        return  # --record was a specification option only
+    try:
+        ns = build_parser().parse_args([command, "s.xlsx", *(["r.csv"] * (command in (
+            "accept", "compare-measured", "calibrate"))), f"{option}={text}"])
+    except AirgunXlError as exc:
+        line = str(exc)
+        assert "\n" not in line and f"argument {option}: found {text!r}" in line, line
+        return
+    assert ns.cfc is None or ns.cfc in CFC_CLASSES
+    assert ns.cfc_given == option
 
 
 def test_a_quantity_past_float_range_is_one_line_not_an_overflow():
