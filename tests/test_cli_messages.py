@@ -104,7 +104,7 @@ def test_the_shared_run_options_have_one_help_text():
     for name, sub in subparsers.choices.items():
         for action in sub._actions:
             for flag in ("--integrator", "--model"):
-                if flag in action.option_strings and name != "convergence":  # takes a list
+                if flag in action.option_strings and name != "convergence":  # repeatable
                     helps.setdefault(flag, set()).add(action.help)
             if "--force" in action.option_strings:
                 assert action.help and action.help.startswith("overwrite "), name

@@ -152,6 +152,29 @@ def test_an_old_spelling_still_works_and_says_the_new_one(tmp_path, capsys):
     assert "expected one archive" in capsys.readouterr().err
 
 
+def test_convergence_takes_one_integrator_an_option_repeated(capsys):
+    """convergence --integrator is one choice, as in every other command, given again for
+    each integrator run side by side; the comma list is the old spelling, noted; a name not
+    an integrator is one line naming the option."""
+    from airgun_xl.errors import OptionError
+
+    parser = SUBPARSERS[("convergence",)]
+    assert parser.parse_args(["s.xlsx"]).integrator == ["legacy"]
+    assert parser.parse_args(["s.xlsx", "--integrator", "newmark"]).integrator == ["newmark"]
+    assert parser.parse_args(["s.xlsx", "--integrator", "newmark", "--integrator",
+                              "legacy"]).integrator == ["newmark", "legacy"]
+    assert capsys.readouterr().err == ""
+    assert parser.parse_args(["s.xlsx", "--integrator", "legacy,newmark"]).integrator == [
+        "legacy", "newmark"]
+    assert capsys.readouterr().err.strip() == (
+        "airgun-xl: note: --integrator legacy,newmark is the old spelling of --integrator "
+        "legacy --integrator newmark, kept until the next release: write --integrator legacy "
+        "--integrator newmark")
+    with pytest.raises(OptionError, match=r"^convergence: argument --integrator: found "
+                                          r"'rk4', expected one of legacy, newmark$"):
+        parser.parse_args(["s.xlsx", "--integrator", "rk4"])
+
+
 @pytest.mark.parametrize("words", [("srs",), ("compare-measured",), ("calibrate",),
                                    ("accept",)], ids=" ".join)
 def test_the_filter_is_cfc_n_or_none_in_every_command(words, capsys):

@@ -2,10 +2,9 @@
 import math
 from pathlib import Path
 
-from ..choices import INTEGRATORS
 from ..errors import OptionError
 from ..transaction import check_output
-from .run_options import SHOT_HELP, add_force, add_output
+from .run_options import SHOT_HELP, add_force, add_integrator, add_output
 
 
 def add_parser(sub):
@@ -18,8 +17,7 @@ def add_parser(sub):
     p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
     p.add_argument("--levels", help="comma-separated time steps, e.g. 5us,2us,1us,500ns "
                                     "(default: the sheet's E2, then 1-2-5 steps down to 5ns)")
-    p.add_argument("--integrator", default="legacy",
-                   help=f"one or more of {', '.join(sorted(INTEGRATORS))}, comma-separated")
+    add_integrator(p, repeated=True)
     p.add_argument("--rtol", default="1e-3", help="tolerance on the peak (default 0.1%%)")
     add_output(p, "workbook; the PNG goes beside it", "SHOT.convergence.xlsx")
     add_force(p)
@@ -33,11 +31,7 @@ def run(args):
     from .messages import warn
 
     shot = Shot.from_workbook(args.shot)
-    integrators = [n.strip() for n in args.integrator.split(",") if n.strip()]
-    unknown = [n for n in integrators if n not in INTEGRATORS]
-    if unknown or not integrators:
-        raise OptionError(f"--integrator: found {args.integrator!r}, expected one or more of "
-                          f"{', '.join(sorted(INTEGRATORS))}")
+    integrators = args.integrator
     try:
         rtol = float(args.rtol)
     except ValueError:

@@ -1,5 +1,7 @@
 """The options every running command shares, declared once: ``--integrator``, ``--model``,
 ``-o``/``--output`` and ``--force`` (their help texts then match across subcommands)."""
+import argparse
+
 from ..choices import INTEGRATORS, MODELS
 
 INTEGRATOR_HELP = ("legacy: ArtSim's scheme (the default); newmark: average-acceleration "
@@ -28,9 +30,38 @@ def tolerance(option, text):
 SHOT_HELP = "the shot's workbook, in the report's layout (.xlsx, .xlsm or .xls)"
 
 
-def add_integrator(p):
-    p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy",
-                   help=INTEGRATOR_HELP)
+def add_integrator(p, repeated=False):
+    """``--integrator``: one choice; ``repeated``, given once for each integrator a command
+    runs side by side (convergence), into a list."""
+    if not repeated:
+        p.add_argument("--integrator", choices=sorted(INTEGRATORS), default="legacy",
+                       help=INTEGRATOR_HELP)
+        return
+    p.add_argument("--integrator", action=Integrators, default=["legacy"],
+                   metavar="{" + ",".join(sorted(INTEGRATORS)) + "}",
+                   help=INTEGRATOR_HELP + "; give it again to run another side by side: "
+                        "--integrator legacy --integrator newmark")
+
+
+class Integrators(argparse.Action):
+    """A repeated ``--integrator``, one choice each time, into a list (the default's list
+    replaced by the first one given). ``legacy,newmark`` is the old spelling of two, noted."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from .messages import note
+        from .vocabulary import old_spelling_note
+
+        names = [n.strip() for n in str(values).split(",")]
+        if any(n not in INTEGRATORS for n in names):
+            raise argparse.ArgumentError(self, f"found {values!r}, expected one of "
+                                               f"{', '.join(sorted(INTEGRATORS))}")
+        if len(names) > 1:
+            note([old_spelling_note(f"{option_string} {values}", " ".join(
+                f"{option_string} {n}" for n in names))])
+        given = getattr(namespace, "integrators_given", False)
+        chosen = (getattr(namespace, self.dest) if given else []) + names
+        setattr(namespace, self.dest, list(dict.fromkeys(chosen)))  # each once, in order
+        namespace.integrators_given = True
 
 
 def add_model(p):

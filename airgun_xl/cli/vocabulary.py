@@ -43,6 +43,7 @@ VOCABULARY = {
     "recording": Idea("RECORDING", ("recording", "measured")),
     "recording's sign": Idea("--sign", ("sign",)),
     "seed of the draws": Idea("--seed", ("seed",)),
+    "integrator": Idea("--integrator", ("integrator",)),
     "relative tolerance": Idea("--rtol", ("rtol",)),
     "absolute tolerance": Idea("--atol", ("atol",)),
     "JSON on stdout": Idea("--json", ("json",)),
