@@ -1,7 +1,8 @@
 """Issue 10: output a test engineer reads and prints.
 
 The page counts come from LibreOffice's PDF export, which prints every sheet: report sheets on
-one page each, data sheets not at all (airgun_xl/xlsx/report.py).
+one page each, first; then each data sheet by itself, its pages numbered (issue 35; before,
+a data sheet printed nothing) (airgun_xl/xlsx/report.py).
 """
 import re
 import shutil
@@ -33,20 +34,41 @@ def _pdf_pages(path, tmp_path):
     return text.split("\f")[:-1]  # pdftotext ends every page with a form feed
 
 
+def _split_pages(pages):
+    """(report pages, {data sheet: its pages}): a data sheet's pages are numbered in the
+    footer, its name at the footer's right; the report pages come first."""
+    numbered = [re.search(r"Page \d+ of \d+", p) is not None for p in pages]
+    first = numbered.index(True) if True in numbered else len(pages)
+    assert all(numbered[first:]), "a report page after a data sheet"
+    data: dict = {}
+    for page in pages[first:]:
+        data.setdefault(re.split(r"\s{2,}", page.strip().splitlines()[-1])[-1], []).append(page)
+    return pages[:first], data
+
+
 @needs_lo
-def test_fill_prints_four_pages(tmp_path):
-    """Parameters, Summary, Charts, Outputs: one page each (the workbook printed 1,303 pages
-    before); the Tracked, Spectrum and ChartData sheets and the result columns not at all."""
+def test_fill_prints_its_five_report_pages_then_its_data(tmp_path):
+    """Sheet 1's parameter block (not its result columns), Parameters, Summary, Charts,
+    Outputs: one page each, first (the workbook printed 1,303 pages before issue 10). Then
+    Tracked, Spectrum and ChartData, each by itself, its header row on every page."""
     out = tmp_path / "shot.xlsx"
     assert main(["fill", str(TEMPLATE), "-o", str(out), "--compare-models"]) == 0
-    pages = _pdf_pages(out, tmp_path)
-    assert len(pages) == 4
-    assert "Damping Factor (Zeta)" in pages[0] and "Y33 (Test Item)" not in pages[0]
-    assert re.search(r"Peak acceleration \(raw\)\s+11\.994 kG", pages[1])
-    assert re.search(r"Time of peak\s+0\.2885 ms", pages[1])
-    assert re.search(r"Time step\s+0\.500 µs", pages[1])
-    assert "Charts of this shot" in pages[2] and "Acceleration, rigid model" in pages[2]
-    assert re.search(r"positions\s+TRUE", pages[3]) and not re.search(r"positions\s+1 ", pages[3])
+    report, data = _split_pages(_pdf_pages(out, tmp_path))
+    assert len(report) == 5
+    assert "Damping Factor (Zeta)" in report[0] and "Y33 (Test Item)" not in report[0]
+    assert "###" not in report[0]  # every number fits its column
+    assert "Damping Factor (Zeta)" in report[1]
+    assert re.search(r"Peak acceleration \(raw\)\s+11\.994 kG", report[2])
+    assert re.search(r"Time of peak\s+0\.2885 ms", report[2])
+    assert re.search(r"Time step\s+0\.500 µs", report[2])
+    assert "Charts of this shot" in report[3] and "Acceleration, rigid model" in report[3]
+    assert re.search(r"positions\s+TRUE", report[4]) and not re.search(r"positions\s+1 ",
+                                                                         report[4])
+    assert list(data) == ["Tracked", "Spectrum", "ChartData"]
+    assert all("Time (s)" in page and "M1 (kg)" in page for page in data["Tracked"])
+    assert all("Frequency (Hz)" in page for page in data["Spectrum"])
+    # 12,002 rows of Tracked, a few dozen a page (at the scale one page wide allows)
+    assert 100 < len(data["Tracked"]) < 600
 
 
 @needs_lo
@@ -140,9 +162,10 @@ def test_spectrum_chart_from_the_lobe_end_with_its_dominant_and_natural_marks(tm
 
 @needs_lo
 def test_compare_and_calibration_workbooks_print_their_reports(tmp_path):
-    """compare-measured: two pages, the scores and the rating, then the three charts (the
-    data sheets unprinted). calibrate: the shot's parameters, its Outputs block, the Crush law and
-    the Calibration report, a page each. LibreOffice opens both (the PDF is its reading)."""
+    """compare-measured: two pages, the scores and the rating, then the three charts; then its
+    data sheets. calibrate: the shot's sheet 1, its parameters, its Outputs block, the Crush
+    law and the Calibration report, a page each; then the Law and Pulses data. LibreOffice
+    opens both (the PDF is its reading)."""
     from airgun_xl.studies.calibrate import synthetic_measurement
 
     p = airgun_xl.load(TEMPLATE).params
@@ -151,16 +174,16 @@ def test_compare_and_calibration_workbooks_print_their_reports(tmp_path):
     compared = tmp_path / "compared.xlsx"
     assert main(["compare-measured", str(TEMPLATE), str(m), "--cfc", "1000", "-o",
                  str(compared)]) == 0
-    pages = _pdf_pages(compared, tmp_path)
-    assert len(pages) == 2
+    pages, data = _split_pages(_pdf_pages(compared, tmp_path))
+    assert len(pages) == 2 and list(data) == ["Traces", "Spectra", "SRS"]
     assert re.search(r"Overall rating R\s+0\.9\d\d", pages[0])
     assert "Test against prediction (Fig. 13)" in pages[1]
     calibrated = tmp_path / "calibrated.xlsx"
     assert main(["calibrate", str(TEMPLATE), str(m), "--cfc", "1000", "-o",
                  str(calibrated)]) == 0
-    pages = _pdf_pages(calibrated, tmp_path)
-    assert len(pages) == 4
-    assert "Damping Factor (Zeta)" in pages[0]
-    assert re.search(r"positions\s+TRUE", pages[1])
-    assert re.search(r"Law\s+fitted", pages[2])
-    assert "Crush-law iteration" in pages[3] and "Figs. 7-8" in pages[3]
+    pages, data = _split_pages(_pdf_pages(calibrated, tmp_path))
+    assert len(pages) == 5 and list(data) == ["Law", "Pulses"]
+    assert "Damping Factor (Zeta)" in pages[0] and "Damping Factor (Zeta)" in pages[1]
+    assert re.search(r"positions\s+TRUE", pages[2])
+    assert re.search(r"Law\s+fitted", pages[3])
+    assert "Crush-law iteration" in pages[4] and "Figs. 7-8" in pages[4]

@@ -1,9 +1,10 @@
 """Issue 20: every workbook the commands write reads and prints like the fill's Summary.
 
 One workbook of each kind (tests/report_workbooks.py) is scanned and printed through
-LibreOffice: one page per report sheet and none for data sheets, no float shown as a General
-number of more than 7 significant digits, a header naming the shot and the version, and a
-grid sweep's charts with one series per level."""
+LibreOffice: one page per report sheet, then each data sheet by itself (issue 35: all its
+rows, one page wide, its header row on every page, no blank print area), no float shown as a
+General number of more than 7 significant digits, a header naming the shot and the version,
+and a grid sweep's charts with one series per level."""
 import re
 import shutil
 import subprocess
@@ -32,9 +33,10 @@ def workbooks(tmp_path_factory):
     return paths
 
 
-def report_sheets(path):
-    """[(sheet, (min_col, min_row, max_col, max_row))] of the sheets that print: a data
-    sheet's print area is the blank XFD1 (airgun_xl/xlsx/report.py)."""
+def _print_setups(path):
+    """[(sheet, (min_col, min_row, max_col, max_row), pages tall)] of every sheet: a report
+    page is fitted to one page (OOXML's fitToHeight, 1 when absent), a data sheet to as many
+    as its rows need (0)."""
     wb = openpyxl.load_workbook(path)
     out = []
     for ws in wb.worksheets:
@@ -42,9 +44,20 @@ def report_sheets(path):
         assert area, f"{path.name}: {ws.title} has no print area"
         bounds = range_boundaries(str(area[0] if isinstance(area, list) else area)
                                   .split("!")[-1].replace("$", ""))
-        if bounds != (16384, 1, 16384, 1):
-            out.append((ws, bounds))
+        assert ws.sheet_properties.pageSetUpPr.fitToPage, (path.name, ws.title)
+        tall = ws.page_setup.fitToHeight
+        out.append((ws, bounds, 1 if tall is None else int(tall)))
     return out
+
+
+def report_sheets(path):
+    """[(sheet, bounds)] of the sheets that print on one page."""
+    return [(ws, bounds) for ws, bounds, tall in _print_setups(path) if tall == 1]
+
+
+def data_sheets(path):
+    """[(sheet, bounds)] of the sheets that print all their rows, one page wide."""
+    return [(ws, bounds) for ws, bounds, tall in _print_setups(path) if tall == 0]
 
 
 def significant_digits(x):
@@ -88,14 +101,31 @@ def test_every_report_sheet_has_the_header(workbooks, kind):
         assert ws.page_setup.orientation == "landscape", ws.title
 
 
+@pytest.mark.parametrize("kind", KINDS)
+def test_every_data_sheet_prints_by_itself(workbooks, kind):
+    """Issue 35: no print-nothing trick. A data sheet's print area is its table from A1 to
+    its last row and column, one page wide, its header row(s) repeated on every page, each
+    page numbered; its numbers have formats (none General)."""
+    for ws, (c0, r0, c1, r1) in data_sheets(workbooks[kind]):
+        assert (c0, r0) == (1, 1) and r1 >= 2 and c1 >= 1, (kind, ws.title)
+        assert r1 >= ws.max_row - 1 and c1 >= 1, (kind, ws.title, r1, ws.max_row)
+        assert ws.page_setup.fitToWidth in (None, 1), (kind, ws.title)
+        assert (ws.print_title_rows or "").startswith("$1:"), (kind, ws.title)
+        assert "&P" in ws.oddFooter.center.text and "&N" in ws.oddFooter.center.text
+        general = [c.coordinate for row in ws.iter_rows(min_row=2, max_row=min(r1, 200))
+                   for c in row if isinstance(c.value, float) and c.number_format == "General"]
+        assert general == [], (kind, ws.title, general[:5])
+
+
 @needs_lo
-def test_each_workbook_prints_one_page_per_report_sheet(workbooks, tmp_path):
-    """LibreOffice's PDF export prints every sheet: each report sheet on one page (its title
-    in the header), each data sheet on none. Before: convergence 7 pages for its one sheet."""
+def test_each_workbook_prints_its_report_pages_first_then_its_data(workbooks, tmp_path):
+    """LibreOffice's PDF export prints every sheet: each report sheet on one page, first
+    (its title in the header, no page number); then each data sheet by itself, its pages
+    numbered and its header row on each. Before: convergence 7 pages for its one sheet."""
     paths = [workbooks[k] for k in KINDS]
     done = subprocess.run(["soffice", f"-env:UserInstallation=file://{tmp_path}/lo",
                            "--headless", "--convert-to", "pdf", "--outdir", str(tmp_path),
-                           *map(str, paths)], capture_output=True, text=True, timeout=600,
+                           *map(str, paths)], capture_output=True, text=True, timeout=900,
                           check=False)
     assert done.returncode == 0, done.stderr
     for kind, path in zip(KINDS, paths, strict=True):
@@ -103,9 +133,14 @@ def test_each_workbook_prints_one_page_per_report_sheet(workbooks, tmp_path):
                                "-"], capture_output=True, text=True, check=True).stdout
         pages = text.split("\f")[:-1]
         sheets = [ws.title for ws, _ in report_sheets(path)]
-        assert len(pages) == len(sheets), (kind, len(pages), sheets)
-        for page, title in zip(pages, sheets, strict=True):
-            assert "airgun-xl" in page.splitlines()[0], (kind, title)
+        numbered = [bool(re.search(r"Page \d+ of \d+", p)) for p in pages]
+        assert numbered == [False] * len(sheets) + [True] * (len(pages) - len(sheets)), kind
+        for page in pages:
+            assert "airgun-xl" in page.splitlines()[0], kind
+        data = {ws.title: ws for ws, _ in data_sheets(path)}
+        printed = {re.split(r"\s{2,}", line.strip())[-1] for p in pages[len(sheets):]
+                   for line in p.splitlines()[-1:]}  # the footer's right: the sheet's name
+        assert printed == set(data), (kind, printed, set(data))
 
 
 def test_the_grid_sweeps_charts_have_one_series_per_level(workbooks):
@@ -139,8 +174,8 @@ ALL_KINDS = set(KINDS) | {"accept", "accept_corridor", "design_confidence"}
 
 @pytest.mark.parametrize("kind", sorted(ALL_KINDS - MACRO_LAYOUT))
 def test_a_study_workbook_opens_on_its_first_report_page(workbooks, kind):
-    """Issue 35: the active sheet is a report page (one printed page, not the blank print
-    area of a data sheet), every report page comes before every data sheet but a shot's own
+    """Issue 35: the active sheet is a report page (one printed page, not a data sheet),
+    every report page comes before every data sheet but a shot's own
     sheets, and no number on the active sheet is a General number past 7 digits."""
     path = workbooks[kind]
     wb = openpyxl.load_workbook(path)

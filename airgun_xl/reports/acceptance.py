@@ -8,8 +8,8 @@ from ..engine.decimate import minmax_indices
 from ..units import G_PER_KG
 from ..xlsx.charts import POINT_BUDGET, line_series, log_axis, nice_range, titled
 from ..xlsx.columns_sheet import ColumnsWorksheet
-from ..xlsx.report import axis, chart_size, not_printed, one_page, report_workbook
-from ..xlsx.sheets import write_about, write_number_columns, write_warnings, write_wrapped
+from ..xlsx.report import Style, axis, chart_size, one_page, report_workbook
+from ..xlsx.sheets import write_about, write_data_sheet, write_warnings, write_wrapped
 
 RECORD, IDEAL, LIMIT, REQUIRED = "#c00000", "#1f4e79", "#7f7f7f", "#000000"
 
@@ -161,9 +161,7 @@ def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=Non
             names += ["Ideal pulse (kG)", "Corridor, upper (kG)", "Corridor, lower (kG)"]
             for col, key in ((2, "ideal"), (3, "upper"), (4, "lower")):
                 columns[col] = np.asarray(pulse[key])[kept]
-        data.write_row(0, 0, names, bold)
-        write_number_columns(data, 1, columns)
-        not_printed(data)
+        write_data_sheet(data, names, columns, Style(wb), shot)
         shown = [v for v in columns.values()][1:]
         values = np.concatenate([v[np.isfinite(v)] for v in shown])
         charts.insert_chart(1, 0, _pulse_chart(wb, len(t_ms), t_ms, values, has_corridor))
@@ -184,9 +182,7 @@ def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=Non
                 columns[col] = np.asarray(spectra[key]) * G_PER_KG
         names.append("Pseudo-velocity (m/s)")
         columns[len(names) - 1] = np.asarray(spectra["pv"])
-        srs_data.write_row(0, 0, names, bold)
-        write_number_columns(srs_data, 1, columns)
-        not_printed(srs_data)
+        write_data_sheet(srs_data, names, columns, Style(wb), shot)
         plotted = np.concatenate([columns[k] for k in range(1, 5 if has_req else 2)])
         srs_ws.insert_chart(1, 0, _srs_chart(wb, len(f), f, plotted, has_req))
         srs_ws.insert_chart(1, CHART_COLS // 2, _pv_chart(wb, len(f), f, columns[len(names) - 1],

@@ -17,9 +17,21 @@ from ..transaction import display
 from ..xlsx.charts import line_series, nice_range, titled
 from ..xlsx.columns_sheet import ColumnsWorksheet
 from ..xlsx.law_sheet import write_law_sheet
-from ..xlsx.report import Style, axis, chart_size, not_printed, one_page, report_workbook, shown
-from ..xlsx.sheets import write_about, write_number_columns, write_parameters, write_warnings
-from ..xlsx.shot_sheets import print_outputs_block, sheet_names, write_cells
+from ..xlsx.report import (
+    Style,
+    axis,
+    chart_size,
+    one_page,
+    report_workbook,
+    shown,
+)
+from ..xlsx.sheets import write_about, write_data_sheet, write_parameters, write_warnings
+from ..xlsx.shot_sheets import (
+    print_outputs_block,
+    print_parameter_block,
+    sheet_names,
+    write_cells,
+)
 
 #: Fitted name -> (parameter cell (row, col), ShotParams field).
 CELLS = {"E40": ((40, 5), "sigmay"), "E43": ((43, 5), "zeta")}
@@ -38,12 +50,12 @@ def _parameter_sheet(wb, shot, params, names, fitted):
         if name in fitted:
             block[cell] = (getattr(params, field), None)  # the fitted value, a plain number
     ws = wb.add_worksheet(names["first"], worksheet_class=ColumnsWorksheet)
-    warnings = write_cells(ws, block, {k: v[0] for k, v in block.items()})
-    not_printed(ws)  # the input's layout, for fill: data (Parameters prints)
+    warnings = write_cells(ws, block, {k: v[0] for k, v in block.items()}, Style(wb))
+    print_parameter_block(ws, block, display(source.path.name), names["first"])
     write_parameters(wb, params, display(source.path.name), names["Parameters"])
     if source.outputs_block:
         out = wb.add_worksheet(names["Outputs"], worksheet_class=ColumnsWorksheet)
-        warnings += write_cells(out, source.outputs_block)
+        warnings += write_cells(out, source.outputs_block, style=Style(wb))
         print_outputs_block(out, source.outputs_block, display(source.path.name))
     return warnings
 
@@ -227,21 +239,19 @@ def write_calibration(path, shot, cal, files, options, force=False):
         # the law against the macro's, over its range; the last iteration's samples
         grid = np.linspace(law.v_range[0], law.v_range[1], 101)
         data = wb.add_worksheet("Law", worksheet_class=ColumnsWorksheet)
-        data.write_row(0, 0, ["Relative velocity (m/s)", "Macro's law (-)", "Fitted law (-)",
-                              "Sample velocity (m/s)", "Sample crush factor (-)"], bold)
+        headers = ["Relative velocity (m/s)", "Macro's law (-)", "Fitted law (-)",
+                   "Sample velocity (m/s)", "Sample crush factor (-)"]
         columns = {0: grid, 1: LEGACY_LAW(grid), 2: law(grid)}
         v = lc.velocity if lc is not None else np.zeros(0)
         x = lc.factor if lc is not None else np.zeros(0)
         if len(v):
             columns.update({3: v, 4: x})
-        write_number_columns(data, 1, columns)
-        not_printed(data)
+        write_data_sheet(data, headers, columns, style, display(shot.source.path.name))
         a = cal.aligned[0]
         pulses = wb.add_worksheet("Pulses", worksheet_class=ColumnsWorksheet)
-        pulses.write_row(0, 0, ["Time (ms)", "Calibrated model (kG)", "Measured (kG)"], bold)
-        write_number_columns(pulses, 1, {0: a.time * 1e3, 1: a.simulated_kg,
-                                         2: a.measured_kg})
-        not_printed(pulses)
+        write_data_sheet(pulses, ["Time (ms)", "Calibrated model (kG)", "Measured (kG)"],
+                         {0: a.time * 1e3, 1: a.simulated_kg, 2: a.measured_kg}, style,
+                         display(shot.source.path.name))
         values = list(columns[1]) + list(columns[2]) + list(np.percentile(x, [1, 99])
                                                             if len(x) else [])
         # the charts right of the tables: the law's only when a law was fitted

@@ -78,7 +78,7 @@ def _write_worst(wb, name, time, x, y, shot=None):
     diff = y - x
     keep = np.union1d(minmax_indices(x, 20_000), minmax_indices(diff, 20_000))
     t_ms = time[keep] * 1e3
-    write_number_columns(ws, 1, {0: t_ms, 1: x[keep], 2: y[keep], 3: diff[keep]})
+    write_number_columns(ws, 1, {0: t_ms, 1: x[keep], 2: y[keep], 3: diff[keep]}, Style(wb))
     n = len(keep)
     chart = wb.add_chart({"type": "scatter", "subtype": "straight"})
     # the legacy curve wide and pale, the new one thin and dashed over it: both show where

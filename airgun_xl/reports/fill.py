@@ -18,8 +18,10 @@ AB      Filtered Acceleration       the sample rows
 I       final M1, final m31         rows+3 and rows+4
 ======  ==========================  =====================================================
 
-Then, as :class:`airgun_xl.outputs.Outputs` selects: Summary, Charts, Tracked, Spectrum,
-ChartData, and the input's Outputs block. A run longer than the sheets may hold writes every
+Then, as :class:`airgun_xl.outputs.Outputs` selects, the report pages (Parameters, Summary,
+Charts, the input's Outputs block) and after them the data sheets (Tracked, Spectrum,
+ChartData). Sheet 1 prints its parameter block; each data sheet prints by itself, all its
+rows one page wide. A run longer than the sheets may hold writes every
 N-th row (N in the Summary) and, by default, its full history to a sidecar file.
 """
 import math
@@ -36,7 +38,7 @@ from ..transaction import atomic_path, check_output, display
 from ..xlsx.charts import add_charts, series_data
 from ..xlsx.columns_sheet import ColumnsWorksheet
 from ..xlsx.law_sheet import write_law_sheet
-from ..xlsx.report import not_printed
+from ..xlsx.report import Style, data_pages
 from ..xlsx.sheets import (
     Ref,
     variant_name,
@@ -47,7 +49,12 @@ from ..xlsx.sheets import (
     write_summary,
     write_tracked,
 )
-from ..xlsx.shot_sheets import print_outputs_block, sheet_names, write_cells
+from ..xlsx.shot_sheets import (
+    print_outputs_block,
+    print_parameter_block,
+    sheet_names,
+    write_cells,
+)
 from ..xlsx.workbook import close_workbook, new_workbook
 
 #: Header text per 0-based column index, as the macro writes it (P is ours).
@@ -152,7 +159,7 @@ def _write_sheet1(wb, result, outputs, keep, stride, title):
     if source is not None:
         block = {k: v for k, v in source.block.items() if k[1] <= PARAMETER_COLUMNS}
         values, warnings = _block_values(source, columns, rows, finals)
-        warnings += write_cells(ws, block, values)
+        warnings += write_cells(ws, block, values, Style(wb))
     for col in sorted(set(columns) | {c for c, g in HEADER_GROUPS.items() if g in outputs}):
         ws.write_string(0, col, HEADERS[col])
     write_number_columns(ws, 1, columns)
@@ -162,7 +169,10 @@ def _write_sheet1(wb, result, outputs, keep, stride, title):
     if "filtered" in outputs:
         for row, value in _filtered_cells(result, stride):
             ws.write_number(row, 27, value)
-    not_printed(ws)  # the input's layout and the macro's columns: data (Parameters prints)
+    if block:  # the input's own page
+        print_parameter_block(ws, block, display(source.path.name), title)
+    else:  # no input's block (a shot made in Python): the macro's columns, as data
+        data_pages(ws, rows, 27)
     refs = {}
     if rows == result.rows:
         title = ws.get_name()
@@ -258,16 +268,27 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
         write_parameters(wb, result.params, shot, names["Parameters"])
         write_summary(wb, result, summary, info, names["Summary"])
     charts_ws = wb.add_worksheet(names["Charts"]) if "charts" in outputs else None
+    if info.get("srs_requirement") is not None:
+        _write_srs_sheets(wb, result, info["srs_requirement"], shot, names["SRS"],
+                          info.get("warnings", []))
+    if source is not None and source.outputs_block:
+        outputs_ws = wb.add_worksheet(names[SHEET_NAME], worksheet_class=ColumnsWorksheet)
+        warnings += write_cells(outputs_ws, source.outputs_block, style=Style(wb))
+        print_outputs_block(outputs_ws, source.outputs_block, shot)
+    if not result.params.crush_law.is_legacy:  # a fitted law goes with the shot
+        write_law_sheet(wb, result.params.crush_law, names[LAW_SHEET], shot=shot)
+    # the data sheets after the report pages, so a whole-workbook print starts with the report
     if "tracked" in outputs:
-        refs.update(write_tracked(wb, result, keep, ColumnsWorksheet, names["Tracked"]))
+        refs.update(write_tracked(wb, result, keep, ColumnsWorksheet, names["Tracked"], shot))
     if "spectrum" in outputs:
-        refs.update(write_spectrum(wb, summary.spectrum, ColumnsWorksheet, names["Spectrum"]))
+        refs.update(write_spectrum(wb, summary.spectrum, ColumnsWorksheet, names["Spectrum"],
+                                   shot))
     if charts_ws is not None:
         compared = info.get("compared")
         data = series_data(result, summary.spectrum, compared, summary.natural_initial)
         placed = write_chart_data(wb, data, refs, ColumnsWorksheet, names["ChartData"],
                                   budget=len(keep),  # --every N thins the copies too
-                                  time_ms=result.history.time[keep] * 1e3)
+                                  time_ms=result.history.time[keep] * 1e3, shot=shot)
         labels = None
         if compared is not None:
             labels = {"compared_kg": f"Acceleration, {variant_name(compared)}",
@@ -277,14 +298,5 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
         add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]) * 1e3, labels,
                    {"spectrum": (np.floor(summary.spectrum.band_start / 100) * 100,
                                  SPECTRUM_MAX_HZ)}, shot)
-    if info.get("srs_requirement") is not None:
-        _write_srs_sheets(wb, result, info["srs_requirement"], shot, names["SRS"],
-                          info.get("warnings", []))
-    if source is not None and source.outputs_block:
-        outputs_ws = wb.add_worksheet(names[SHEET_NAME], worksheet_class=ColumnsWorksheet)
-        warnings += write_cells(outputs_ws, source.outputs_block)
-        print_outputs_block(outputs_ws, source.outputs_block, shot)
-    if not result.params.crush_law.is_legacy:  # a fitted law goes with the shot
-        write_law_sheet(wb, result.params.crush_law, names[LAW_SHEET], shot=shot)
     close_workbook(wb, shown if shown is not None else tmp)
     return warnings

@@ -7,8 +7,8 @@ import numpy as np
 from ..units import G_PER_KG
 from ..xlsx.charts import line_series, log_axis, nice_range, titled
 from ..xlsx.columns_sheet import ColumnsWorksheet
-from ..xlsx.report import axis, chart_size, not_printed, one_page, report_workbook
-from ..xlsx.sheets import write_about, write_number_columns, write_warnings
+from ..xlsx.report import Style, axis, chart_size, one_page, report_workbook
+from ..xlsx.sheets import write_about, write_data_sheet, write_warnings
 
 ROWS = (("Peak acceleration", "peak_kg", "kG", 1.0, "0.000"),
         ("Time of peak, after impact", "time_of_peak", "ms", 1e3, "0.0000"),
@@ -190,25 +190,19 @@ def write_comparison(path, comparison, about, force=False, models=("4-mass", "ri
         if c.rigid_kg is not None:
             names.append(f"Predicted, {models[1]} model (kG)")
             columns[3] = c.rigid_kg
-        data.write_row(0, 0, names, bold)
-        write_number_columns(data, 1, columns)
-        not_printed(data)
+        write_data_sheet(data, names, columns, Style(wb), shot)
 
         spectra = wb.add_worksheet("Spectra", worksheet_class=ColumnsWorksheet)
-        spectra.write_row(0, 0, ["Frequency (Hz)", "Predicted (kG)", "Measured (kG)"], bold)
         f = c.predicted_spectrum.frequency
         n_spec = min(len(f), len(c.measured_spectrum.amplitude))
-        write_number_columns(spectra, 1, {0: f[:n_spec],
-                                          1: c.predicted_spectrum.amplitude[:n_spec],
-                                          2: c.measured_spectrum.amplitude[:n_spec]})
-        not_printed(spectra)
+        write_data_sheet(spectra, ["Frequency (Hz)", "Predicted (kG)", "Measured (kG)"],
+                         {0: f[:n_spec], 1: c.predicted_spectrum.amplitude[:n_spec],
+                          2: c.measured_spectrum.amplitude[:n_spec]}, Style(wb), shot)
 
         srs = wb.add_worksheet("SRS", worksheet_class=ColumnsWorksheet)
-        srs.write_row(0, 0, ["Natural frequency (Hz)", "Predicted (g)", "Measured (g)"],
-                      bold)
-        write_number_columns(srs, 1, {0: c.srs_frequencies, 1: c.predicted_srs * G_PER_KG,
-                                      2: c.measured_srs * G_PER_KG})
-        not_printed(srs)
+        write_data_sheet(srs, ["Natural frequency (Hz)", "Predicted (g)", "Measured (g)"],
+                         {0: c.srs_frequencies, 1: c.predicted_srs * G_PER_KG,
+                          2: c.measured_srs * G_PER_KG}, Style(wb), shot)
 
         charts.write_string(0, 0, f"Measured record: {c.srs_record}")
         charts.insert_chart(1, 0, _traces_chart(wb, c, len(c.time), models))

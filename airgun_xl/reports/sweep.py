@@ -11,12 +11,12 @@ from ..xlsx.report import (
     Style,
     axis,
     chart_size,
+    data_pages,
     general_format,
-    not_printed,
     one_page,
     report_workbook,
 )
-from ..xlsx.sheets import write_number_columns
+from ..xlsx.sheets import write_data_sheet, write_number_columns
 
 FIGURE_HEADERS = {"peak_kg": "Peak (kG)", "time_of_peak": "Time of peak (s)",
                   "filtered_peak_kg": "Filtered peak (kG)",
@@ -65,9 +65,6 @@ def write_sweep(result, path, force, stats=None, sensitivity=None, shot=None):
         headers = ([_label(c) for c in result.cells]
                    + [FIGURE_HEADERS[f] for f in FIGURES]
                    + ["Diverged", "Invalid", "Warnings (count)", "Warnings"])
-        ws.write_row(0, 0, headers, style.bold)
-        ws.set_column(0, len(headers) - 2, 16)
-        ws.set_column(len(headers) - 1, len(headers) - 1, 120)
         k = len(result.cells)
         columns = {i: result.values[:, i] for i in range(k)}
         columns.update({k + j: result.figures[:, j] for j in range(len(FIGURES))})
@@ -75,12 +72,12 @@ def write_sweep(result, path, force, stats=None, sensitivity=None, shot=None):
         columns[k + len(FIGURES) + 1] = result.invalid.astype(float)
         flags = result.flags or [[] for _ in result.values]
         columns[k + len(FIGURES) + 2] = np.array([len(f) for f in flags], dtype=float)
-        write_number_columns(ws, 1, columns)
+        write_data_sheet(ws, headers, columns, style, shot)
+        ws.set_column(len(headers) - 1, len(headers) - 1, 60, style.wrap)
         for r, found in enumerate(flags, start=1):  # text stays text: never a formula
             if found:
-                ws.write_string(r, len(headers) - 1, " | ".join(found))
-        not_printed(ws)
-        _write_chart_data(wb, family_data)
+                ws.write_string(r, len(headers) - 1, " | ".join(found), style.wrap)
+        _write_chart_data(wb, family_data, shot)
 
 
 def families(result, i):
@@ -122,7 +119,7 @@ CHART_COLS, CHART_ROWS = 10, 22
 
 def _write_charts(wb, result, shot):
     """The Charts sheet: the peak against each input, two charts a row, on one page. A grid
-    over two or more inputs draws a family of curves (their data on the not printed Chart
+    over two or more inputs draws a family of curves (their data on the Chart
     data sheet, written after the report pages by :func:`_write_chart_data` from the
     ``[(col, header, x, peak)]`` this returns); samples draw a scatter."""
     charts = wb.add_worksheet("Charts")
@@ -169,16 +166,19 @@ def _write_charts(wb, result, shot):
     return data
 
 
-def _write_chart_data(wb, family_data):
+def _write_chart_data(wb, family_data, shot):
     """The Chart data sheet of a grid's families of curves (none for samples)."""
     if not family_data:
         return
     data = wb.add_worksheet("Chart data", worksheet_class=ColumnsWorksheet)
-    not_printed(data)
+    style = Style(wb)
     for col, header, x, y in family_data:
-        data.write_string(0, col, header)
-        data.write_string(0, col + 1, "Peak (kG)")
-        write_number_columns(data, 1, {col: x, col + 1: y})
+        data.write_string(0, col, header, style.header)
+        data.write_string(0, col + 1, "Peak (kG)", style.header)
+        write_number_columns(data, 1, {col: x, col + 1: y}, style)
+    data.set_column(0, max(c for c, *_ in family_data) + 1, 16)
+    data_pages(data, max(len(x) for _, _, x, _ in family_data),
+               max(c for c, *_ in family_data) + 1, shot=shot)
 
 
 FAMILY_COLORS = ("#1f4e79", "#c00000", "#548235", "#7f6000", "#7030a0", "#00b0f0",

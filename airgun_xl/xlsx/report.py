@@ -7,12 +7,12 @@ calibrate) goes through this module:
   the factor from the unit the writer holds it in, and its number format (kG or g, ms, kHz,
   MPa, %). :class:`Style` makes the formats once per workbook and writes numbers with them.
 - :func:`one_page` prints a report sheet on one landscape A4 page with a header naming the
-  shot, the input file, the version and the print date; :func:`not_printed` leaves a data
-  sheet out of the print. A fill's workbook holds up to a million rows of data; printed
-  (LibreOffice's PDF export prints every sheet) it used to run to 1,303 pages. A data sheet's
-  print area is one cell that is always blank: LibreOffice leaves out empty pages and Excel
-  prints nothing for it. To print a data sheet, clear its print area (Excel: Page Layout >
-  Print Area > Clear; LibreOffice: Format > Print Ranges > Clear).
+  shot, the input file, the version and the print date. :func:`data_pages` prints a data
+  sheet by itself: all its rows, one page wide, its header row repeated on every page and
+  each page numbered. Every workbook puts its report pages first and its data sheets after
+  them, so a print of the whole workbook (LibreOffice's PDF export prints every sheet) starts
+  with the report, and a print of the active sheet (Excel's and LibreOffice's default) is a
+  report page.
 - :func:`axis` gives a chart axis its explicit limits and the number format of its quantity;
   :func:`chart_size` sizes a chart to the printed columns.
 
@@ -26,10 +26,6 @@ from ..version import __version__
 
 #: A4 in xlsxwriter's paper codes; Letter printers scale it.
 A4 = 9
-
-#: The blank cell a data sheet's print area holds: the sheet's last column, row 1 (XFD1).
-BLANK_CELL = (0, 16_383)
-
 
 @dataclass(frozen=True)
 class Quantity:
@@ -89,6 +85,26 @@ def general_format(values, digits=4):
         return "0." + "0" * (digits - 1) + "E+00"
     decimals = max(0, digits - 1 - math.floor(math.log10(top)))
     return "#,##0" + ("." + "0" * decimals if decimals else "")
+
+
+#: Characters of a column that shows :func:`value_format`'s widest text (-1.2346E+08).
+VALUE_COLUMN_CHARS = 12
+
+
+def value_format(value, digits=7):
+    """A number format that shows ``value`` in at most ``digits`` significant digits, with
+    no trailing zeros: ``0`` for a whole number below 10^digits, decimals as needed from
+    1e-3, scientific notation past them with 5 (a copied input cell, whose quantity is not
+    known; at most :data:`VALUE_COLUMN_CHARS` characters)."""
+    import math
+
+    x = abs(float(value))
+    if not math.isfinite(x) or x == 0.0 or (x == round(x) and x < 10.0 ** digits):
+        return "0"
+    if 1e-3 <= x < 10.0 ** digits:
+        decimals = max(1, digits - 1 - math.floor(math.log10(x)))
+        return "0." + "#" * decimals
+    return "0.####E+00"
 
 
 class Style:
@@ -163,9 +179,22 @@ def one_page(ws, last_row, last_col, first_row=0, first_col=0, landscape=True, s
     ws.set_footer("&L&F&R&A")
 
 
-def not_printed(ws):
-    """Leave ``ws`` out of the default print: a print area of one blank cell."""
-    ws.print_area(*BLANK_CELL, *BLANK_CELL)
+def data_pages(ws, last_row, last_col, header_rows=1, shot=None, title=None):
+    """Print data sheet ``ws``'s range (0-based, inclusive, from A1) by itself: as many A4
+    pages as its rows need, one page wide, its first ``header_rows`` rows repeated on each,
+    the gridlines printed, the header and footer of a report page (with the page number)."""
+    ws.print_area(0, 0, max(last_row, 0), max(last_col, 0))
+    if header_rows:
+        ws.repeat_rows(0, header_rows - 1)
+    ws.set_landscape() if last_col >= 6 else ws.set_portrait()
+    ws.set_paper(A4)
+    ws.fit_to_pages(1, 0)
+    ws.hide_gridlines(0)  # shown and printed
+    ws.set_margins(left=0.5, right=0.5, top=0.75, bottom=0.6)
+    left = _header_text(shot) if shot else "&F"
+    centre = _header_text(title) if title else "&A"
+    ws.set_header(f"&L{left}&C&B{centre}&Rairgun-xl {__version__}, printed &D")
+    ws.set_footer("&L&F&CPage &P of &N&R&A")
 
 
 #: Pixels of a default column (8.43 characters) and of a default row (15 points).

@@ -13,7 +13,7 @@ from ..engine.decimate import minmax_indices
 from ..engine.summary import PULSE_FRACTION, SPECTRUM_MAX_HZ
 from ..errors import OutputError
 from .charts import COPY_POINTS, POINT_BUDGET
-from .report import Style, general_format, not_printed, one_page, shown
+from .report import Style, data_pages, general_format, one_page, shown
 
 
 @dataclass(frozen=True)
@@ -51,17 +51,45 @@ def write_about(ws, about, bold):
     return len(about)
 
 
-def write_number_columns(ws, first_row, columns):
-    """Write ``{col: array}`` down from ``first_row``; NaN cells are left empty."""
+#: Significant digits a data sheet shows of its numbers (the cells hold all 17).
+DATA_DIGITS = 7
+
+
+def data_format(values):
+    """The number format of a data column: whole numbers as such (a count, a flag),
+    otherwise :data:`DATA_DIGITS` significant digits of the largest magnitude, or scientific
+    notation past 1e6 or below 1e-3 (:func:`~airgun_xl.xlsx.report.general_format`)."""
+    finite = values[np.isfinite(values)]
+    if len(finite) and np.all(finite == np.round(finite)) and np.abs(finite).max() < 1e15:
+        return "#,##0"
+    return general_format(finite.tolist(), DATA_DIGITS)
+
+
+def write_number_columns(ws, first_row, columns, style=None):
+    """Write ``{col: array}`` down from ``first_row``; NaN cells are left empty. With
+    ``style`` (a :class:`~airgun_xl.xlsx.report.Style`), each column is shown in a format
+    of :data:`DATA_DIGITS` significant digits of its largest value, or in scientific
+    notation, never as General."""
     for col, given in columns.items():
         values = np.asarray(given, dtype=float)
+        fmt = None if style is None else style.get(num_format=data_format(values))
         finite = np.concatenate(([False], np.isfinite(values), [False]))
         edges = np.flatnonzero(np.diff(finite.astype(np.int8)))
         for start, stop in zip(edges[0::2].tolist(), edges[1::2].tolist(), strict=True):
-            if ws.write_number_column(first_row + start, col, values[start:stop]) == -1:
+            if ws.write_number_column(first_row + start, col, values[start:stop], fmt) == -1:
                 raise OutputError(f"{ws.get_name()}: {stop - start:,} rows from row "
                                   f"{first_row + start + 1:,} pass the sheet's last row; "
                                   "expected fewer rows on the sheet (a larger row stride: every)")
+
+
+def write_data_sheet(ws, headers, columns, style, shot=None, width=16):
+    """A data sheet: ``headers`` in row 1, the ``{col: array}`` columns under them (see
+    :func:`write_number_columns`), printed by itself (:func:`~airgun_xl.xlsx.report.data_pages`)."""
+    ws.set_column(0, len(headers) - 1, width)
+    ws.write_row(0, 0, headers, style.header)
+    write_number_columns(ws, 1, columns, style)
+    rows = max((len(v) for v in columns.values()), default=0)
+    data_pages(ws, rows, len(headers) - 1, shot=shot)
 
 
 TRACKED_COLUMNS = (
@@ -72,19 +100,20 @@ TRACKED_COLUMNS = (
 )
 
 
-def write_tracked(wb, result, keep, sheet_class, name="Tracked"):
+def write_tracked(wb, result, keep, sheet_class, name="Tracked", shot=None):
     """The Tracked sheet: step values the kernel recorded, every kept row."""
     ws = wb.add_worksheet(name, worksheet_class=sheet_class)
     ws.set_column(0, len(TRACKED_COLUMNS) - 1, 16)
+    style = Style(wb)
     h = result.history
     columns = {}
     for col, (header, key) in enumerate(TRACKED_COLUMNS):
-        ws.write_string(0, col, header)
+        ws.write_string(0, col, header, style.header)
         values = getattr(h, key)
         if values is not None:
             columns[col] = values[keep]
-    write_number_columns(ws, 1, columns)
-    not_printed(ws)
+    write_number_columns(ws, 1, columns, style)
+    data_pages(ws, len(keep), len(TRACKED_COLUMNS) - 1, shot=shot)
     full = len(keep) == result.rows
     refs = {}
     for col, (_, key) in enumerate(TRACKED_COLUMNS[1:], start=1):
@@ -93,21 +122,23 @@ def write_tracked(wb, result, keep, sheet_class, name="Tracked"):
     return refs
 
 
-def write_spectrum(wb, spectrum, sheet_class, name="Spectrum"):
+def write_spectrum(wb, spectrum, sheet_class, name="Spectrum", shot=None):
     ws = wb.add_worksheet(name, worksheet_class=sheet_class)
+    style = Style(wb)
     ws.set_column(0, 1, 16)
-    ws.write_string(0, 0, "Frequency (Hz)")
-    ws.write_string(0, 1, "Amplitude (kG)")
+    ws.set_column(3, 3, 60, style.wrap)
+    ws.write_string(0, 0, "Frequency (Hz)", style.header)
+    ws.write_string(0, 1, "Amplitude (kG)", style.header)
     ws.write_string(0, 3, f"Single-sided amplitude spectrum 2|FFT|/N (numpy.fft.rfft) of the "
                           f"test-item acceleration in kG, 0-{SPECTRUM_MAX_HZ:,.0f} Hz")
-    write_number_columns(ws, 1, {0: spectrum.frequency, 1: spectrum.amplitude})
-    not_printed(ws)
+    write_number_columns(ws, 1, {0: spectrum.frequency, 1: spectrum.amplitude}, style)
     n = len(spectrum.frequency)
+    data_pages(ws, n, 3, shot=shot)
     return {"spectrum": Ref(ws.get_name(), 0, 1, 1, n, n)} if n else {}
 
 
 def write_chart_data(wb, data, refs, sheet_class, name="ChartData", budget=POINT_BUDGET,
-                     time_ms=None):
+                     time_ms=None, shot=None):
     """Copies on ChartData of the series that have no usable home; decimated past the budget.
 
     ``budget`` lowers the budget (the rows a ``--every N`` run keeps on its sheets): a longer
@@ -119,7 +150,7 @@ def write_chart_data(wb, data, refs, sheet_class, name="ChartData", budget=POINT
     import dataclasses
 
     ws = wb.add_worksheet(name, worksheet_class=sheet_class)
-    not_printed(ws)
+    style = Style(wb)
     limit = max(2, min(budget, POINT_BUDGET))
     ws.write_string(0, 0, f"Chart series not on another sheet at full resolution; a series "
                           f"longer than {limit:,} points is cut to {min(COPY_POINTS, limit):,}, "
@@ -133,19 +164,23 @@ def write_chart_data(wb, data, refs, sheet_class, name="ChartData", budget=POINT
             if key in TIME_SERIES and time_ms is not None:
                 if time_col is None:  # the kept rows' time in ms, once, for every home
                     time_col = col
-                    ws.write_string(1, col, "Time (ms)")
-                    write_number_columns(ws, 2, {col: time_ms[:limit]})
+                    ws.write_string(1, col, "Time (ms)", style.header)
+                    write_number_columns(ws, 2, {col: time_ms[:limit]}, style)
                     col += 1
                 home = dataclasses.replace(home, x_sheet=ws.get_name(), x_col=time_col,
                                            x_first_row=home.first_row + 1)
             out[key] = home
             continue
         index = minmax_indices(y, min(COPY_POINTS, limit) if len(y) > limit else limit)
-        ws.write_string(1, col, f"{key} x")
-        ws.write_string(1, col + 1, key)
-        write_number_columns(ws, 2, {col: x[index], col + 1: y[index]})
+        ws.write_string(1, col, f"{key} x", style.header)
+        ws.write_string(1, col + 1, key, style.header)
+        write_number_columns(ws, 2, {col: x[index], col + 1: y[index]}, style)
         out[key] = Ref(ws.get_name(), col, col + 1, 2, 1 + len(index), len(y))
         col += 2
+    longest = max((r.last_row for r in out.values() if r.sheet == ws.get_name()), default=1)
+    if time_col is not None:
+        longest = max(longest, 1 + len(time_ms[:limit]))
+    data_pages(ws, max(longest, 1), max(col - 1, 0), header_rows=2, shot=shot)
     return out
 
 

@@ -6,9 +6,10 @@ import math
 
 from xlsxwriter.utility import xl_rowcol_to_cell
 
+from ..cells import PARAMETER_COLUMNS
 from ..outputs import SHEET_NAME
 from ..readers.law_sheet import SHEET_NAME as LAW_SHEET
-from .report import one_page
+from .report import VALUE_COLUMN_CHARS, one_page, value_format
 from .safe_text import copyable_formula, sheet_title
 
 #: The sheets a fill adds after sheet 1, by their fixed names.
@@ -26,20 +27,28 @@ def sheet_names(source_title):
     return names
 
 
-def write_cells(ws, cells, values=None):
+def write_cells(ws, cells, values=None, style=None):
     """Copy ``{(row, col): (value, formula)}`` cells (1-based) as they were; return warnings.
 
     Formulas stay formulas, cached with ``values[(row, col)]``, unless they reach outside the
     workbook (DDE, another file, a web call): those are written as their cached value. Text is
-    always written as text; numbers exactly.
+    always written as text; numbers exactly, shown (with ``style``, a
+    :class:`~airgun_xl.xlsx.report.Style`) in at most 7 significant digits
+    (:func:`~airgun_xl.xlsx.report.value_format`) rather than as General.
     """
     values = values or {}
     warnings = []
+
+    def shown(number):
+        if style is None or not isinstance(number, (int, float)) or isinstance(number, bool):
+            return None
+        return style.get(num_format=value_format(number))
+
     for (row, col), (cached, formula) in sorted(cells.items()):
         r, c = row - 1, col - 1
         if formula is not None and copyable_formula(formula):
             value = values.get((row, col), cached)
-            ws.write_formula(r, c, formula, None, "" if value is None else value)
+            ws.write_formula(r, c, formula, shown(value), "" if value is None else value)
             continue
         if formula is not None:
             warnings.append(f"{ws.get_name()}!{xl_rowcol_to_cell(r, c)}: the formula reaches "
@@ -50,12 +59,20 @@ def write_cells(ws, cells, values=None):
         if isinstance(cached, bool):
             ws.write_boolean(r, c, cached)
         elif isinstance(cached, (int, float)) and math.isfinite(cached):
-            ws.write_number_column(r, c, [cached])  # exact: xlsxwriter keeps 16 digits
+            ws.write_number_column(r, c, [cached], shown(cached))  # exact: all 17 digits
         elif isinstance(cached, (int, float)):
             ws.write_number(r, c, cached)  # NaN/inf: written as an error cell
         else:
             ws.write_string(r, c, str(cached))  # text stays text, whatever it starts with
     return warnings
+
+
+def print_parameter_block(ws, block, shot, title):
+    """Sheet 1's parameter block on one page, its columns (A to G, where the labels overflow)
+    wide enough for the numbers as :func:`write_cells` shows them; its result columns from H
+    are data, printed from the Tracked sheet and summed up on the Summary."""
+    ws.set_column(0, PARAMETER_COLUMNS - 1, VALUE_COLUMN_CHARS)
+    one_page(ws, max(r for r, _ in block) - 1, PARAMETER_COLUMNS - 1, shot=shot, title=title)
 
 
 def print_outputs_block(ws, block, shot):
