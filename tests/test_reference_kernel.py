@@ -79,6 +79,11 @@ def test_sheet_xml_python_twin_writes_the_same_text():
                              [0.0, -0.0, 5e-324, 1.7976931348623157e308, 0.1, 1e-5, 123456.0]])
     assert compiled_xml.render_cells("AB", 7, values) == sheet_xml.render_cells_python(
         "AB", 7, values)
+    styled = compiled_xml.render_cells("AB", 7, values, 12)  # a column's number format
+    assert styled == sheet_xml.render_cells_python("AB", 7, values, 12)
+    assert styled[0].startswith('<c r="AB7" s="12"><v>') and styled[0].endswith("</v></c>")
+    assert compiled_xml.render_cells("AB", 7, values, -1) == compiled_xml.render_cells(
+        "AB", 7, values)
     with pytest.raises(ValueError):
         sheet_xml.render_cells_python("A", 1, np.array([1.0, np.nan]))
 

@@ -198,5 +198,17 @@ def test_a_study_workbook_opens_on_its_first_report_page(workbooks, kind):
 
 @pytest.mark.parametrize("kind", sorted(MACRO_LAYOUT))
 def test_a_workbook_in_the_macros_layout_opens_on_its_parameter_sheet(workbooks, kind):
-    wb = openpyxl.load_workbook(workbooks[kind])
+    """Sheet 1 stays first and active; it prints its parameter block on one page, and no
+    number on it, the macro's result columns included, is a General number past 7 digits."""
+    path = workbooks[kind]
+    wb = openpyxl.load_workbook(path)
     assert wb.active.title == wb.sheetnames[0] == "Sheet1"
+    assert "Sheet1" in [ws.title for ws, _ in report_sheets(path)]
+    long, numbers = [], 0
+    for row in wb.active.iter_rows():
+        for c in row:
+            if isinstance(c.value, (int, float)) and not isinstance(c.value, bool):
+                numbers += 1
+                if c.number_format == "General" and significant_digits(c.value) > MAX_DIGITS:
+                    long.append((c.coordinate, c.value))
+    assert numbers > 10_000 and long == [], (kind, long[:5])

@@ -41,6 +41,7 @@ from ..xlsx.law_sheet import write_law_sheet
 from ..xlsx.report import Style, data_pages
 from ..xlsx.sheets import (
     Ref,
+    data_format,
     variant_name,
     write_chart_data,
     write_number_columns,
@@ -162,13 +163,17 @@ def _write_sheet1(wb, result, outputs, keep, stride, title):
         warnings += write_cells(ws, block, values, Style(wb))
     for col in sorted(set(columns) | {c for c, g in HEADER_GROUPS.items() if g in outputs}):
         ws.write_string(0, col, HEADERS[col])
-    write_number_columns(ws, 1, columns)
+    style = Style(wb)
+    write_number_columns(ws, 1, columns, style)  # shown in 7 digits; the cells hold all 17
     if finals is not None:
-        ws.write_number(rows + 2, 8, finals[0])
-        ws.write_number(rows + 3, 8, finals[1])
+        shown = style.get(num_format=data_format(np.array(finals, dtype=float)))
+        ws.write_number(rows + 2, 8, finals[0], shown)
+        ws.write_number(rows + 3, 8, finals[1], shown)
     if "filtered" in outputs:
-        for row, value in _filtered_cells(result, stride):
-            ws.write_number(row, 27, value)
+        cells = _filtered_cells(result, stride)
+        shown = style.get(num_format=data_format(np.array([v for _, v in cells], dtype=float)))
+        for row, value in cells:
+            ws.write_number(row, 27, value, shown)
     if block:  # the input's own page
         print_parameter_block(ws, block, display(source.path.name), title)
     else:  # no input's block (a shot made in Python): the macro's columns, as data

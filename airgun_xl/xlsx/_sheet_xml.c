@@ -3,9 +3,10 @@
  * (airgun_xl/workbook/columns_sheet.py). Not part of the simulation.
  *
  * Python interface (module airgun_xl.workbook._sheet_xml):
- *   render_cells(column, first_row, values) -> list of str
+ *   render_cells(column, first_row, values[, style]) -> list of str
  *     '<c r="I5"><v>...</v></c>' for each value (finite float64), rows counted from
- *     first_row (1-based), numbers with 17 significant digits (exact round trip).
+ *     first_row (1-based), numbers with 17 significant digits (exact round trip);
+ *     with a style index >= 0, '<c r="I5" s="3"><v>...</v></c>'.
  * The pure-Python twin is airgun_xl/workbook/sheet_xml.py; a test compares them.
  */
 #define PY_SSIZE_T_CLEAN
@@ -25,13 +26,13 @@
 static PyObject *py_render_cells(PyObject *self, PyObject *args)
 {
     const char *column;
-    Py_ssize_t first_row, n, i, bad = -1;
+    Py_ssize_t first_row, n, i, bad = -1, style = -1;
     PyObject *values, *out = NULL;
     Py_buffer view;
     char *text;
     int *lengths;
 
-    if (!PyArg_ParseTuple(args, "snO", &column, &first_row, &values))
+    if (!PyArg_ParseTuple(args, "snO|n", &column, &first_row, &values, &style))
         return NULL;
     if (strlen(column) > 8)
         return PyErr_Format(PyExc_ValueError, "column name too long");
@@ -65,8 +66,12 @@ static PyObject *py_render_cells(PyObject *self, PyObject *args)
             break;
         }
         /* 17 significant digits always read back as the same double */
-        len = snprintf(cell, CELL_MAX, "<c r=\"%s%zd\"><v>%.17g</v></c>", column,
-                       first_row + i, x);
+        if (style >= 0)
+            len = snprintf(cell, CELL_MAX, "<c r=\"%s%zd\" s=\"%zd\"><v>%.17g</v></c>",
+                           column, first_row + i, style, x);
+        else
+            len = snprintf(cell, CELL_MAX, "<c r=\"%s%zd\"><v>%.17g</v></c>", column,
+                           first_row + i, x);
         for (j = 0; j < len; j++)
             if (cell[j] == ',')
                 cell[j] = '.'; /* a caller's setlocale() must not change the XML */
@@ -93,7 +98,8 @@ static PyObject *py_render_cells(PyObject *self, PyObject *args)
 
 static PyMethodDef methods[] = {
     {"render_cells", py_render_cells, METH_VARARGS,
-     "render_cells(column, first_row, values) -> list of '<c r=...><v>...</v></c>' strings"},
+     "render_cells(column, first_row, values[, style]) -> list of '<c r=...><v>...</v></c>'"
+     " strings"},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_sheet_xml",

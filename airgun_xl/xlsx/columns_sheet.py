@@ -117,14 +117,13 @@ class ColumnsWorksheet(SafeWorksheet):
         pieces = [(col, max(first, lo), values[max(first, lo) - first:min(hi - first,
                                                                           len(values))])
                   for col, first, values in runs]
+        styles = [self._bulk_formats.get((col, first)) for col, first, _ in runs]
+        styles = [-1 if fmt is None else fmt._get_xf_index() for fmt in styles]
         with ThreadPoolExecutor(2) as pool:  # render_cells formats without the GIL
-            texts = list(pool.map(lambda p: render_cells(xl_col_to_name(p[0]), p[1] + 1, p[2]),
-                                  pieces))
-        for k, (col, first, _) in enumerate(runs):  # a run's format: its cells' style index
-            fmt = self._bulk_formats.get((col, first))
-            if fmt is not None:
-                style = f'" s="{fmt._get_xf_index()}"><v>'
-                texts[k] = [t.replace('"><v>', style, 1) for t in texts[k]]
+            texts = list(pool.map(lambda p: render_cells(xl_col_to_name(p[0]), p[1] + 1, p[2],
+                                                         p[3]),
+                                  [(*piece, style) for piece, style in zip(pieces, styles,
+                                                                          strict=True)]))
         spans = [(col, first, first + len(values), t)
                  for (col, first, values), t in zip(pieces, texts, strict=True)]
         edges = sorted({s[1] for s in spans} | {s[2] for s in spans})
