@@ -149,7 +149,8 @@ def test_fitted_values_land_in_their_cells(tmp_path):
     (["{T}", "m.csv", "--fit", "E40,scale"], "--fit: found both E40 and scale"),
     (["{T}", "m.csv", "--fit", "zeta"], "--fit: found zeta, expected names from E40, E43"),
     (["{T}", "m.csv", "--degree", "7"], "--degree: found 7, expected 1 to 6"),
-    (["{T}", "m.csv", "--cfc", "100"], "--cfc: found 100, expected one of 60, 180, 600"),
+    (["{T}", "m.csv", "--cfc", "100"], "--cfc: found '100', expected a J211 class (60, 180, 600 "
+                                             "or 1000) or none"),
 ])
 def test_bad_options_one_line_no_file(tmp_path, capsys, argv, message):
     argv = [a.replace("{T}", str(TEMPLATE)) for a in argv]
