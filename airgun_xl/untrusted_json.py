@@ -28,7 +28,7 @@ from .errors import AirgunXlError
 
 #: The largest file read, by kind [bytes]: each is a few kilobytes when the tool writes it.
 MAX_BYTES = {"profile": 65_536, "law": 1 << 20, "verdict": 1 << 20, "summary": 4 << 20,
-             "params": 1 << 20, "provenance": 1 << 20, "manifest": 1 << 20}
+             "params": 1 << 20, "provenance": 1 << 20, "manifest": 1 << 20, "marker": 4096}
 
 #: The deepest nesting of arrays and objects read (the tool writes 4 at most).
 MAX_DEPTH = 32
@@ -108,6 +108,11 @@ SCHEMAS: dict[str, dict] = {
         "properties": {"index": {"type": "object", "required": ["shot", "version"],
                                  "properties": {"shot": _TEXT, "version": {"type": "integer"}}},
                        "files": {"type": "object", "additionalProperties": _TEXT}}},
+    "marker": {
+        "type": "object", "required": ["format"], "description": "an archive's marker",
+        "properties": {"format": {"type": "integer", "enum": [1]}, "tool": _TEXT,
+                       "index": {"enum": ["sqlite", "server"]},
+                       "identity": {"type": "string", "pattern": "^[0-9a-f]{32}$"}}},
 }
 
 

@@ -149,6 +149,32 @@ SLOW_TESTS = {
 }
 
 
+@pytest.fixture(scope="session")
+def pg_server():
+    """A real PostgreSQL server for the session (tests/pg_server.py); skipped, with what to
+    install, without the server's binaries or psycopg."""
+    import pg_server as pg
+
+    if not pg.available():
+        pytest.skip(pg.WHY_SKIPPED)
+    server = pg.start_server()
+    yield server
+    pg.remove_server(server)
+
+
+@pytest.fixture
+def server_env(pg_server, monkeypatch):
+    """The archive role's address in $AIRGUN_XL_INDEX and its password in $PGPASSWORD, as a
+    lab engineer's shell would have them; returns the server."""
+    import pg_server as pg
+
+    monkeypatch.setenv("AIRGUN_XL_INDEX", pg_server.address)
+    monkeypatch.setenv("PGPASSWORD", pg.PASSWORD)
+    for name in ("PGHOST", "PGPORT", "PGUSER", "PGDATABASE", "PGSERVICE", "PGPASSFILE"):
+        monkeypatch.delenv(name, raising=False)
+    return pg_server
+
+
 def pytest_collection_modifyitems(config, items):
     for item in items:
         if (item.module.__name__.rsplit(".", 1)[-1] in SLOW_MODULES

@@ -51,7 +51,8 @@ def test_convergence_at_the_finest_level_says_what_to_do(tmp_path, capsys):
     ("history", ["the archive folder", "only this shot's runs", "ISO date", "as JSON"]),
     ("show", ["SHOT (its latest run)", "the archive folder"]),
     ("compare", ["Exit 0 when", "SHOT, SHOT@VERSION or #ID", "largest magnitude"]),
-    ("archive", ["re-hash every", "verify the archive", "the archive folder"]),
+    ("archive", ["re-hash every", "verify: check one", "init: make a new archive",
+                 "the archive folder", "never a password"]),
 ])
 def test_archive_commands_have_help(capsys, command, words):
     with pytest.raises(SystemExit):

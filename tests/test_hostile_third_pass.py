@@ -536,7 +536,8 @@ def test_32_10_a_worker_killed_by_sigkill_loses_its_shot_only(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "airgun_xl", "fill", str(day), "--jobs", "2",
                              "--summary", str(summary)], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
-    owner = re.compile(r"^\.(s\d)\.out\.xlsx\.(\d+)\.\d+-[0-9a-f]{16}\.airgun-xl-tmp$")
+    owner = re.compile(r"^\.(s\d)\.out\.xlsx\.(\d+)\.\d+\.[a-z][a-z0-9]*-[0-9a-f]{16}"
+                       r"\.airgun-xl-tmp$")
     deadline = time.monotonic() + 120
     killed = None
     while killed is None and proc.poll() is None:  # polled, not slept

@@ -34,6 +34,8 @@ NOT_RUN = [
     ("README.md", "python3 -m venv .venv && . .venv/bin/activate && pip install . && "
                   "airgun-xl fill templates/shot_a.xlsx"),
     ("README.md", '. .venv/bin/activate && pip install -e ".[test]" && python -m pytest'),
+    ("README.md", '# needs: a lab\'s PostgreSQL server, and the extra: pip install '
+                  '"airgun-xl[server]"'),
     ("docs/legacy.md", "# needs: root (apt-get) and the lab's macro runner, which is outside "
                        "this repository"),
 ]

@@ -5,6 +5,7 @@ killed publisher can leave and check what the next publisher's recovery makes of
 """
 import json
 import os
+import re
 import sys
 
 import pytest
@@ -94,10 +95,30 @@ def test_a_live_publishers_files_are_left_alone(tmp_path):
 
 
 def test_a_reused_pid_does_not_look_like_the_owner():
-    pid, started = owner_token().split(".")
-    assert owner_alive(f"{pid}.{started}")
-    assert not owner_alive(f"{pid}.{int(started) + 1}")  # same pid, another process
+    pid, started, host = owner_token().split(".")
+    assert owner_alive(f"{pid}.{started}.{host}") and owner_alive(f"{pid}.{started}")
+    assert not owner_alive(f"{pid}.{int(started) + 1}.{host}")  # same pid, another process
     assert not owner_alive(DEAD)
+
+
+def test_an_owner_names_its_host_and_another_hosts_owner_is_never_taken_for_dead():
+    """Issue 36: two hosts on one share. A token names its host; a process of another host
+    cannot be seen from this one, so it is taken to be alive (its files are never removed
+    here); a token of before the host was named is this host's."""
+    from airgun_xl.transaction import owners
+
+    token = owner_token()
+    assert re.fullmatch(owners.OWNER_PATTERN, token) and token.endswith("." + owners.host_tag())
+    assert owners.host_tag("LAB-Cell.2") == "labcell2" and owners.host_tag("42") == "h42"
+    assert owners.host_tag("x" * 40) == "x" * 32 and owners.host_tag("") == "h"
+    assert owner_alive(f"{DEAD}.otherhost")  # another host's: alive as far as this one knows
+    assert not owner_alive(f"{DEAD}.{owners.host_tag()}")  # this host's, gone
+    # a file name reads one way: the owner with its host, not the host taken for a start time
+    name = f".out.xlsx.{DEAD}.h42-{'ab' * 8}.airgun-xl-tmp"
+    from airgun_xl.transaction.publication import _OWNED
+
+    match = _OWNED.match(name)
+    assert match and match["owner"] == f"{DEAD}.h42" and match["name"] == "out.xlsx"
 
 
 def test_without_force_the_second_publication_of_a_name_fails_whole(tmp_path):

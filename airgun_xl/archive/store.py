@@ -2,8 +2,10 @@
 
 Layout of an archive folder::
 
-    .airgun-xl-archive      marker: this folder is an archive (JSON, the format version)
-    index.sqlite            one row an entry (SQLite, WAL mode; no server)
+    .airgun-xl-archive      marker: this folder is an archive (JSON: the format version; for
+                            an index on a server, its identity, never its address)
+    index.sqlite            one row an entry (SQLite, WAL mode; no server), or the same rows
+                            on a PostgreSQL server (:mod:`.index`)
     <shot>/v0001/           an entry: input, output.xlsx, params.json, history.parquet,
                             summary.json, provenance.json, manifest.json (SHA-256 of each)
     .airgun-xl-scratch/<owner>-<hex>/   an entry being written
@@ -30,7 +32,6 @@ import json
 import os
 import re
 import shutil
-import sqlite3
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,30 +39,17 @@ from typing import Any
 
 from ..choices import ARCHIVE_ENV
 from ..errors import ArchiveError, OptionError
-from ..transaction import display, fsync, owner_alive, owner_token
+from ..transaction import display, fsync, owner_token
+from ..transaction.owners import OWNER_PATTERN
+from .index import INDEX, ServerIndex, SqliteIndex, is_sqlite_index
 
 ENV = ARCHIVE_ENV
-INDEX = "index.sqlite"
 MARKER = ".airgun-xl-archive"
 SCRATCH = ".airgun-xl-scratch"
 MANIFEST = "manifest.json"
 FORMAT = 1
-_SCRATCH_NAME = re.compile(r"^(?P<owner>\d+\.\d+)-[0-9a-f]{32}$")
+_SCRATCH_NAME = re.compile(r"^(?P<owner>" + OWNER_PATTERN + r")-[0-9a-f]{32}$")
 _ENTRY_NAME = re.compile(r"^v(\d{4,})$")
-SCHEMA = """
-CREATE TABLE IF NOT EXISTS entries (
-    id INTEGER PRIMARY KEY,
-    shot TEXT NOT NULL,
-    version INTEGER NOT NULL,
-    path TEXT NOT NULL,
-    created TEXT NOT NULL,
-    input_sha256 TEXT,
-    v0 REAL, delta REAL, max_time REAL, sigmay REAL, rcone REAL,
-    peak_kg REAL, integrator TEXT, model TEXT, engine TEXT,
-    UNIQUE (shot, version)
-)"""
-
-
 def archive_dir(given=None, required=True):
     """The archive folder: the given one, else $AIRGUN_XL_ARCHIVE."""
     path = given or os.environ.get(ENV)
@@ -158,44 +146,19 @@ def _read_manifest(folder):
     return manifest if ok else None
 
 
-#: How long a writer waits for another's lock on the index [s].
-LOCK_WAIT = 120
+def read_marker(root):
+    """An archive folder's marker: {"format", "index" ("sqlite" or "server"), "identity"};
+    read as untrusted (a hostile marker is refused in one line, never dialled)."""
+    from ..untrusted_json import read_json
 
-
-def _prepare(conn):
-    """WAL mode, full sync and the schema on a new connection. Two processes creating the index
-    at once may see "database is locked" from the journal-mode switch, which SQLite does not
-    retry through the busy timeout: it is retried here, up to :data:`LOCK_WAIT`."""
-    import time
-
-    deadline = time.monotonic() + LOCK_WAIT
-    while True:
-        try:
-            if str(conn.execute("PRAGMA journal_mode").fetchone()[0]).lower() != "wal":
-                conn.execute("PRAGMA journal_mode=WAL")
-            conn.execute("PRAGMA synchronous=FULL")
-            conn.execute(SCHEMA)
-            return
-        except sqlite3.OperationalError as exc:
-            if "locked" not in str(exc) or time.monotonic() > deadline:
-                raise
-            time.sleep(0.02)
-
-
-def _is_index(path):
-    """Whether ``path`` is an SQLite file with this tool's ``entries`` table."""
-    if not path.is_file():
-        return False
-    try:
-        conn = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
-        try:
-            row = conn.execute("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = "
-                               "'entries'").fetchone()
-        finally:
-            conn.close()
-    except sqlite3.Error:
-        return False
-    return row is not None
+    marker = read_json(Path(root) / MARKER, "marker", display(Path(root) / MARKER),
+                       ArchiveError)
+    marker.setdefault("index", "sqlite")
+    if marker["index"] == "server" and "identity" not in marker:
+        raise ArchiveError(f"{display(Path(root) / MARKER)}: identity: found none, expected "
+                           "the archive's identity (32 hexadecimal digits) for an index on a "
+                           "server")
+    return marker
 
 
 class Archive:
@@ -209,6 +172,9 @@ class Archive:
         it, ``root`` must already be an archive.
     dry_run : bool
         With ``create``: check that it could, and change nothing.
+    index : str, optional
+        For an archive whose index is on a server: its address (else ``$AIRGUN_XL_INDEX`` or
+        libpq's defaults; never the marker's say).
 
     Raises
     ------
@@ -217,8 +183,9 @@ class Archive:
         other files and is not an archive.
     """
 
-    def __init__(self, root, create=False, dry_run=False):
+    def __init__(self, root, create=False, dry_run=False, index=None):
         self.root = Path(root)
+        self.index: SqliteIndex | ServerIndex = SqliteIndex(self.root)
         self.created_here = False  # this object made the folder (undone if nothing commits)
         shown = display(self.root)
         if dry_run and not self.root.exists():  # what create would do, without doing it
@@ -242,14 +209,14 @@ class Archive:
                 raise ArchiveError(f"{shown}: cannot be created ({exc.strerror})") from None
         if not self.root.is_dir():
             raise ArchiveError(f"{shown}: is not a folder, expected an archive folder")
-        marked = (self.root / MARKER).is_file() or _is_index(self.root / INDEX)
+        marked = (self.root / MARKER).is_file() or is_sqlite_index(self.root / INDEX)
         if not marked:
             try:
                 empty = not any(os.scandir(self.root))
             except OSError as exc:
                 raise ArchiveError(f"{shown}: cannot be read ({exc.strerror})") from None
             # a fill that created the folder a moment ago may have marked it since we looked
-            marked = (self.root / MARKER).is_file() or _is_index(self.root / INDEX)
+            marked = (self.root / MARKER).is_file() or is_sqlite_index(self.root / INDEX)
             if not (create and empty) and not marked:
                 raise ArchiveError(
                     f"{shown}: is not an airgun-xl archive (no {MARKER} or {INDEX}), expected "
@@ -263,6 +230,54 @@ class Archive:
                 pass
             except OSError as exc:
                 raise ArchiveError(f"{shown}: cannot be written ({exc.strerror})") from None
+        if dry_run or not (self.root / MARKER).is_file():
+            return
+        marker = read_marker(self.root)
+        if marker["index"] == "server":
+            self.index = ServerIndex(self.root, marker["identity"], index)
+
+    @classmethod
+    def init(cls, root, index=None, server=None):
+        """Make a new archive at ``root`` (a new or empty folder): its index in the folder, or
+        with ``server`` (default: when ``index`` is given) on a PostgreSQL server at ``index``
+        (an address, :func:`~airgun_xl.archive.index.server_address`; None for
+        ``$AIRGUN_XL_INDEX`` or libpq's defaults), the marker naming its identity; return it.
+
+        Raises
+        ------
+        airgun_xl.errors.ArchiveError
+            When ``root`` is an archive already, or a folder that holds other files.
+        """
+        root = Path(root)
+        shown = display(root)
+        if (root / MARKER).exists() or (root / INDEX).exists():
+            raise ArchiveError(f"{shown}: is an archive already, expected a new or empty "
+                               "folder (airgun-xl archive migrate moves an index to a server)")
+        on_server = server if server is not None else index is not None
+        server = None
+        if on_server:  # the address checked, and the server reached, before the folder is made
+            server = ServerIndex(root, uuid.uuid4().hex, index)
+        probe = cls(root, create=True, dry_run=True)
+        del probe
+        if root.exists() and any(os.scandir(root)):
+            raise ArchiveError(f"{shown}: is not empty, expected a new or empty folder")
+        if server is not None:
+            server.create()
+        made = not root.exists()
+        try:
+            os.makedirs(root, exist_ok=True)
+            marker = {"format": FORMAT, "tool": "airgun-xl"}
+            if server is not None:
+                marker.update(index="server", identity=server.identity)
+            with open(root / MARKER, "x") as fh:
+                json.dump(marker, fh)
+                fh.flush()
+                os.fsync(fh.fileno())
+        except OSError as exc:
+            if made:
+                shutil.rmtree(root, ignore_errors=True)
+            raise ArchiveError(f"{shown}: cannot be written ({exc.strerror})") from None
+        return cls(root)
 
     def remove_if_unused(self):
         """Undo the creation of a new archive whose first entry was never committed (a failed
@@ -271,20 +286,14 @@ class Archive:
         folder this object created."""
         if not self.created_here:
             return
-        index_files = {INDEX, f"{INDEX}-wal", f"{INDEX}-shm", f"{INDEX}-journal"}
-        with contextlib.suppress(OSError, sqlite3.Error):
+        if self.index.kind != "sqlite":
+            return  # a server archive is made by archive init, and kept
+        index_files = self.index.files()
+        with contextlib.suppress(Exception):  # OSError, or the index's own error
             if set(os.listdir(self.root)) - {MARKER, SCRATCH} - index_files:
                 return
-            if (self.root / INDEX).exists():
-                conn = sqlite3.connect(self.root / INDEX, timeout=5, isolation_level=None)
-                try:
-                    conn.execute("BEGIN IMMEDIATE")  # no other writer is committing
-                    rows = conn.execute("SELECT COUNT(*) FROM entries").fetchone()[0]
-                    conn.execute("ROLLBACK")
-                finally:
-                    conn.close()
-                if rows:
-                    return
+            if self.index.exists() and self.index.count():
+                return
             if (self.root / SCRATCH).exists():
                 os.rmdir(self.root / SCRATCH)  # fails if another writer works in it
             for name in sorted(index_files):
@@ -295,26 +304,10 @@ class Archive:
             os.rmdir(self.root)
 
     # -- the index ------------------------------------------------------------------------
-    def _connect(self):
-        try:
-            conn = sqlite3.connect(self.root / INDEX, timeout=LOCK_WAIT, isolation_level=None)
-            conn.row_factory = sqlite3.Row
-            _prepare(conn)
-        except sqlite3.Error as exc:
-            raise ArchiveError(f"{display(self.root / INDEX)}: cannot be used ({exc}), expected "
-                               "the archive's SQLite index") from None
-        return conn
-
-    def _insert(self, conn, manifest, path):
+    @staticmethod
+    def _row(manifest, path, root):
         meta = manifest["index"]
-        conn.execute(
-            "INSERT INTO entries (shot, version, path, created, input_sha256, v0, delta, "
-            "max_time, sigmay, rcone, peak_kg, integrator, model, engine) VALUES "
-            "(?,?,?,?,?,?,?,?,?,?,?,?,?,?)",
-            (meta["shot"], meta["version"], path.relative_to(self.root).as_posix(),
-             meta["created"], meta.get("input_sha256"), meta.get("v0"), meta.get("delta"),
-             meta.get("max_time"), meta.get("sigmay"), meta.get("rcone"), meta.get("peak_kg"),
-             meta.get("integrator"), meta.get("model"), meta.get("engine")))
+        return dict(meta, path=path.relative_to(root).as_posix())
 
     def _entry_folders(self):
         """``(folder, version)`` of every folder shaped like an entry, ``<shot>/vNNNN``."""
@@ -326,22 +319,22 @@ class Archive:
                 if version is not None and folder.is_dir() and not folder.is_symlink():
                     yield folder, version
 
-    def _recover(self, conn):
+    def _recover(self, session):
         """Under the write lock: index complete entries whose row was lost to a kill, and
-        remove the scratch folders of writers that are gone (only those)."""
-        known = {r["path"] for r in conn.execute("SELECT path FROM entries")}
+        remove the scratch folders of writers that are gone (only those: another host's only
+        when a server index says so)."""
+        known = session.paths()
         for folder, _ in self._entry_folders():
             rel = folder.relative_to(self.root).as_posix()
             if rel in known:
                 continue
             manifest = _read_manifest(folder)
             if manifest is not None and self._complete(folder, manifest):
-                with contextlib.suppress(sqlite3.IntegrityError):  # a clash: verify reports it
-                    self._insert(conn, manifest, folder)
+                session.insert(self._row(manifest, folder, self.root))  # a clash: verify says
         scratch = self.root / SCRATCH
         for folder in scratch.iterdir() if scratch.is_dir() else ():
             m = _SCRATCH_NAME.match(folder.name)
-            if m and folder.is_dir() and not folder.is_symlink() and not owner_alive(
+            if m and folder.is_dir() and not folder.is_symlink() and self.index.writer_gone(
                     m["owner"]):
                 shutil.rmtree(folder, ignore_errors=True)
 
@@ -370,6 +363,7 @@ class Archive:
         """
         shot = safe_name(shot)
         scratch = self.root / SCRATCH
+        self.index.hold(owner_token())  # a server archive: this writer is alive, on any host
         try:
             scratch.mkdir(exist_ok=True)
             work = scratch / f"{owner_token()}-{uuid.uuid4().hex}"
@@ -402,31 +396,15 @@ class Archive:
         """Store one entry on its own (see :meth:`prepare`); return the :class:`Entry`."""
         return self.prepare(shot, files, documents, index, generated).commit_alone()
 
-    def _next_version(self, conn, shot):
-        row = conn.execute("SELECT MAX(version) FROM entries WHERE shot = ?", (shot,)).fetchone()
+    def _next_version(self, session, shot):
         folder = self.root / shot
         on_disk = [v for v in (_entry_version(p) for p in folder.iterdir()) if v is not None] \
             if folder.is_dir() else []
-        return max([row[0] or 0] + on_disk) + 1
+        return max([session.last_version(shot)] + on_disk) + 1
 
     # -- reading --------------------------------------------------------------------------
     def entries(self, shot=None, since=None):
-        if not (self.root / INDEX).exists():
-            return []
-        conn = self._connect()
-        try:
-            sql, args = "SELECT * FROM entries WHERE 1=1", []
-            if shot:
-                sql += " AND shot = ?"
-                args.append(safe_name(shot))
-            if since:
-                sql += " AND created >= ?"
-                args.append(since)
-            rows = conn.execute(sql + " ORDER BY created, shot, version", args).fetchall()
-        except sqlite3.Error as exc:
-            raise ArchiveError(f"{display(self.root / INDEX)}: cannot be read ({exc})") from None
-        finally:
-            conn.close()
+        rows = self.index.rows(safe_name(shot) if shot else None, since)
         return [e for e in (self._entry(r) for r in rows) if e is not None]
 
     def _entry(self, r):
@@ -469,20 +447,21 @@ class Archive:
         file, a row whose path is not an entry.
         """
         problems = []
-        conn = self._connect()
         try:
-            conn.execute("BEGIN IMMEDIATE")
-            self._recover(conn)
-            conn.execute("COMMIT")
-            check = conn.execute("PRAGMA integrity_check").fetchone()[0]
-            if check != "ok":
-                problems.append(f"{INDEX}: {check}")
-            rows = conn.execute("SELECT * FROM entries ORDER BY shot, version").fetchall()
-        except sqlite3.Error as exc:
-            problems.append(f"{INDEX}: cannot be read ({exc})")
+            session = self.index.write()
+            try:
+                self._recover(session)
+                session.commit()
+            finally:
+                session.close()
+            problems += self.index.problems()
+        except ArchiveError as exc:
+            problems.append(str(exc))
+        try:
+            rows = self.index.rows(order="shot, version")
+        except ArchiveError as exc:
+            problems.append(str(exc))
             rows = []
-        finally:
-            conn.close()
         indexed = set()
         for r in rows:
             e = self._entry(r)
@@ -541,14 +520,9 @@ class PendingEntry:
     def prepare(self, txn=None):
         """Lock the index, recover, pick the version; return the path of the manifest that
         names ``txn`` once the entry is committed."""
-        self.conn = self.archive._connect()
-        try:
-            self.conn.execute("BEGIN IMMEDIATE")  # the write lock: one writer at a time
-            self.archive._recover(self.conn)
-            version = self.archive._next_version(self.conn, self.shot)
-        except sqlite3.Error as exc:
-            raise ArchiveError(f"{display(self.archive.root / INDEX)}: cannot be used "
-                               f"({exc})") from None
+        self.conn = self.archive.index.write()  # the write lock: one writer at a time
+        self.archive._recover(self.conn)
+        version = self.archive._next_version(self.conn, self.shot)
         self.manifest["index"]["version"] = version
         if txn is not None:
             self.manifest["txn"] = txn
@@ -570,8 +544,11 @@ class PendingEntry:
                                f"({exc.strerror})") from None
         try:
             fsync(self.final.parent, directory=True)
-            self.archive._insert(self.conn, self.manifest, self.final)
-            self.conn.execute("COMMIT")
+            if not self.conn.insert(self.archive._row(self.manifest, self.final,
+                                                      self.archive.root)):
+                raise ArchiveError(f"{display(self.final)}: its version was taken by another "
+                                   "writer, expected the write lock to keep it")
+            self.conn.commit()
         except BaseException:
             with contextlib.suppress(OSError):
                 os.rename(self.final, self.work)  # not committed after all
@@ -584,9 +561,6 @@ class PendingEntry:
     def release(self):
         """Give up: roll back the index transaction and remove the scratch folder."""
         if self.conn is not None:
-            with contextlib.suppress(sqlite3.Error):
-                if self.conn.in_transaction:
-                    self.conn.execute("ROLLBACK")
             self.conn.close()
             self.conn = None
         if self.work.exists():

@@ -1,8 +1,9 @@
-"""``history``, ``show``, ``compare`` and ``archive verify``: find archived shots again."""
+"""``history``, ``show``, ``compare``, ``archive init`` and ``archive verify``: make an
+archive, and find archived shots again."""
 import json
 import sys
 
-from ..archive import ENV, Archive, archive_dir
+from ..archive import ENV, INDEX_ENV, Archive, archive_dir
 from ..transaction import display
 from ..untrusted_json import printable
 from .run_options import ATOL_HELP, RTOL_HELP, add_force, tolerance
@@ -49,13 +50,22 @@ def add_parser(sub):
                    help="also write a workbook: the input cells that differ and the error table")
     add_force(c, "REPORT.xlsx")
     c.set_defaults(run=run_compare)
-    a = sub.add_parser("archive", help="archive maintenance: verify",
-                       description=f"verify: finish what killed writers left, re-hash every "
-                                   f"file of every entry, and list anything missing, altered "
-                                   f"or out of place. Exit 0 clean, 1 with problems. {where}")
-    a.add_argument("action", choices=["verify"], help="verify the archive")
+    a = sub.add_parser("archive", help="archive maintenance: init, verify",
+                       description=f"init: make a new archive in a new or empty folder, its "
+                                   f"index in the folder (SQLite, one machine) or, with "
+                                   f"--index, on a PostgreSQL server (a lab's share written by "
+                                   f"several hosts). verify: finish what killed writers left, "
+                                   f"re-hash every file of every entry, and list anything "
+                                   f"missing, altered or out of place. Exit 0 clean, 1 with "
+                                   f"problems. {where}")
+    a.add_argument("action", choices=["init", "verify"],
+                   help="init: make a new archive; verify: check one")
     a.add_argument("dir", nargs="?", metavar="DIR", help="the archive folder")
-    a.set_defaults(run=run_verify)
+    a.add_argument("--index", metavar="postgresql://HOST/DB",
+                   help=f"the PostgreSQL server of the archive's index (default "
+                        f"${INDEX_ENV}, else libpq's PGHOST, PGSERVICE and service file); "
+                        "never a password: ~/.pgpass or $PGPASSWORD hold it")
+    a.set_defaults(run=run_archive)
 
 
 def _count(n, one, many):
@@ -350,8 +360,27 @@ def _history_archive(args):
     return args.dir
 
 
+def run_archive(args):
+    if args.action == "init":
+        return run_init(args)
+    return run_verify(args)
+
+
+def run_init(args):
+    """Make a new archive: its index in the folder, or on a server with --index."""
+    import os
+
+    root = archive_dir(args.dir)
+    server = args.index is not None or bool(os.environ.get(INDEX_ENV))
+    archive = Archive.init(root, args.index, server=server)
+    where = (f"its index on {archive.index.shown}" if archive.index.kind == "server"
+             else "its index in the folder")
+    print(f"made the archive {display(archive.root)}, {where}")
+    return 0
+
+
 def run_verify(args):
-    archive = _archive(args.dir)
+    archive = Archive(archive_dir(args.dir), index=args.index)
     problems = archive.verify()
     entries = archive.entries()
     for p in problems:

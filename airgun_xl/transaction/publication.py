@@ -34,11 +34,11 @@ from pathlib import Path
 from ..errors import OutputError
 from .checks import display
 from .locks import folder_lock, fsync
-from .owners import owner_alive, owner_token
+from .owners import OWNER_PATTERN, owner_alive, owner_token
 from .signals import SIGNALS, Interrupted, signals_held
 
 SUFFIX = "airgun-xl"
-_OWNED = re.compile(r"^\.(?P<name>.+)\.(?P<owner>\d+\.\d+)-(?P<hex>[0-9a-f]{16})"
+_OWNED = re.compile(r"^\.(?P<name>.+)\.(?P<owner>" + OWNER_PATTERN + r")-(?P<hex>[0-9a-f]{16})"
                     r"\.airgun-xl-(?P<kind>tmp|bak|journal)$")
 
 

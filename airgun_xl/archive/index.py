@@ -1,0 +1,534 @@
+"""The archive's index: one row an entry, on one of two back ends behind one interface.
+
+- :class:`SqliteIndex`, the default: ``index.sqlite`` in the archive folder, WAL mode, for
+  one machine (SQLite's WAL needs shared memory on one host, so it does not hold on a
+  network share);
+- :class:`ServerIndex`: tables on a PostgreSQL server (psycopg 3, the ``server`` extra), for
+  a lab's share written by several hosts. The folder's marker names the archive's identity
+  and that its index is on a server, never an address: the address comes from the user's
+  side (:func:`server_address`), and the server must hold that identity.
+
+A writer takes the archive's write lock with :meth:`write` (SQLite: ``BEGIN IMMEDIATE``; the
+server: a row lock on the archive's own row, ``SELECT ... FOR UPDATE``) and gets a
+:class:`Session`: the paths indexed, a shot's last version, the insert, the commit. Every SQL
+statement takes its values as parameters, never as text pasted in.
+"""
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import os
+import sqlite3
+import time
+from pathlib import Path
+from typing import Any
+
+from ..errors import ArchiveError, OptionError
+from ..transaction import display
+
+INDEX = "index.sqlite"
+
+#: The environment variable that gives a server archive's address (a libpq URL or
+#: ``key=value`` string, without a password); libpq's own variables and service file work too.
+INDEX_ENV = "AIRGUN_XL_INDEX"
+
+#: How long a writer waits for another's lock on the index [s].
+LOCK_WAIT = 120
+
+#: How long one statement may run on the server before it is cancelled [s].
+STATEMENT_TIMEOUT = 60
+
+#: The columns of an entry's row, after its id, in order.
+COLUMNS = ("shot", "version", "path", "created", "input_sha256", "v0", "delta", "max_time",
+           "sigmay", "rcone", "peak_kg", "integrator", "model", "engine")
+
+SQLITE_SCHEMA = """
+CREATE TABLE IF NOT EXISTS entries (
+    id INTEGER PRIMARY KEY,
+    shot TEXT NOT NULL,
+    version INTEGER NOT NULL,
+    path TEXT NOT NULL,
+    created TEXT NOT NULL,
+    input_sha256 TEXT,
+    v0 REAL, delta REAL, max_time REAL, sigmay REAL, rcone REAL,
+    peak_kg REAL, integrator TEXT, model TEXT, engine TEXT,
+    UNIQUE (shot, version)
+)"""
+
+#: The server's schema: the role needs the rights of this schema only (README, "A shared
+#: archive"). One schema holds any number of archives, each its own row in ``archives``.
+SERVER_SCHEMA = "airgun_xl"
+SERVER_TABLES = (
+    f"CREATE SCHEMA IF NOT EXISTS {SERVER_SCHEMA}",
+    f"""CREATE TABLE IF NOT EXISTS {SERVER_SCHEMA}.archives (
+        identity TEXT PRIMARY KEY,
+        created TEXT NOT NULL,
+        format INTEGER NOT NULL)""",
+    f"""CREATE TABLE IF NOT EXISTS {SERVER_SCHEMA}.entries (
+        id BIGSERIAL PRIMARY KEY,
+        archive TEXT NOT NULL REFERENCES {SERVER_SCHEMA}.archives (identity),
+        shot TEXT NOT NULL,
+        version INTEGER NOT NULL,
+        path TEXT NOT NULL,
+        created TEXT NOT NULL,
+        input_sha256 TEXT,
+        v0 DOUBLE PRECISION, delta DOUBLE PRECISION, max_time DOUBLE PRECISION,
+        sigmay DOUBLE PRECISION, rcone DOUBLE PRECISION, peak_kg DOUBLE PRECISION,
+        integrator TEXT, model TEXT, engine TEXT,
+        UNIQUE (archive, shot, version))""",
+)
+
+
+class Session:
+    """A write transaction on the index, holding the archive's write lock (from
+    :meth:`SqliteIndex.write` or :meth:`ServerIndex.write`)."""
+
+    def paths(self) -> set[str]:
+        raise NotImplementedError
+
+    def last_version(self, shot: str) -> int:
+        raise NotImplementedError
+
+    def insert(self, row: dict) -> bool:
+        """Insert an entry's row; False when its (shot, version) is taken already."""
+        raise NotImplementedError
+
+    def commit(self) -> None:
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Roll back what was not committed, and let the lock go."""
+        raise NotImplementedError
+
+
+# -- SQLite ------------------------------------------------------------------------------------
+
+def _prepare(conn):
+    """WAL mode, full sync and the schema on a new connection. Two processes creating the index
+    at once may see "database is locked" from the journal-mode switch, which SQLite does not
+    retry through the busy timeout: it is retried here, up to :data:`LOCK_WAIT`."""
+    deadline = time.monotonic() + LOCK_WAIT
+    while True:
+        try:
+            if str(conn.execute("PRAGMA journal_mode").fetchone()[0]).lower() != "wal":
+                conn.execute("PRAGMA journal_mode=WAL")
+            conn.execute("PRAGMA synchronous=FULL")
+            conn.execute(SQLITE_SCHEMA)
+            return
+        except sqlite3.OperationalError as exc:
+            if "locked" not in str(exc) or time.monotonic() > deadline:
+                raise
+            time.sleep(0.02)
+
+
+def is_sqlite_index(path):
+    """Whether ``path`` is an SQLite file with this tool's ``entries`` table."""
+    if not path.is_file():
+        return False
+    try:
+        conn = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+        try:
+            row = conn.execute("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = "
+                               "'entries'").fetchone()
+        finally:
+            conn.close()
+    except sqlite3.Error:
+        return False
+    return row is not None
+
+
+class _SqliteSession(Session):
+    def __init__(self, conn, label):
+        self.conn, self.label = conn, label
+
+    def paths(self):
+        return {r[0] for r in self.conn.execute("SELECT path FROM entries")}
+
+    def last_version(self, shot):
+        row = self.conn.execute("SELECT MAX(version) FROM entries WHERE shot = ?",
+                                (shot,)).fetchone()
+        return int(row[0] or 0)
+
+    def insert(self, row):
+        try:
+            self.conn.execute(f"INSERT INTO entries ({', '.join(COLUMNS)}) VALUES "
+                              f"({', '.join('?' * len(COLUMNS))})",
+                              tuple(row.get(c) for c in COLUMNS))
+        except sqlite3.IntegrityError:
+            return False
+        return True
+
+    def commit(self):
+        try:
+            self.conn.execute("COMMIT")
+        except sqlite3.Error as exc:
+            raise ArchiveError(f"{self.label}: the entry's row cannot be committed ({exc})") \
+                from None
+
+    def close(self):
+        with contextlib.suppress(sqlite3.Error):
+            if self.conn.in_transaction:
+                self.conn.execute("ROLLBACK")
+        self.conn.close()
+
+
+class SqliteIndex:
+    """The index as ``index.sqlite`` in the archive folder (the default: one machine)."""
+
+    kind = "sqlite"
+
+    def __init__(self, root):
+        self.path = Path(root) / INDEX
+        self.label = display(self.path)
+
+    def exists(self):
+        return self.path.exists()
+
+    def _connect(self):
+        try:
+            conn = sqlite3.connect(self.path, timeout=LOCK_WAIT, isolation_level=None)
+            conn.row_factory = sqlite3.Row
+            _prepare(conn)
+        except sqlite3.Error as exc:
+            raise ArchiveError(f"{self.label}: cannot be used ({exc}), expected the archive's "
+                               "SQLite index") from None
+        return conn
+
+    def write(self):
+        """Begin a write transaction, holding the write lock: one writer at a time."""
+        conn = self._connect()
+        try:
+            conn.execute("BEGIN IMMEDIATE")
+        except sqlite3.Error as exc:
+            conn.close()
+            raise ArchiveError(f"{self.label}: cannot be used ({exc})") from None
+        return _SqliteSession(conn, self.label)
+
+    def rows(self, shot=None, since=None, order="created, shot, version"):
+        """The entries' rows as dicts, filtered by shot and creation date."""
+        if not self.exists():
+            return []
+        conn = self._connect()
+        try:
+            sql, args = "SELECT * FROM entries WHERE 1=1", []
+            if shot:
+                sql += " AND shot = ?"
+                args.append(shot)
+            if since:
+                sql += " AND created >= ?"
+                args.append(since)
+            return [dict(r) for r in conn.execute(f"{sql} ORDER BY {order}", args)]
+        except sqlite3.Error as exc:
+            raise ArchiveError(f"{self.label}: cannot be read ({exc})") from None
+        finally:
+            conn.close()
+
+    def problems(self):
+        """What the index's own check finds (empty when sound)."""
+        conn = self._connect()
+        try:
+            check = conn.execute("PRAGMA integrity_check").fetchone()[0]
+        except sqlite3.Error as exc:
+            return [f"{INDEX}: cannot be read ({exc})"]
+        finally:
+            conn.close()
+        return [] if check == "ok" else [f"{INDEX}: {check}"]
+
+    def count(self):
+        """Entries indexed, counted under the write lock (no writer is committing)."""
+        conn = sqlite3.connect(self.path, timeout=5, isolation_level=None)
+        try:
+            conn.execute("BEGIN IMMEDIATE")
+            rows = conn.execute("SELECT COUNT(*) FROM entries").fetchone()[0]
+            conn.execute("ROLLBACK")
+        finally:
+            conn.close()
+        return int(rows)
+
+    def files(self):
+        """The index's own files in the archive folder."""
+        return {INDEX, f"{INDEX}-wal", f"{INDEX}-shm", f"{INDEX}-journal"}
+
+    def writer_gone(self, owner):
+        """Whether a scratch folder's writer is gone: this host's process table says."""
+        from ..transaction import owner_alive
+
+        return not owner_alive(owner)
+
+    def hold(self, owner):
+        """Nothing to hold: this host's process table shows the writer's process."""
+        return None
+
+
+# -- PostgreSQL --------------------------------------------------------------------------------
+
+def _psycopg():
+    try:
+        import psycopg
+    except ImportError:
+        raise ArchiveError("the archive's index is on a PostgreSQL server, and psycopg is not "
+                           "installed; expected pip install 'airgun-xl[server]'") from None
+    return psycopg
+
+
+def server_address(given=None, where="--index"):
+    """The server's address, checked: the given one, else ``$AIRGUN_XL_INDEX``, else libpq's
+    own defaults (``PGHOST``, ``PGSERVICE`` and the service file). A password in it is
+    refused, without repeating it: the command line is recorded in provenance and shown by
+    ``ps``; it belongs in ``~/.pgpass`` or ``$PGPASSWORD``.
+
+    Raises
+    ------
+    airgun_xl.errors.OptionError
+    """
+    text = given if given is not None else os.environ.get(INDEX_ENV)
+    if text is None:
+        return "", "libpq's defaults"
+    source = where if given is not None else f"${INDEX_ENV}"
+    text = str(text).strip()
+    if not text.startswith(("postgresql://", "postgres://")) and "=" not in text:
+        raise OptionError(f"{source}: found an address that is neither a postgresql:// URL "
+                          "nor key=value pairs; expected postgresql://HOST[:PORT]/DATABASE")
+    from psycopg.conninfo import conninfo_to_dict
+
+    try:
+        parts = conninfo_to_dict(text)
+    except Exception:
+        raise OptionError(f"{source}: found an address libpq cannot read; expected "
+                          "postgresql://HOST[:PORT]/DATABASE") from None
+    if parts.get("password") not in (None, ""):
+        raise OptionError(f"{source}: found a password in the address (not repeated here); "
+                          "expected it in ~/.pgpass or $PGPASSWORD, since the command line is "
+                          "recorded with every entry and shown by ps")
+    return text, _shown_address(parts)
+
+
+def _shown_address(parts):
+    """An address as messages show it: host, port and database, never more."""
+    host = parts.get("host") or parts.get("hostaddr") or "localhost"
+    if str(host).startswith("/"):
+        host = "socket"
+    port = f":{parts['port']}" if parts.get("port") else ""
+    return f"{host}{port}/{parts.get('dbname') or parts.get('service') or ''}"
+
+
+def _owner_key(owner):
+    """The advisory lock that a live writer holds for its owner token (64-bit)."""
+    return int.from_bytes(hashlib.sha256(f"airgun-xl:{owner}".encode()).digest()[:8], "big",
+                          signed=True)
+
+
+class _ServerSession(Session):
+    def __init__(self, conn, identity, label):
+        self.conn, self.identity, self.label = conn, identity, label
+
+    def _run(self, sql, args=()):
+        psycopg = _psycopg()
+        try:
+            return self.conn.execute(sql, args)
+        except psycopg.Error as exc:
+            raise ArchiveError(f"{self.label}: {_reason(exc)}") from None
+
+    def paths(self):
+        return {r[0] for r in self._run(
+            f"SELECT path FROM {SERVER_SCHEMA}.entries WHERE archive = %s", (self.identity,))}
+
+    def last_version(self, shot):
+        row = self._run(f"SELECT MAX(version) FROM {SERVER_SCHEMA}.entries WHERE archive = %s "
+                        "AND shot = %s", (self.identity, shot)).fetchone()
+        return int(row[0] or 0)
+
+    def insert(self, row):
+        psycopg = _psycopg()
+        try:
+            with self.conn.transaction():  # a savepoint: a clash leaves the rest standing
+                self.conn.execute(
+                    f"INSERT INTO {SERVER_SCHEMA}.entries (archive, {', '.join(COLUMNS)}) "
+                    f"VALUES (%s, {', '.join(['%s'] * len(COLUMNS))})",
+                    (self.identity, *(row.get(c) for c in COLUMNS)))
+        except psycopg.errors.UniqueViolation:
+            return False
+        except psycopg.Error as exc:
+            raise ArchiveError(f"{self.label}: {_reason(exc)}") from None
+        return True
+
+    def commit(self):
+        psycopg = _psycopg()
+        try:
+            self.conn.commit()
+        except psycopg.Error as exc:
+            raise ArchiveError(f"{self.label}: the entry's row cannot be committed "
+                               f"({_reason(exc)})") from None
+
+    def close(self):
+        with contextlib.suppress(Exception):
+            self.conn.rollback()
+        with contextlib.suppress(Exception):
+            self.conn.close()
+
+
+def _reason(exc):
+    """A server error in words, on one line (libpq's message; never the address's secrets,
+    which libpq does not repeat)."""
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text[:300]
+
+
+class ServerIndex:
+    """The index as tables on a PostgreSQL server (schema :data:`SERVER_SCHEMA`).
+
+    Parameters
+    ----------
+    root : path
+        The archive folder (its entries stay there, on the share).
+    identity : str
+        The archive's identity, from its marker: 32 hexadecimal digits.
+    address : str, optional
+        The server's address (checked by :func:`server_address`); None for
+        ``$AIRGUN_XL_INDEX`` or libpq's defaults.
+    """
+
+    kind = "server"
+
+    def __init__(self, root, identity, address=None, where="--index"):
+        self.root = Path(root)
+        self.identity = identity
+        self.address, self.shown = server_address(address, where)
+        self.label = f"the archive's index on {self.shown}"
+        self._holder = None
+
+    def _connect(self, check=True):
+        psycopg = _psycopg()
+        try:
+            conn = psycopg.connect(
+                self.address, connect_timeout=10, application_name="airgun-xl",
+                options=f"-c statement_timeout={STATEMENT_TIMEOUT * 1000} "
+                        f"-c lock_timeout={LOCK_WAIT * 1000} -c idle_in_transaction_session_"
+                        f"timeout={(LOCK_WAIT + STATEMENT_TIMEOUT) * 1000}")
+        except psycopg.Error as exc:
+            raise ArchiveError(f"{self.label}: cannot be reached ({_reason(exc)}); expected a "
+                               f"PostgreSQL server at ${INDEX_ENV}, --index or libpq's "
+                               "defaults") from None
+        if check:
+            try:
+                row = conn.execute(f"SELECT format FROM {SERVER_SCHEMA}.archives WHERE "
+                                   "identity = %s", (self.identity,)).fetchone()
+            except psycopg.Error:
+                conn.close()
+                row = None
+            if row is None:
+                with contextlib.suppress(Exception):
+                    conn.close()
+                raise ArchiveError(f"{display(self.root)}: its marker names archive "
+                                   f"{self.identity}, which {self.label} does not hold; "
+                                   "expected the server the archive was made on (check "
+                                   f"${INDEX_ENV})")
+            conn.rollback()
+        return conn
+
+    def create(self):
+        """Make the schema (if the role may) and this archive's row."""
+        import datetime
+
+        psycopg = _psycopg()
+        conn = self._connect(check=False)
+        try:
+            for sql in SERVER_TABLES:
+                if sql.startswith("CREATE SCHEMA"):
+                    exists = conn.execute("SELECT 1 FROM pg_namespace WHERE nspname = %s",
+                                          (SERVER_SCHEMA,)).fetchone()
+                    if exists:
+                        continue
+                conn.execute(sql)
+            created = datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")
+            conn.execute(f"INSERT INTO {SERVER_SCHEMA}.archives (identity, created, format) "
+                         "VALUES (%s, %s, 1)", (self.identity, created))
+            conn.commit()
+        except psycopg.Error as exc:
+            raise ArchiveError(f"{self.label}: cannot hold a new archive ({_reason(exc)}); "
+                               f"expected a role that owns schema {SERVER_SCHEMA} or may "
+                               "create it (README, 'A shared archive')") from None
+        finally:
+            conn.close()
+
+    def exists(self):
+        return True
+
+    def write(self):
+        conn = self._connect()
+        session = _ServerSession(conn, self.identity, self.label)
+        try:
+            session._run(f"SELECT identity FROM {SERVER_SCHEMA}.archives WHERE identity = %s "
+                         "FOR UPDATE", (self.identity,))  # the write lock: one writer at a time
+        except BaseException:
+            session.close()
+            raise
+        return session
+
+    def rows(self, shot=None, since=None, order="created, shot, version"):
+        psycopg = _psycopg()
+        from psycopg.rows import dict_row
+
+        conn = self._connect()
+        try:
+            sql = (f"SELECT id, {', '.join(COLUMNS)} FROM {SERVER_SCHEMA}.entries "
+                   "WHERE archive = %s")
+            args: list[Any] = [self.identity]
+            if shot:
+                sql += " AND shot = %s"
+                args.append(shot)
+            if since:
+                sql += " AND created >= %s"
+                args.append(since)
+            with conn.cursor(row_factory=dict_row) as cur:
+                return list(cur.execute(f"{sql} ORDER BY {order}", args).fetchall())
+        except psycopg.Error as exc:
+            raise ArchiveError(f"{self.label}: cannot be read ({_reason(exc)})") from None
+        finally:
+            conn.close()
+
+    def problems(self):
+        return []  # the server keeps its own pages whole
+
+    def count(self):
+        return len(self.rows())
+
+    def files(self):
+        return set()
+
+    def hold(self, owner):
+        """Hold, for as long as this process writes, the advisory lock that says its owner
+        token is alive: another host asks the server, not its own process table."""
+        if self._holder is None:
+            conn = self._connect()
+            conn.autocommit = True
+            conn.execute("SELECT pg_advisory_lock(%s)", (_owner_key(owner),))
+            self._holder = conn
+        return self._holder
+
+    def release_hold(self):
+        if self._holder is not None:
+            with contextlib.suppress(Exception):
+                self._holder.close()
+            self._holder = None
+
+    def writer_gone(self, owner):
+        """Whether a scratch folder's writer is gone: its advisory lock is free on the server
+        (the server drops a session's locks when its process dies, on any host)."""
+        from ..transaction import owner_alive
+        from ..transaction.owners import host_tag, owner_host
+
+        host = owner_host(owner)
+        if host is None or host == host_tag():
+            if owner_alive(owner):
+                return False
+        conn = self._connect()
+        try:
+            conn.autocommit = True
+            key = _owner_key(owner)
+            free = conn.execute("SELECT pg_try_advisory_lock(%s)", (key,)).fetchone()[0]
+            if free:
+                conn.execute("SELECT pg_advisory_unlock(%s)", (key,))
+            return bool(free)
+        finally:
+            conn.close()
