@@ -238,6 +238,75 @@ def test_an_unreachable_server_or_a_wrong_password_is_one_line_and_publishes_not
         (root / ".airgun-xl-scratch").iterdir())
 
 
+def _history_rows(root, capsys):
+    assert main(["history", "--archive", str(root), "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_migrate_moves_the_index_and_history_reads_the_same(tmp_path, capsys, server_env):
+    """An SQLite archive of three runs moved to the server: history is the same, ids
+    included; the SQLite index is kept as a backup; the next fill goes to the server."""
+    root = tmp_path / "local"
+    for extra in ([], ["--integrator", "newmark"], ["--name", "other"]):
+        assert main(["fill", str(TEMPLATE), "-o", str(tmp_path / "o.xlsx"), "--force",
+                     "--archive", str(root), "--only", "summary", *extra]) == 0
+    capsys.readouterr()
+    before = _history_rows(root, capsys)
+    assert main(["archive", "migrate", str(root)]) == 0
+    out = capsys.readouterr().out
+    assert "(3 entries) to 127.0.0.1:" in out and "kept as .index.sqlite.moved-" in out
+    assert _history_rows(root, capsys) == before
+    marker = json.loads((root / MARKER).read_text())
+    assert marker["index"] == "server" and not (root / "index.sqlite").exists()
+    assert [p.name for p in root.iterdir() if p.name.startswith(".index.sqlite.moved-")]
+    assert main(["fill", str(TEMPLATE), "-o", str(tmp_path / "o.xlsx"), "--force",
+                 "--archive", str(root), "--only", "summary"]) == 0
+    capsys.readouterr()
+    after = _history_rows(root, capsys)
+    assert len(after) == 4 and after[-1]["shot"] == "shot_a" and after[-1]["version"] == 3
+    assert main(["archive", "verify", str(root)]) == 0
+    assert "4 entries, 0 problems" in capsys.readouterr().out
+    assert main(["archive", "migrate", str(root)]) == 2
+    assert "its index is on a server already" in _one_line(capsys)
+
+
+def test_migrate_refuses_a_row_that_does_not_match_its_manifest_and_moves_nothing(
+        tmp_path, capsys, server_env):
+    root = tmp_path / "local"
+    archive = Archive(root, create=True)
+    note = tmp_path / "n.txt"
+    note.write_text("x")
+    archive.add("a", {"n.txt": note}, {}, {})
+    archive.add("b", {"n.txt": note}, {}, {})
+    (root / "b" / "v0001" / "n.txt").write_text("altered")
+    marker = (root / MARKER).read_text()
+    assert main(["archive", "migrate", str(root)]) == 2
+    line = _one_line(capsys)
+    assert "1 of 2 rows do not match their entry's manifest (the first: b@1)" in line
+    assert (root / MARKER).read_text() == marker and (root / "index.sqlite").is_file()
+
+
+def test_a_writer_that_waited_on_the_lock_through_a_migrate_stops_and_publishes_nothing(
+        tmp_path, server_env):
+    """Writers are kept out: one that held its scratch folder and waited for the SQLite lock
+    while the index moved finds the marker changed, stops in one line, and leaves nothing."""
+    from airgun_xl.errors import ArchiveError
+
+    root = tmp_path / "local"
+    archive = Archive(root, create=True)
+    archive.add("a", {}, {"summary.json": {}}, {})
+    pending = archive.prepare("a", {}, {"summary.json": {"late": True}}, {})
+    Archive(root).migrate()
+    with pytest.raises(ArchiveError, match="its index was moved to a server while this "
+                                           "writer waited"):
+        try:
+            pending.prepare()
+        finally:
+            pending.release()
+    assert not any((root / ".airgun-xl-scratch").iterdir())
+    assert [e.ref for e in Archive(root).entries()] == ["a@1"]
+
+
 from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 

@@ -56,7 +56,8 @@ CREATE TABLE IF NOT EXISTS entries (
 )"""
 
 #: The server's schema: the role needs the rights of this schema only (README, "A shared
-#: archive"). One schema holds any number of archives, each its own row in ``archives``.
+#: archive"). One schema holds any number of archives, each its own row in ``archives``; an
+#: entry's id counts within its archive, as in SQLite (``#3`` is the same entry after a move).
 SERVER_SCHEMA = "airgun_xl"
 SERVER_TABLES = (
     f"CREATE SCHEMA IF NOT EXISTS {SERVER_SCHEMA}",
@@ -65,8 +66,8 @@ SERVER_TABLES = (
         created TEXT NOT NULL,
         format INTEGER NOT NULL)""",
     f"""CREATE TABLE IF NOT EXISTS {SERVER_SCHEMA}.entries (
-        id BIGSERIAL PRIMARY KEY,
         archive TEXT NOT NULL REFERENCES {SERVER_SCHEMA}.archives (identity),
+        id BIGINT NOT NULL,
         shot TEXT NOT NULL,
         version INTEGER NOT NULL,
         path TEXT NOT NULL,
@@ -75,6 +76,7 @@ SERVER_TABLES = (
         v0 DOUBLE PRECISION, delta DOUBLE PRECISION, max_time DOUBLE PRECISION,
         sigmay DOUBLE PRECISION, rcone DOUBLE PRECISION, peak_kg DOUBLE PRECISION,
         integrator TEXT, model TEXT, engine TEXT,
+        PRIMARY KEY (archive, id),
         UNIQUE (archive, shot, version))""",
 )
 
@@ -158,6 +160,11 @@ class _SqliteSession(Session):
             return False
         return True
 
+    def all_rows(self):
+        """Every row, read under the write lock (archive migrate)."""
+        self.conn.row_factory = sqlite3.Row
+        return [dict(r) for r in self.conn.execute("SELECT * FROM entries ORDER BY id")]
+
     def commit(self):
         try:
             self.conn.execute("COMMIT")
@@ -179,7 +186,7 @@ class SqliteIndex:
 
     def __init__(self, root):
         self.path = Path(root) / INDEX
-        self.label = display(self.path)
+        self.label = self.shown = display(self.path)
 
     def exists(self):
         return self.path.exists()
@@ -342,10 +349,11 @@ class _ServerSession(Session):
         psycopg = _psycopg()
         try:
             with self.conn.transaction():  # a savepoint: a clash leaves the rest standing
-                self.conn.execute(
-                    f"INSERT INTO {SERVER_SCHEMA}.entries (archive, {', '.join(COLUMNS)}) "
-                    f"VALUES (%s, {', '.join(['%s'] * len(COLUMNS))})",
-                    (self.identity, *(row.get(c) for c in COLUMNS)))
+                self.conn.execute(  # the next id of this archive, under its write lock
+                    f"INSERT INTO {SERVER_SCHEMA}.entries (archive, id, {', '.join(COLUMNS)}) "
+                    f"SELECT %s, COALESCE(MAX(id), 0) + 1, {', '.join(['%s'] * len(COLUMNS))} "
+                    f"FROM {SERVER_SCHEMA}.entries WHERE archive = %s",
+                    (self.identity, *(row.get(c) for c in COLUMNS), self.identity))
         except psycopg.errors.UniqueViolation:
             return False
         except psycopg.Error as exc:
@@ -426,8 +434,9 @@ class ServerIndex:
             conn.rollback()
         return conn
 
-    def create(self):
-        """Make the schema (if the role may) and this archive's row."""
+    def create(self, rows=()):
+        """Make the schema (if the role may), this archive's row and ``rows`` (an index
+        moved from SQLite, their ids kept apart), in one transaction."""
         import datetime
 
         psycopg = _psycopg()
@@ -443,6 +452,12 @@ class ServerIndex:
             created = datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")
             conn.execute(f"INSERT INTO {SERVER_SCHEMA}.archives (identity, created, format) "
                          "VALUES (%s, %s, 1)", (self.identity, created))
+            with conn.cursor() as cur:
+                cur.executemany(
+                    f"INSERT INTO {SERVER_SCHEMA}.entries (archive, id, {', '.join(COLUMNS)}) "
+                    f"VALUES (%s, %s, {', '.join(['%s'] * len(COLUMNS))})",
+                    [(self.identity, row["id"], *(row.get(c) for c in COLUMNS))
+                     for row in rows])
             conn.commit()
         except psycopg.Error as exc:
             raise ArchiveError(f"{self.label}: cannot hold a new archive ({_reason(exc)}); "

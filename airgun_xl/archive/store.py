@@ -279,6 +279,79 @@ class Archive:
             raise ArchiveError(f"{shown}: cannot be written ({exc.strerror})") from None
         return cls(root)
 
+    def migrate(self, index=None):
+        """Move this archive's SQLite index to a PostgreSQL server at ``index`` (else
+        ``$AIRGUN_XL_INDEX`` or libpq's defaults); return the backup the SQLite index was
+        renamed to.
+
+        Writers are kept out throughout: the SQLite write lock is held from the first read
+        to the new marker, and a writer that waited on it finds the marker changed and stops
+        (:meth:`PendingEntry.prepare`). Every row is verified against its entry's manifest
+        first (any mismatch refuses the move, changing nothing); the rows reach the server in
+        one transaction; the marker then names the server's archive, and only then is the
+        SQLite index renamed, kept as a backup.
+
+        Raises
+        ------
+        airgun_xl.errors.ArchiveError
+        """
+        if self.index.kind != "sqlite":
+            raise ArchiveError(f"{display(self.root)}: its index is on a server already, "
+                               "expected an archive whose index is index.sqlite")
+        if not self.index.exists():
+            raise ArchiveError(f"{display(self.root)}: has no {INDEX} to move, expected an "
+                               "archive written by airgun-xl fill --archive")
+        server = ServerIndex(self.root, uuid.uuid4().hex, index)  # checked before the lock
+        session = self.index.write()
+        try:
+            self._recover(session)
+            rows = session.all_rows()
+            wrong = [r for r in rows if not self._matches_manifest(r)]
+            if wrong:
+                r = wrong[0]
+                raise ArchiveError(f"{display(self.root)}: {len(wrong)} of {len(rows)} rows do "
+                                   f"not match their entry's manifest (the first: "
+                                   f"{r['shot']}@{r['version']}); expected a clean archive "
+                                   "(see airgun-xl archive verify); nothing was moved")
+            server.create(rows)
+            marker = {"format": FORMAT, "tool": "airgun-xl", "index": "server",
+                      "identity": server.identity}
+            temp = self.root / f".{MARKER}.{owner_token()}.tmp"
+            with open(temp, "w") as fh:
+                json.dump(marker, fh)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.replace(temp, self.root / MARKER)  # from here on, writers use the server
+            fsync(self.root, directory=True)
+        finally:
+            session.close()
+        stamp = datetime.datetime.now(datetime.UTC).strftime("%Y%m%dT%H%M%SZ")
+        backup = self.root / f".{INDEX}.moved-{stamp}"
+        for suffix in ("", "-wal", "-shm"):
+            with contextlib.suppress(FileNotFoundError):
+                os.rename(self.root / f"{INDEX}{suffix}", self.root / f"{backup.name}{suffix}")
+        self.index = server
+        return backup
+
+    def _moved(self):
+        """Whether the marker now says the index is on a server (a migrate finished while
+        this writer waited on the SQLite lock)."""
+        try:
+            return read_marker(self.root)["index"] == "server"
+        except ArchiveError:
+            return False
+
+    def _matches_manifest(self, row):
+        """Whether an index row is its entry's: the folder is ``<shot>/vNNNN``, its manifest
+        names this shot and version, and every file hashes as listed."""
+        entry = self._entry(row)
+        if entry is None or not entry.path.is_dir():
+            return False
+        manifest = _read_manifest(entry.path)
+        return (manifest is not None and manifest["index"]["shot"] == row["shot"]
+                and manifest["index"]["version"] == row["version"]
+                and self._complete(entry.path, manifest))
+
     def remove_if_unused(self):
         """Undo the creation of a new archive whose first entry was never committed (a failed
         or interrupted fill): remove its empty index, marker and empty scratch folder, then
@@ -521,6 +594,10 @@ class PendingEntry:
         """Lock the index, recover, pick the version; return the path of the manifest that
         names ``txn`` once the entry is committed."""
         self.conn = self.archive.index.write()  # the write lock: one writer at a time
+        if self.archive.index.kind == "sqlite" and self.archive._moved():
+            raise ArchiveError(f"{display(self.archive.root)}: its index was moved to a server "
+                               "while this writer waited (archive migrate); expected the same "
+                               "command run again")
         self.archive._recover(self.conn)
         version = self.archive._next_version(self.conn, self.shot)
         self.manifest["index"]["version"] = version

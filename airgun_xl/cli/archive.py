@@ -50,16 +50,20 @@ def add_parser(sub):
                    help="also write a workbook: the input cells that differ and the error table")
     add_force(c, "REPORT.xlsx")
     c.set_defaults(run=run_compare)
-    a = sub.add_parser("archive", help="archive maintenance: init, verify",
+    a = sub.add_parser("archive", help="archive maintenance: init, migrate, verify",
                        description=f"init: make a new archive in a new or empty folder, its "
                                    f"index in the folder (SQLite, one machine) or, with "
                                    f"--index, on a PostgreSQL server (a lab's share written by "
-                                   f"several hosts). verify: finish what killed writers left, "
+                                   f"several hosts). migrate: move an archive's SQLite index to "
+                                   f"such a server, writers kept out, every row verified "
+                                   f"against its manifest, the SQLite index kept as a backup. "
+                                   f"verify: finish what killed writers left, "
                                    f"re-hash every file of every entry, and list anything "
                                    f"missing, altered or out of place. Exit 0 clean, 1 with "
                                    f"problems. {where}")
-    a.add_argument("action", choices=["init", "verify"],
-                   help="init: make a new archive; verify: check one")
+    a.add_argument("action", choices=["init", "migrate", "verify"],
+                   help="init: make a new archive; migrate: move an archive's SQLite index to "
+                        "the --index server; verify: check one")
     a.add_argument("dir", nargs="?", metavar="DIR", help="the archive folder")
     a.add_argument("--index", metavar="postgresql://HOST/DB",
                    help=f"the PostgreSQL server of the archive's index (default "
@@ -363,7 +367,19 @@ def _history_archive(args):
 def run_archive(args):
     if args.action == "init":
         return run_init(args)
+    if args.action == "migrate":
+        return run_migrate(args)
     return run_verify(args)
+
+
+def run_migrate(args):
+    """Move an archive's SQLite index to a server, writers kept out, every row verified."""
+    archive = Archive(archive_dir(args.dir))
+    before = len(archive.entries())
+    backup = archive.migrate(args.index)
+    print(f"moved the index of {display(archive.root)} ({_count(before, 'entry', 'entries')}) "
+          f"to {archive.index.shown}; the SQLite index is kept as {backup.name}")
+    return 0
 
 
 def run_init(args):
