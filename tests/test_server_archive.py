@@ -6,11 +6,14 @@ install.
 Covered here: ``archive init --index``, the marker (an identity, never an address), a password
 in the address refused unrepeated, fill/history/show/verify unchanged on a server archive
 (history equal to the SQLite archive's), 4 processes x 25 entries at once, two hosts sharing a
-scratch folder, psycopg missing, a marker naming an archive the server does not hold, and the
-server unreachable or the password wrong (one line, exit 2, nothing published).
+scratch folder, psycopg missing, a marker naming an archive the server does not hold,
+``archive migrate``, and the faults (one line, exit 2, nothing published): the server
+unreachable, the password wrong, the server stopped mid-campaign, a lock wait past its
+timeout, the share turning read-only.
 """
 import json
 import os
+import re
 import subprocess
 import sys
 import textwrap
@@ -305,6 +308,109 @@ def test_a_writer_that_waited_on_the_lock_through_a_migrate_stops_and_publishes_
             pending.release()
     assert not any((root / ".airgun-xl-scratch").iterdir())
     assert [e.ref for e in Archive(root).entries()] == ["a@1"]
+
+
+def _server_rows(server, root):
+    """Entries the server holds for the archive at ``root`` (read as the superuser)."""
+    import psycopg
+
+    identity = json.loads((root / MARKER).read_text())["identity"]
+    with psycopg.connect(server.admin.replace("dbname=postgres", "dbname=lab")) as conn:
+        return conn.execute(f"SELECT shot, version FROM {SERVER_SCHEMA}.entries WHERE "
+                            "archive = %s ORDER BY shot, version", (identity,)).fetchall()
+
+
+def test_the_server_stopped_mid_campaign_names_the_shots_not_archived_and_a_rerun_ends_it(
+        tmp_path, capsys, server_env):
+    """pg_ctl stop -m immediate while a campaign archives: the shots it could not archive are
+    named, each in one line, with exit 2, and their workbooks are not published; once the
+    server is back, a second run fills and archives only those: no duplicate, no loss."""
+    import time
+
+    from conftest import template_with
+
+    root = _init(tmp_path, capsys)
+    day = tmp_path / "day"
+    day.mkdir()
+    for k in range(8):
+        template_with(day, A28=150.0 + 5 * k, A29=150.0 + 5 * k,
+                      A30=150.0 + 5 * k).rename(day / f"s{k}.xlsx")
+    proc = subprocess.Popen([sys.executable, "-m", "airgun_xl", "fill", str(day), "--jobs", "2",
+                             "--archive", str(root), "--only", "summary"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+    deadline = time.monotonic() + 120
+    try:
+        while not _server_rows(server_env, root):  # polled: the first shot archived
+            assert proc.poll() is None and time.monotonic() < deadline
+            time.sleep(0.01)
+        server_env.stop("immediate")
+        out, err = proc.communicate(timeout=300)
+    finally:
+        server_env.start()
+    assert proc.returncode == 2, (out, err)
+    assert "Traceback" not in err
+    failed = sorted(set(re.findall(r"(s\d)\.xlsx: .*cannot be reached|(s\d)\.xlsx: .*"
+                                   r"terminat", err + out)) - {("", "")})
+    published = sorted(p.name for p in day.glob("s?.out.xlsx"))
+    archived = sorted(shot for shot, _ in _server_rows(server_env, root))
+    assert failed and len(published) + len(failed) == 8, (out, err)
+    assert [n.replace(".out.xlsx", "") for n in published] == archived  # published = archived
+    proc2 = subprocess.run([sys.executable, "-m", "airgun_xl", "fill", str(day), "--jobs", "2",
+                            "--archive", str(root), "--only", "summary"],
+                           capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert proc2.returncode == 0, proc2.stderr
+    rows = _server_rows(server_env, root)
+    assert sorted(shot for shot, _ in rows) == [f"s{k}" for k in range(8)]  # once each
+    assert all(version == 1 for _, version in rows)
+    assert Archive(root).verify() == []
+
+
+def test_a_statement_that_times_out_is_one_line_and_publishes_nothing(tmp_path, capsys,
+                                                                       server_env,
+                                                                       monkeypatch):
+    """Another session holds the entries table: the writer's wait ends at the lock timeout
+    (1 s here, 120 s as shipped) in one line, exit 2; no workbook, no row, no scratch."""
+    import psycopg
+
+    from airgun_xl.archive import index
+
+    root = _init(tmp_path, capsys)
+    monkeypatch.setattr(index, "LOCK_WAIT", 1)
+    monkeypatch.setattr(index, "STATEMENT_TIMEOUT", 1)
+    out = tmp_path / "o.xlsx"
+    with psycopg.connect(server_env.admin.replace("dbname=postgres", "dbname=lab")) as conn:
+        conn.execute(f"LOCK TABLE {SERVER_SCHEMA}.entries IN ACCESS EXCLUSIVE MODE")
+        code = main(["fill", str(TEMPLATE), "-o", str(out), "--archive", str(root),
+                     "--only", "summary"])
+        line = _one_line(capsys)
+        conn.rollback()
+    assert code == 2 and "timeout" in line, line
+    assert not out.exists() and _server_rows(server_env, root) == []
+    assert not any((root / ".airgun-xl-scratch").iterdir())
+
+
+@pytest.mark.parametrize("stage", ["scratch", "rename"])
+def test_a_share_that_turns_read_only_is_one_line_and_publishes_nothing(
+        tmp_path, capsys, server_env, monkeypatch, stage):
+    """EROFS, injected (root ignores permissions): when the scratch folder is made, or when
+    the entry is renamed into place. One line, exit 2; no workbook, no row."""
+    import errno
+
+    root = _init(tmp_path, capsys)
+    real = os.mkdir if stage == "scratch" else os.rename
+
+    def read_only(src, *args, **kwargs):
+        if ".airgun-xl-scratch" in str(src):
+            raise OSError(errno.EROFS, os.strerror(errno.EROFS), str(src))
+        return real(src, *args, **kwargs)
+
+    monkeypatch.setattr(os, "mkdir" if stage == "scratch" else "rename", read_only)
+    out = tmp_path / "o.xlsx"
+    code = main(["fill", str(TEMPLATE), "-o", str(out), "--archive", str(root),
+                 "--only", "summary"])
+    line = _one_line(capsys)
+    assert code == 2 and "Read-only file system" in line, line
+    assert not out.exists() and _server_rows(server_env, root) == []
 
 
 from hypothesis import given, settings  # noqa: E402
