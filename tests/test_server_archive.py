@@ -413,6 +413,64 @@ def test_a_share_that_turns_read_only_is_one_line_and_publishes_nothing(
     assert not out.exists() and _server_rows(server_env, root) == []
 
 
+KILLED_AT = textwrap.dedent("""
+    import os, signal, sys
+    from pathlib import Path
+    from airgun_xl.archive import Archive, index, store
+
+    root, stage = Path(sys.argv[1]), sys.argv[2]
+
+    def die(*args, **kwargs):
+        os.kill(os.getpid(), signal.SIGKILL)
+
+    def after(original):
+        def wrapped(*args, **kwargs):
+            result = original(*args, **kwargs)
+            die()
+            return result
+        return wrapped
+
+    if stage == "scratch":  # files written and synced, nothing asked of the server
+        store.PendingEntry.prepare = die
+    elif stage == "locked":  # the write lock held on the server, the version chosen
+        store.Archive._next_version = after(store.Archive._next_version)
+    elif stage == "renamed":  # the folder in place, its row not inserted
+        index._ServerSession.insert = die
+    elif stage == "inserted":  # the row inserted, not committed
+        index._ServerSession.commit = die
+    elif stage == "committed":  # the row committed, the scratch lock still held
+        store.PendingEntry.commit = after(store.PendingEntry.commit)
+    Archive(root).add("s", {}, {"summary.json": {"stage": float(sys.argv[3])}}, {"v0": 1.0})
+""")
+
+STAGES = ("scratch", "locked", "renamed", "inserted", "committed")
+
+
+@pytest.mark.parametrize("stage, kept", [("scratch", False), ("locked", False),
+                                         ("renamed", True), ("inserted", True),
+                                         ("committed", True)])
+def test_a_sigkill_at_each_stage_of_a_publication_leaves_nothing_the_next_writer_cannot_recover(
+        tmp_path, capsys, server_env, stage, kept):
+    """The writer SIGKILLed at each stage: the server rolls back its transaction and frees its
+    locks when the session ends; the next writer removes the dead writer's scratch folder (the
+    server says it is gone) and adopts a folder renamed into place from its manifest. The
+    entry is whole or absent, and the next entry takes the next version."""
+    root = _init(tmp_path, capsys)
+    Archive(root).add("s", {}, {"summary.json": {"first": True}}, {})
+    proc = subprocess.run([sys.executable, "-c", KILLED_AT, str(root), stage,
+                           str(STAGES.index(stage))], cwd=ROOT, capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == -9, proc.stderr
+    Archive(root).add("s", {}, {"summary.json": {"after": True}}, {})
+    assert Archive(root).verify() == []
+    versions = [e.version for e in Archive(root).entries("s")]
+    assert versions == ([1, 2, 3] if kept else [1, 2])
+    assert not any((root / ".airgun-xl-scratch").iterdir())
+    if kept:
+        assert Archive(root).get("s@2").load("summary.json") == {
+            "stage": float(STAGES.index(stage))}
+
+
 from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
