@@ -256,6 +256,9 @@ class SqliteIndex:
         """The index's own files in the archive folder."""
         return {INDEX, f"{INDEX}-wal", f"{INDEX}-shm", f"{INDEX}-journal"}
 
+    def close(self):
+        """Nothing to close: each use opens and closes its own connection."""
+
     def writer_gone(self, owner):
         """Whether a scratch folder's writer is gone: this host's process table says."""
         from ..transaction import owner_alive
@@ -269,7 +272,30 @@ class SqliteIndex:
 
 # -- PostgreSQL --------------------------------------------------------------------------------
 
+_WARMING: list = []
+
+
+def warm_server_driver():
+    """Import psycopg on a daemon thread, once a process, while the run goes on: its import
+    (about 0.1 s) then costs a server archive's fill nothing it would notice."""
+    import threading
+
+    if _WARMING:
+        return
+
+    def load():
+        with contextlib.suppress(Exception):
+            import psycopg  # noqa: F401
+            import psycopg.rows  # noqa: F401
+
+    thread = threading.Thread(target=load, name="airgun-xl-psycopg", daemon=True)
+    _WARMING.append(thread)
+    thread.start()
+
+
 def _psycopg():
+    for thread in _WARMING:
+        thread.join()
     try:
         import psycopg
     except ImportError:
@@ -296,6 +322,7 @@ def server_address(given=None, where="--index"):
     if not text.startswith(("postgresql://", "postgres://")) and "=" not in text:
         raise OptionError(f"{source}: found an address that is neither a postgresql:// URL "
                           "nor key=value pairs; expected postgresql://HOST[:PORT]/DATABASE")
+    _psycopg()  # the driver, whole (a warming import finished first)
     from psycopg.conninfo import conninfo_to_dict
 
     try:
@@ -326,8 +353,11 @@ def _owner_key(owner):
 
 
 class _ServerSession(Session):
-    def __init__(self, conn, identity, label):
-        self.conn, self.identity, self.label = conn, identity, label
+    """A write transaction on the index's one connection (closing it rolls back what was not
+    committed; the connection, and the writer's session lock, stay)."""
+
+    def __init__(self, conn, identity, label, index):
+        self.conn, self.identity, self.label, self.index = conn, identity, label, index
 
     def _run(self, sql, args=()):
         psycopg = _psycopg()
@@ -369,10 +399,12 @@ class _ServerSession(Session):
                                f"({_reason(exc)})") from None
 
     def close(self):
-        with contextlib.suppress(Exception):
+        try:
             self.conn.rollback()
-        with contextlib.suppress(Exception):
-            self.conn.close()
+        except Exception:  # a broken connection: the next use makes a new one
+            self.index.close()
+        else:
+            self.index._done()
 
 
 def _reason(exc):
@@ -403,7 +435,27 @@ class ServerIndex:
         self.identity = identity
         self.address, self.shown = server_address(address, where)
         self.label = f"the archive's index on {self.shown}"
-        self._holder = None
+        self._conn: Any = None  # one connection: the writer's lock, its writes, its reads
+        self._held: Any = None  # (owner, the connection that holds its session lock)
+
+    def _connection(self):
+        """The index's one connection, made (and the identity checked) on first use."""
+        if self._conn is None or self._conn.closed or self._conn.broken:
+            self._conn = self._connect()
+        return self._conn
+
+    def close(self):
+        if self._conn is not None:
+            with contextlib.suppress(Exception):
+                self._conn.close()
+            self._conn = None
+        self._held = None
+
+    def _done(self):
+        """After a read or a write: keep the connection while it holds a writer's session
+        lock (its scratch folder exists), else close it."""
+        if self._held is None or self._held[1] is not self._conn:
+            self.close()
 
     def _connect(self, check=True):
         psycopg = _psycopg()
@@ -421,9 +473,12 @@ class ServerIndex:
             try:
                 row = conn.execute(f"SELECT format FROM {SERVER_SCHEMA}.archives WHERE "
                                    "identity = %s", (self.identity,)).fetchone()
-            except psycopg.Error:
-                conn.close()
-                row = None
+            except (psycopg.errors.UndefinedTable, psycopg.errors.InvalidSchemaName):
+                row = None  # no archive was ever made here
+            except psycopg.Error as exc:  # the server went away, or refused the statement
+                with contextlib.suppress(Exception):
+                    conn.close()
+                raise ArchiveError(f"{self.label}: cannot be used ({_reason(exc)})") from None
             if row is None:
                 with contextlib.suppress(Exception):
                     conn.close()
@@ -431,7 +486,12 @@ class ServerIndex:
                                    f"{self.identity}, which {self.label} does not hold; "
                                    "expected the server the archive was made on (check "
                                    f"${INDEX_ENV})")
-            conn.rollback()
+            try:
+                conn.rollback()
+            except psycopg.Error as exc:
+                with contextlib.suppress(Exception):
+                    conn.close()
+                raise ArchiveError(f"{self.label}: cannot be used ({_reason(exc)})") from None
         return conn
 
     def create(self, rows=()):
@@ -470,8 +530,7 @@ class ServerIndex:
         return True
 
     def write(self):
-        conn = self._connect()
-        session = _ServerSession(conn, self.identity, self.label)
+        session = _ServerSession(self._connection(), self.identity, self.label, self)
         try:
             session._run(f"SELECT identity FROM {SERVER_SCHEMA}.archives WHERE identity = %s "
                          "FOR UPDATE", (self.identity,))  # the write lock: one writer at a time
@@ -484,7 +543,7 @@ class ServerIndex:
         psycopg = _psycopg()
         from psycopg.rows import dict_row
 
-        conn = self._connect()
+        conn = self._connection()
         try:
             sql = (f"SELECT id, {', '.join(COLUMNS)} FROM {SERVER_SCHEMA}.entries "
                    "WHERE archive = %s")
@@ -496,11 +555,13 @@ class ServerIndex:
                 sql += " AND created >= %s"
                 args.append(since)
             with conn.cursor(row_factory=dict_row) as cur:
-                return list(cur.execute(f"{sql} ORDER BY {order}", args).fetchall())
+                found = list(cur.execute(f"{sql} ORDER BY {order}", args).fetchall())
+            conn.rollback()  # no transaction left open between uses
+            self._done()
+            return found
         except psycopg.Error as exc:
+            self.close()
             raise ArchiveError(f"{self.label}: cannot be read ({_reason(exc)})") from None
-        finally:
-            conn.close()
 
     def problems(self):
         return []  # the server keeps its own pages whole
@@ -512,20 +573,20 @@ class ServerIndex:
         return set()
 
     def hold(self, owner):
-        """Hold, for as long as this process writes, the advisory lock that says its owner
-        token is alive: another host asks the server, not its own process table."""
-        if self._holder is None:
-            conn = self._connect()
-            conn.autocommit = True
+        """Hold, on the index's connection and for as long as it lives, the session lock that
+        says this writer's owner token is alive: another host asks the server, not its own
+        process table (the server frees the lock when the session ends, the process dead)."""
+        psycopg = _psycopg()
+        conn = self._connection()
+        if self._held == (owner, conn):
+            return
+        try:
             conn.execute("SELECT pg_advisory_lock(%s)", (_owner_key(owner),))
-            self._holder = conn
-        return self._holder
-
-    def release_hold(self):
-        if self._holder is not None:
-            with contextlib.suppress(Exception):
-                self._holder.close()
-            self._holder = None
+            conn.commit()  # a session lock: it outlives the transaction
+        except psycopg.Error as exc:
+            self.close()
+            raise ArchiveError(f"{self.label}: {_reason(exc)}") from None
+        self._held = (owner, conn)
 
     def writer_gone(self, owner):
         """Whether a scratch folder's writer is gone: its advisory lock is free on the server
@@ -537,13 +598,13 @@ class ServerIndex:
         if host is None or host == host_tag():
             if owner_alive(owner):
                 return False
-        conn = self._connect()
+        psycopg = _psycopg()
+        conn = self._connection()  # within the writer's transaction: session locks ignore it
+        key = _owner_key(owner)
         try:
-            conn.autocommit = True
-            key = _owner_key(owner)
             free = conn.execute("SELECT pg_try_advisory_lock(%s)", (key,)).fetchone()[0]
             if free:
                 conn.execute("SELECT pg_advisory_unlock(%s)", (key,))
-            return bool(free)
-        finally:
-            conn.close()
+        except psycopg.Error as exc:
+            raise ArchiveError(f"{self.label}: {_reason(exc)}") from None
+        return bool(free)

@@ -212,7 +212,8 @@ class Archive:
         marked = (self.root / MARKER).is_file() or is_sqlite_index(self.root / INDEX)
         if not marked:
             try:
-                empty = not any(os.scandir(self.root))
+                with os.scandir(self.root) as found:
+                    empty = not any(found)
             except OSError as exc:
                 raise ArchiveError(f"{shown}: cannot be read ({exc.strerror})") from None
             # a fill that created the folder a moment ago may have marked it since we looked
@@ -230,7 +231,14 @@ class Archive:
                 pass
             except OSError as exc:
                 raise ArchiveError(f"{shown}: cannot be written ({exc.strerror})") from None
-        if dry_run or not (self.root / MARKER).is_file():
+        if not (self.root / MARKER).is_file():
+            return
+        if dry_run:  # a server archive's driver loads while the run goes on
+            with contextlib.suppress(ArchiveError):
+                if read_marker(self.root)["index"] == "server":
+                    from .index import warm_server_driver
+
+                    warm_server_driver()
             return
         marker = read_marker(self.root)
         if marker["index"] == "server":
@@ -259,7 +267,7 @@ class Archive:
             server = ServerIndex(root, uuid.uuid4().hex, index)
         probe = cls(root, create=True, dry_run=True)
         del probe
-        if root.exists() and any(os.scandir(root)):
+        if root.exists() and next(iter(os.listdir(root)), None) is not None:
             raise ArchiveError(f"{shown}: is not empty, expected a new or empty folder")
         if server is not None:
             server.create()
@@ -442,6 +450,7 @@ class Archive:
             work = scratch / f"{owner_token()}-{uuid.uuid4().hex}"
             work.mkdir()
         except OSError as exc:
+            self.index.close()  # no scratch folder to vouch for
             raise ArchiveError(f"{display(scratch)}: cannot be written ({exc.strerror})") from None
         pending = PendingEntry(self, shot, work)
         try:
@@ -632,6 +641,7 @@ class PendingEntry:
             raise
         self.conn.close()
         self.conn = None
+        self.archive.index.close()  # no scratch folder left to vouch for
         self.entry = Entry(0, self.shot, self.manifest["index"]["version"], self.final,
                            self.manifest["index"]["created"], {})
 
@@ -642,6 +652,7 @@ class PendingEntry:
             self.conn = None
         if self.work.exists():
             shutil.rmtree(self.work, ignore_errors=True)
+        self.archive.index.close()
 
     def commit_alone(self):
         """Commit without a publication; return the :class:`Entry`."""
