@@ -75,9 +75,18 @@ def bench_archive(repeat, tmp):
                                 "2", "--only", "summary", "--archive", str(root)],
                                check=True, capture_output=True, env=env)
                 per_shot.append((time.perf_counter() - started) / shots)
+            listed = subprocess.run([sys.executable, "-m", "airgun_xl", "history", "--archive",
+                                     str(root), "--json"], check=True, capture_output=True,
+                                    env=env, text=True).stdout
+            import json
+
+            written = sum(1 for r in json.loads(listed) if r["shot"][5:].isdigit())
+            if written != shots * len(per_shot):
+                raise RuntimeError(f"{label}: {written} campaign entries in the archive, "
+                                   f"expected {shots * len(per_shot)}")
             rows.append((f"archived campaign of {shots} shots, --jobs 2, {label}",
                          "wall per shot", f"{statistics.median(per_shot):.3f} s",
-                         f"{shots * len(per_shot)} entries written"))
+                         f"{written} entries in the archive, counted"))
         extra = fills["PostgreSQL on the loopback (TCP)"] - fills["SQLite in the folder"]
         rows.append(("the server's cost over SQLite, one archived fill", "wall",
                      f"{extra * 1e3:+.0f} ms",
