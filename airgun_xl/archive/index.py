@@ -103,6 +103,19 @@ class Session:
         raise NotImplementedError
 
 
+def _filters(shot, since, mark):
+    """The history's filters as SQL (`` AND shot = ?``...) with their values as parameters;
+    ``mark`` is the driver's placeholder (``?`` or ``%s``)."""
+    where, args = "", []
+    if shot:
+        where += f" AND shot = {mark}"
+        args.append(shot)
+    if since:
+        where += f" AND created >= {mark}"
+        args.append(since)
+    return where, args
+
+
 # -- SQLite ------------------------------------------------------------------------------------
 
 def _prepare(conn):
@@ -217,14 +230,9 @@ class SqliteIndex:
             return []
         conn = self._connect()
         try:
-            sql, args = "SELECT * FROM entries WHERE 1=1", []
-            if shot:
-                sql += " AND shot = ?"
-                args.append(shot)
-            if since:
-                sql += " AND created >= ?"
-                args.append(since)
-            return [dict(r) for r in conn.execute(f"{sql} ORDER BY {order}", args)]
+            where, args = _filters(shot, since, "?")
+            return [dict(r) for r in conn.execute(
+                f"SELECT * FROM entries WHERE 1=1{where} ORDER BY {order}", args)]
         except sqlite3.Error as exc:
             raise ArchiveError(f"{self.label}: cannot be read ({exc})") from None
         finally:
@@ -545,17 +553,11 @@ class ServerIndex:
 
         conn = self._connection()
         try:
-            sql = (f"SELECT id, {', '.join(COLUMNS)} FROM {SERVER_SCHEMA}.entries "
-                   "WHERE archive = %s")
-            args: list[Any] = [self.identity]
-            if shot:
-                sql += " AND shot = %s"
-                args.append(shot)
-            if since:
-                sql += " AND created >= %s"
-                args.append(since)
+            where, args = _filters(shot, since, "%s")
             with conn.cursor(row_factory=dict_row) as cur:
-                found = list(cur.execute(f"{sql} ORDER BY {order}", args).fetchall())
+                found = list(cur.execute(
+                    f"SELECT id, {', '.join(COLUMNS)} FROM {SERVER_SCHEMA}.entries WHERE "
+                    f"archive = %s{where} ORDER BY {order}", [self.identity, *args]).fetchall())
             conn.rollback()  # no transaction left open between uses
             self._done()
             return found
