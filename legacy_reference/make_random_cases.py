@@ -8,7 +8,6 @@ ranges (numpy's default_rng(SEED)); shots whose OBR chain is unstable at their s
 skipped (fill refuses them, as the macro overflows). Writes random_SEED_NN_input.xlsx and
 _legacy.xlsx with make_case.py and prints the cases.json entries (host "calc").
 """
-import json
 import sys
 
 import numpy as np

@@ -19,6 +19,7 @@ import sys
 import textwrap
 from pathlib import Path
 
+import openpyxl
 import pytest
 from conftest import TEMPLATE
 
@@ -474,11 +475,18 @@ def test_a_sigkill_at_each_stage_of_a_publication_leaves_nothing_the_next_writer
 from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
+
+def _nested(inner):
+    """Lists and objects of ``inner`` (a named function: hypothesis reads a lambda's source
+    to check that it recurses, and misreads one split over lines)."""
+    return st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=8), inner,
+                                                         max_size=3)
+
+
 MARKER_VALUES = st.recursive(
     st.one_of(st.none(), st.booleans(), st.integers(-5, 5), st.text(max_size=40),
               st.sampled_from(["server", "sqlite", "f" * 32, "0" * 31, "postgresql://x/y"])),
-    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=8), inner,
-                                                                max_size=3), max_leaves=8)
+    _nested, max_leaves=8)
 
 
 @settings(max_examples=200, deadline=None, derandomize=True)
@@ -525,3 +533,121 @@ def test_the_markers_short_check_agrees_with_its_json_schema(marker):
         return True
 
     assert verdict(check_marker) == verdict(check)
+
+
+def _files_hold(folder, secret):
+    """The files under ``folder`` (a workbook's zipped parts opened) that hold ``secret``."""
+    import zipfile
+
+    found = []
+    for path in sorted(p for p in Path(folder).rglob("*") if p.is_file()):
+        parts = [path.read_bytes()]
+        if zipfile.is_zipfile(path):
+            with zipfile.ZipFile(path) as z:
+                parts = [z.read(n) for n in z.namelist()]
+        if any(secret.encode() in part for part in parts):
+            found.append(path)
+    return found
+
+
+def test_every_archive_command_works_unchanged_and_the_password_is_never_written(
+        tmp_path, capsys, server_env):
+    """calibrate --name, fill --crush-law NAME, a campaign, accept, history --where and -o,
+    show, compare and verify on a server archive, as on an SQLite one; the password (in
+    $PGPASSWORD, as a lab's shell has it) appears in no message, --json, workbook,
+    provenance or any other file the commands wrote."""
+    import pg_server
+    from conftest import write_trace_csv
+
+    import airgun_xl
+    from airgun_xl.studies.calibrate import synthetic_measurement
+    from airgun_xl.studies.recorder import Recorder
+
+    root = _init(tmp_path, capsys)
+    work = tmp_path / "work"
+    work.mkdir()
+    p = airgun_xl.load(TEMPLATE).params
+    measured = write_trace_csv(work / "m.csv", synthetic_measurement(
+        p.replace(sigmay=p.sigmay * 1.05), seed=5))
+    said = []
+
+    def run(*argv, code=0):
+        assert main([*map(str, argv)]) == code, argv
+        said.append(capsys.readouterr())
+        return said[-1].out
+
+    out = run("calibrate", TEMPLATE, measured, "--cfc", "1000", "-o", work / "cal.xlsx",
+              "--archive", root, "--name", "LOT-36")
+    assert "stored the law as LOT-36@1" in out
+    run("fill", TEMPLATE, "--crush-law", "LOT-36", "--archive", root, "-o",
+        work / "by_law.xlsx", "--name", "shot", "--only", "summary")
+    day = work / "day"
+    day.mkdir()
+    for k in range(2):
+        (day / f"d{k}.xlsx").write_bytes(TEMPLATE.read_bytes())
+    run("fill", day, "--jobs", "2", "--archive", root, "--only", "summary")
+    run("fill", TEMPLATE, "--archive", root, "-o", work / "again.xlsx", "--name", "shot",
+        "--only", "summary", "--integrator", "newmark")
+    recording = work / "rec.csv"
+    Recorder(rate=50_000.0).csv(Recorder(rate=50_000.0).record(
+        airgun_xl.load(TEMPLATE).run(track=()), seed=5), recording)
+    out = run("accept", TEMPLATE, recording, "--sign", "-1", "--cfc", "1000", "--peak",
+              "9.5kG:10%", "-o", work / "v.xlsx", "--archive", root)
+    assert "PASS: " in out
+    assert len(list((root / ".verdicts").rglob("v*.json"))) == 1
+
+    listed = json.loads(run("history", "--archive", root, "--json"))
+    assert sorted((r["shot"], r["version"]) for r in listed) == [
+        ("d0", 1), ("d1", 1), ("shot", 1), ("shot", 2)]
+    where = json.loads(run("history", "--archive", root, "--where", "E40=2.703e7", "--json"))
+    assert sorted(r["shot"] for r in where) == ["d0", "d1", "shot", "shot"]
+    out = run("history", "--archive", root)
+    assert "LOT-36@1" in out and "verdicts (accept --archive):" in out
+    run("history", "--archive", root, "-o", work / "shots.xlsx")
+    rows = list(openpyxl.load_workbook(work / "shots.xlsx", read_only=True).worksheets[0]
+                .values)
+    assert sorted(r[0] for r in rows[3:7]) == ["d0@1", "d1@1", "shot@1", "shot@2"]
+    provenance = Archive(root).get("shot@1").load("provenance.json")
+    assert provenance["crush_law"]["name"] == "fitted (LOT-36@1)"
+    assert "newmark" in run("show", "shot@2", "--archive", root)
+    compared = json.loads(run("compare", "shot@1", "shot@2", "--archive", root, "--json",
+                              code=1))
+    assert compared["same"] is False  # another law and another integrator
+    assert json.loads(run("compare", "d0", "d1", "--archive", root, "--json"))["same"] is True
+    assert "4 entries, 0 problems" in run("archive", "verify", root)
+
+    secret = pg_server.PASSWORD
+    assert not [s for s in said if secret in s.out or secret in s.err]
+    assert _files_hold(root, secret) == [] and _files_hold(work, secret) == []
+
+
+def test_a_hostile_row_on_the_server_is_reported_never_followed(tmp_path, capsys,
+                                                                  server_env):
+    """A row planted on the server (by a role that may write the schema) whose path leads out
+    of the folder and whose shot is a formula: history shows it as text, show and compare
+    refuse it in one line, verify reports it, and nothing outside the archive is read or
+    written."""
+    import psycopg
+
+    root = _init(tmp_path, capsys)
+    Archive(root).add("s", {}, {"summary.json": {}}, {"v0": 1.0})
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (outside / "v0001").mkdir()
+    identity = json.loads((root / MARKER).read_text())["identity"]
+    with psycopg.connect(server_env.admin.replace("dbname=postgres", "dbname=lab")) as conn:
+        conn.execute(f"INSERT INTO {SERVER_SCHEMA}.entries (archive, id, shot, version, path, "
+                     "created) VALUES (%s, 7, %s, 1, %s, '2026-01-01')",
+                     (identity, '=HYPERLINK("http://x","y")', "../outside/v0001"))
+    before = sorted(os.listdir(outside))
+    assert main(["history", "--archive", str(root), "-o", str(tmp_path / "h.xlsx")]) == 0
+    capsys.readouterr()
+    cells = [c for r in openpyxl.load_workbook(tmp_path / "h.xlsx").worksheets[0].iter_rows()
+             for c in r if isinstance(c.value, str) and "HYPERLINK" in c.value]
+    assert all(c.data_type == "s" for c in cells)  # text, never a live formula
+    assert main(["show", "#7", "--archive", str(root)]) == 2
+    assert "no such entry" in _one_line(capsys)
+    assert main(["archive", "verify", str(root)]) == 1
+    out = capsys.readouterr().out
+    assert "row #7: its path '../outside/v0001' is not an entry folder" in out
+    assert sorted(os.listdir(outside)) == before and not any((outside / "v0001").iterdir())
