@@ -192,10 +192,21 @@ def test_on_an_sqlite_archive_another_hosts_scratch_folder_is_never_removed(tmp_
 def test_without_psycopg_a_server_archive_is_one_line_naming_the_extra(tmp_path, capsys,
                                                                        server_env,
                                                                        monkeypatch):
+    """psycopg is imported by the index's agent (airgun_xl/archive/agent.py): a psycopg that
+    cannot be imported, first on the agent's path, is one that is not installed."""
+    from airgun_xl.archive import agent
+
     root = _init(tmp_path, capsys)
-    monkeypatch.setitem(sys.modules, "psycopg", None)  # as if not installed
+    fake = tmp_path / "path" / "psycopg"
+    fake.mkdir(parents=True)
+    (fake / "__init__.py").write_text("raise ImportError('as if not installed')\n")
+    monkeypatch.setenv("PYTHONPATH", str(fake.parent))
+    agent.stop()  # the next agent starts with that path
     out = tmp_path / "o.xlsx"
-    assert main(["fill", str(TEMPLATE), "-o", str(out), "--archive", str(root)]) == 2
+    try:
+        assert main(["fill", str(TEMPLATE), "-o", str(out), "--archive", str(root)]) == 2
+    finally:
+        agent.stop()
     line = _one_line(capsys)
     assert "psycopg is not installed" in line and "airgun-xl[server]" in line
     assert not out.exists()
@@ -651,3 +662,68 @@ def test_a_hostile_row_on_the_server_is_reported_never_followed(tmp_path, capsys
     out = capsys.readouterr().out
     assert "row #7: its path '../outside/v0001' is not an entry folder" in out
     assert sorted(os.listdir(outside)) == before and not any((outside / "v0001").iterdir())
+
+
+def test_a_fill_leaves_psycopg_to_the_index_agent_which_ends_with_it(tmp_path, capsys,
+                                                                     server_env):
+    """The fill process never imports psycopg (its 0.1 s of import runs in the index's agent,
+    beside the fill: benchmarks/bench_archive.py); the agent ends when its parent ends, even
+    by SIGKILL, and the server then frees the parent's locks (the next writer goes on)."""
+    import signal
+    import time
+
+    root = _init(tmp_path, capsys)
+    code = textwrap.dedent(f"""
+        import os, sys
+        from airgun_xl.cli import main
+        from airgun_xl.archive import agent
+        assert main(["fill", {str(TEMPLATE)!r}, "-o", {str(tmp_path / 'o.xlsx')!r},
+                     "--only", "summary", "--archive", {str(root)!r}]) == 0
+        assert "psycopg" not in sys.modules, "the fill imported psycopg"
+        from airgun_xl.archive import Archive
+        pending = Archive({str(root)!r}).prepare("held", {{}}, {{"summary.json": {{}}}}, {{}})
+        print(agent.agent().proc.pid, flush=True)
+        os.kill(os.getpid(), 9)  # the writer dies holding its scratch folder's session lock
+    """)
+    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
+                          text=True, timeout=120)
+    assert proc.returncode == -signal.SIGKILL, proc.stderr
+    helper = int(proc.stdout.split()[-1])
+    deadline = time.monotonic() + 30
+    while _running(helper):  # it reads the end of its input, and ends (polled)
+        assert time.monotonic() < deadline, "the agent outlived its parent"
+        time.sleep(0.01)
+    Archive(root).add("next", {}, {"summary.json": {}}, {})
+    assert Archive(root).verify() == []
+    assert sorted(e.ref for e in Archive(root).entries()) == ["next@1", "shot_a@1"]
+    assert not any((root / ".airgun-xl-scratch").iterdir())
+
+
+def _running(pid):
+    import psutil
+
+    try:
+        return psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
+
+
+def test_the_agent_lost_mid_publication_is_one_line_and_the_next_writer_goes_on(
+        tmp_path, capsys, server_env):
+    """The index's agent killed between an entry's scratch folder and its commit: the commit
+    is one ArchiveError naming the index, nothing is published, and the next entry (a new
+    agent) takes version 1."""
+    from airgun_xl.archive import agent
+    from airgun_xl.errors import ArchiveError
+
+    root = _init(tmp_path, capsys)
+    pending = Archive(root).prepare("s", {}, {"summary.json": {}}, {})
+    agent.agent().proc.kill()
+    with pytest.raises(ArchiveError) as caught:
+        pending.commit_alone()
+    line = str(caught.value)
+    assert "\n" not in line and "helper process stopped" in line, line
+    assert "the archive's index on 127.0.0.1:" in line
+    assert Archive(root).entries() == [] and not (root / "s").exists()
+    assert Archive(root).add("s", {}, {"summary.json": {}}, {}).version == 1
+    assert Archive(root).verify() == []

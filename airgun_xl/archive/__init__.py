@@ -3,6 +3,8 @@
 - :mod:`.store`: the folder, its entries and how they are committed (light: the standard
   library only, so ``history`` and ``show`` start fast);
 - :mod:`.index`: the index, in the folder (SQLite) or on a PostgreSQL server;
+- :mod:`.agent`: the helper process that holds a server index's connections (psycopg loads
+  there, beside the command);
 - :mod:`.entry`: what a fill puts in an entry (imported by the fill when it archives);
 - :mod:`.laws`: the library of fitted crush laws, kept by name (calibrate stores, fill runs).
 """

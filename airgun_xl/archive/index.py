@@ -280,48 +280,46 @@ class SqliteIndex:
 
 # -- PostgreSQL --------------------------------------------------------------------------------
 
-_WARMING: list = []
+def session_options():
+    """A connection's settings: how long a statement, a lock wait and an idle transaction
+    may last."""
+    return (f"-c statement_timeout={STATEMENT_TIMEOUT * 1000} "
+            f"-c lock_timeout={LOCK_WAIT * 1000} -c idle_in_transaction_session_timeout="
+            f"{(LOCK_WAIT + STATEMENT_TIMEOUT) * 1000}")
 
 
-def warm_server_driver():
-    """Import psycopg on a daemon thread, once a process, while the run goes on: its import
-    (about 0.1 s) then costs a server archive's fill nothing it would notice."""
-    import threading
+def preconnect():
+    """Start the index's agent and connect it ahead of time, to the address a command without
+    ``--index`` uses (``$AIRGUN_XL_INDEX`` or libpq's defaults): a fill then waits for neither
+    psycopg's import nor the login. Nothing is checked here; the connection is used only by
+    a :class:`ServerIndex` that asks for the same address, once that address is checked."""
+    from .agent import prestart
 
-    if _WARMING:
-        return
-
-    def load():
-        with contextlib.suppress(Exception):
-            import psycopg  # noqa: F401
-            import psycopg.rows  # noqa: F401
-
-    thread = threading.Thread(target=load, name="airgun-xl-psycopg", daemon=True)
-    _WARMING.append(thread)
-    thread.start()
+    text = os.environ.get(INDEX_ENV)
+    prestart("" if text is None else str(text).strip(), session_options())
 
 
-def _psycopg():
-    for thread in _WARMING:
-        thread.join()
-    try:
-        import psycopg
-    except ImportError:
-        raise ArchiveError("the archive's index is on a PostgreSQL server, and psycopg is not "
-                           "installed; expected pip install 'airgun-xl[server]'") from None
-    return psycopg
+def _link_error(exc, label, doing=""):
+    """A :class:`~airgun_xl.archive.agent.LinkError` as the archive's one line."""
+    if exc.kind == "missing":
+        return ArchiveError("the archive's index is on a PostgreSQL server, and psycopg is not "
+                            "installed; expected pip install 'airgun-xl[server]'")
+    return ArchiveError(f"{label}: {doing}{exc.message}")
 
 
 def server_address(given=None, where="--index"):
     """The server's address, checked: the given one, else ``$AIRGUN_XL_INDEX``, else libpq's
     own defaults (``PGHOST``, ``PGSERVICE`` and the service file). A password in it is
     refused, without repeating it: the command line is recorded in provenance and shown by
-    ``ps``; it belongs in ``~/.pgpass`` or ``$PGPASSWORD``.
+    ``ps``; it belongs in ``~/.pgpass`` or ``$PGPASSWORD``. libpq reads it, in the index's
+    agent.
 
     Raises
     ------
     airgun_xl.errors.OptionError
     """
+    from .agent import LinkError, agent
+
     text = given if given is not None else os.environ.get(INDEX_ENV)
     if text is None:
         return "", "libpq's defaults"
@@ -330,15 +328,14 @@ def server_address(given=None, where="--index"):
     if not text.startswith(("postgresql://", "postgres://")) and "=" not in text:
         raise OptionError(f"{source}: found an address that is neither a postgresql:// URL "
                           "nor key=value pairs; expected postgresql://HOST[:PORT]/DATABASE")
-    _psycopg()  # the driver, whole (a warming import finished first)
-    from psycopg.conninfo import conninfo_to_dict
-
     try:
-        parts = conninfo_to_dict(text)
-    except Exception:
+        parts = agent().call("parse", address=text)
+    except LinkError as exc:
+        if exc.kind != "address":
+            raise _link_error(exc, "the archive's index") from None
         raise OptionError(f"{source}: found an address libpq cannot read; expected "
                           "postgresql://HOST[:PORT]/DATABASE") from None
-    if parts.get("password") not in (None, ""):
+    if parts.pop("password"):
         raise OptionError(f"{source}: found a password in the address (not repeated here); "
                           "expected it in ~/.pgpass or $PGPASSWORD, since the command line is "
                           "recorded with every entry and shown by ps")
@@ -368,11 +365,12 @@ class _ServerSession(Session):
         self.conn, self.identity, self.label, self.index = conn, identity, label, index
 
     def _run(self, sql, args=()):
-        psycopg = _psycopg()
+        from .agent import LinkError
+
         try:
             return self.conn.execute(sql, args)
-        except psycopg.Error as exc:
-            raise ArchiveError(f"{self.label}: {_reason(exc)}") from None
+        except LinkError as exc:
+            raise _link_error(exc, self.label) from None
 
     def paths(self):
         return {r[0] for r in self._run(
@@ -384,27 +382,28 @@ class _ServerSession(Session):
         return int(row[0] or 0)
 
     def insert(self, row):
-        psycopg = _psycopg()
-        try:
-            with self.conn.transaction():  # a savepoint: a clash leaves the rest standing
-                self.conn.execute(  # the next id of this archive, under its write lock
-                    f"INSERT INTO {SERVER_SCHEMA}.entries (archive, id, {', '.join(COLUMNS)}) "
-                    f"SELECT %s, COALESCE(MAX(id), 0) + 1, {', '.join(['%s'] * len(COLUMNS))} "
-                    f"FROM {SERVER_SCHEMA}.entries WHERE archive = %s",
-                    (self.identity, *(row.get(c) for c in COLUMNS), self.identity))
-        except psycopg.errors.UniqueViolation:
-            return False
-        except psycopg.Error as exc:
-            raise ArchiveError(f"{self.label}: {_reason(exc)}") from None
+        from .agent import LinkError
+
+        try:  # in a savepoint: a clash leaves the rest standing
+            self.conn.execute(  # the next id of this archive, under its write lock
+                f"INSERT INTO {SERVER_SCHEMA}.entries (archive, id, {', '.join(COLUMNS)}) "
+                f"SELECT %s, COALESCE(MAX(id), 0) + 1, {', '.join(['%s'] * len(COLUMNS))} "
+                f"FROM {SERVER_SCHEMA}.entries WHERE archive = %s",
+                (self.identity, *(row.get(c) for c in COLUMNS), self.identity), savepoint=True)
+        except LinkError as exc:
+            if exc.kind == "unique":
+                return False
+            raise _link_error(exc, self.label) from None
         return True
 
     def commit(self):
-        psycopg = _psycopg()
+        from .agent import LinkError
+
         try:
             self.conn.commit()
-        except psycopg.Error as exc:
-            raise ArchiveError(f"{self.label}: the entry's row cannot be committed "
-                               f"({_reason(exc)})") from None
+        except LinkError as exc:
+            raise _link_error(exc, self.label, "the entry's row cannot be committed: ") \
+                from None
 
     def close(self):
         try:
@@ -415,15 +414,9 @@ class _ServerSession(Session):
             self.index._done()
 
 
-def _reason(exc):
-    """A server error in words, on one line (libpq's message; never the address's secrets,
-    which libpq does not repeat)."""
-    text = " ".join(str(exc).split()) or type(exc).__name__
-    return text[:300]
-
-
 class ServerIndex:
-    """The index as tables on a PostgreSQL server (schema :data:`SERVER_SCHEMA`).
+    """The index as tables on a PostgreSQL server (schema :data:`SERVER_SCHEMA`), reached
+    through the index's agent (:mod:`airgun_xl.archive.agent`).
 
     Parameters
     ----------
@@ -466,40 +459,37 @@ class ServerIndex:
             self.close()
 
     def _connect(self, check=True):
-        psycopg = _psycopg()
+        from .agent import Link, LinkError
+
         try:
-            conn = psycopg.connect(
-                self.address, connect_timeout=10, application_name="airgun-xl",
-                options=f"-c statement_timeout={STATEMENT_TIMEOUT * 1000} "
-                        f"-c lock_timeout={LOCK_WAIT * 1000} -c idle_in_transaction_session_"
-                        f"timeout={(LOCK_WAIT + STATEMENT_TIMEOUT) * 1000}")
-        except psycopg.Error as exc:
-            raise ArchiveError(f"{self.label}: cannot be reached ({_reason(exc)}); expected a "
+            conn = Link(self.address, session_options())
+        except LinkError as exc:
+            if exc.kind == "missing":
+                raise _link_error(exc, self.label) from None
+            raise ArchiveError(f"{self.label}: cannot be reached ({exc.message}); expected a "
                                f"PostgreSQL server at ${INDEX_ENV}, --index or libpq's "
                                "defaults") from None
         if check:
             try:
                 row = conn.execute(f"SELECT format FROM {SERVER_SCHEMA}.archives WHERE "
                                    "identity = %s", (self.identity,)).fetchone()
-            except (psycopg.errors.UndefinedTable, psycopg.errors.InvalidSchemaName):
+            except LinkError as exc:
+                if exc.kind != "undefined":  # the server went away, or refused the statement
+                    conn.close()
+                    raise ArchiveError(f"{self.label}: cannot be used ({exc.message})") \
+                        from None
                 row = None  # no archive was ever made here
-            except psycopg.Error as exc:  # the server went away, or refused the statement
-                with contextlib.suppress(Exception):
-                    conn.close()
-                raise ArchiveError(f"{self.label}: cannot be used ({_reason(exc)})") from None
             if row is None:
-                with contextlib.suppress(Exception):
-                    conn.close()
+                conn.close()
                 raise ArchiveError(f"{display(self.root)}: its marker names archive "
                                    f"{self.identity}, which {self.label} does not hold; "
                                    "expected the server the archive was made on (check "
                                    f"${INDEX_ENV})")
             try:
                 conn.rollback()
-            except psycopg.Error as exc:
-                with contextlib.suppress(Exception):
-                    conn.close()
-                raise ArchiveError(f"{self.label}: cannot be used ({_reason(exc)})") from None
+            except LinkError as exc:
+                conn.close()
+                raise ArchiveError(f"{self.label}: cannot be used ({exc.message})") from None
         return conn
 
     def create(self, rows=()):
@@ -507,7 +497,8 @@ class ServerIndex:
         moved from SQLite, their ids kept apart), in one transaction."""
         import datetime
 
-        psycopg = _psycopg()
+        from .agent import LinkError
+
         conn = self._connect(check=False)
         try:
             for sql in SERVER_TABLES:
@@ -520,15 +511,17 @@ class ServerIndex:
             created = datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")
             conn.execute(f"INSERT INTO {SERVER_SCHEMA}.archives (identity, created, format) "
                          "VALUES (%s, %s, 1)", (self.identity, created))
-            with conn.cursor() as cur:
-                cur.executemany(
+            if rows:
+                conn.executemany(
                     f"INSERT INTO {SERVER_SCHEMA}.entries (archive, id, {', '.join(COLUMNS)}) "
                     f"VALUES (%s, %s, {', '.join(['%s'] * len(COLUMNS))})",
                     [(self.identity, row["id"], *(row.get(c) for c in COLUMNS))
                      for row in rows])
             conn.commit()
-        except psycopg.Error as exc:
-            raise ArchiveError(f"{self.label}: cannot hold a new archive ({_reason(exc)}); "
+        except LinkError as exc:
+            if exc.kind == "missing":
+                raise _link_error(exc, self.label) from None
+            raise ArchiveError(f"{self.label}: cannot hold a new archive ({exc.message}); "
                                f"expected a role that owns schema {SERVER_SCHEMA} or may "
                                "create it (README, 'A shared archive')") from None
         finally:
@@ -548,22 +541,20 @@ class ServerIndex:
         return session
 
     def rows(self, shot=None, since=None, order="created, shot, version"):
-        psycopg = _psycopg()
-        from psycopg.rows import dict_row
+        from .agent import LinkError
 
         conn = self._connection()
         try:
             where, args = _filters(shot, since, "%s")
-            with conn.cursor(row_factory=dict_row) as cur:
-                found = list(cur.execute(
-                    f"SELECT id, {', '.join(COLUMNS)} FROM {SERVER_SCHEMA}.entries WHERE "
-                    f"archive = %s{where} ORDER BY {order}", [self.identity, *args]).fetchall())
+            found = conn.execute(
+                f"SELECT id, {', '.join(COLUMNS)} FROM {SERVER_SCHEMA}.entries WHERE "
+                f"archive = %s{where} ORDER BY {order}", [self.identity, *args]).dicts()
             conn.rollback()  # no transaction left open between uses
             self._done()
             return found
-        except psycopg.Error as exc:
+        except LinkError as exc:
             self.close()
-            raise ArchiveError(f"{self.label}: cannot be read ({_reason(exc)})") from None
+            raise ArchiveError(f"{self.label}: cannot be read ({exc.message})") from None
 
     def problems(self):
         return []  # the server keeps its own pages whole
@@ -578,16 +569,17 @@ class ServerIndex:
         """Hold, on the index's connection and for as long as it lives, the session lock that
         says this writer's owner token is alive: another host asks the server, not its own
         process table (the server frees the lock when the session ends, the process dead)."""
-        psycopg = _psycopg()
+        from .agent import LinkError
+
         conn = self._connection()
         if self._held == (owner, conn):
             return
         try:
             conn.execute("SELECT pg_advisory_lock(%s)", (_owner_key(owner),))
             conn.commit()  # a session lock: it outlives the transaction
-        except psycopg.Error as exc:
+        except LinkError as exc:
             self.close()
-            raise ArchiveError(f"{self.label}: {_reason(exc)}") from None
+            raise _link_error(exc, self.label) from None
         self._held = (owner, conn)
 
     def writer_gone(self, owner):
@@ -595,18 +587,17 @@ class ServerIndex:
         (the server drops a session's locks when its process dies, on any host)."""
         from ..transaction import owner_alive
         from ..transaction.owners import host_tag, owner_host
+        from .agent import LinkError
 
         host = owner_host(owner)
-        if host is None or host == host_tag():
-            if owner_alive(owner):
-                return False
-        psycopg = _psycopg()
+        if host is None or host == host_tag():  # this host's process table says
+            return not owner_alive(owner)
         conn = self._connection()  # within the writer's transaction: session locks ignore it
         key = _owner_key(owner)
         try:
             free = conn.execute("SELECT pg_try_advisory_lock(%s)", (key,)).fetchone()[0]
             if free:
                 conn.execute("SELECT pg_advisory_unlock(%s)", (key,))
-        except psycopg.Error as exc:
-            raise ArchiveError(f"{self.label}: {_reason(exc)}") from None
+        except LinkError as exc:
+            raise _link_error(exc, self.label) from None
         return bool(free)

@@ -161,6 +161,20 @@ def read_marker(root):
     return marker
 
 
+def prestart_index(root):
+    """Start the index's agent now when ``root`` is an archive whose index is on a server
+    (:func:`airgun_xl.archive.agent.prestart`), so that psycopg loads on the other core
+    while the command goes on; anything else does nothing here (it is checked where the
+    archive is opened)."""
+    if root is None or not (Path(root) / MARKER).is_file():
+        return
+    with contextlib.suppress(ArchiveError):
+        if read_marker(root)["index"] == "server":
+            from .index import preconnect
+
+            preconnect()
+
+
 class Archive:
     """An archive folder.
 
@@ -233,12 +247,8 @@ class Archive:
                 raise ArchiveError(f"{shown}: cannot be written ({exc.strerror})") from None
         if not (self.root / MARKER).is_file():
             return
-        if dry_run:  # a server archive's driver loads while the run goes on
-            with contextlib.suppress(ArchiveError):
-                if read_marker(self.root)["index"] == "server":
-                    from .index import warm_server_driver
-
-                    warm_server_driver()
+        if dry_run:  # a server archive's agent starts while the run goes on
+            prestart_index(self.root)
             return
         marker = read_marker(self.root)
         if marker["index"] == "server":

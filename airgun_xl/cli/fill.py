@@ -3,6 +3,7 @@ import math
 from pathlib import Path
 
 from ..archive import ENV, archive_dir
+from ..archive.store import prestart_index
 from ..choices import HOSTS, SIDECAR_MODES, UNLOADINGS
 from ..outputs import GROUPS
 from ..transaction import display
@@ -138,6 +139,7 @@ def settings_of(args):
 
 
 def run(args):
+    prestart_index(archive_dir(args.archive, required=False))  # psycopg loads meanwhile
     settings = settings_of(args)
     if len(args.shots) == 1 and not Path(args.shots[0]).is_dir() and not args.summary:
         return run_one(args.shots[0], settings)
