@@ -75,7 +75,9 @@ def test_a_monte_carlo_without_seed_repeats_and_prints_its_seed(tmp_path, capsys
         out = tmp_path / f"mc{k}.xlsx"
         assert main(["sweep", str(TEMPLATE), "--mc", "8", "--sd", "E40=3%", "-o", str(out)]) == 0
         assert "(seed 1)" in capsys.readouterr().out
-        tables.append(list(openpyxl.load_workbook(out, read_only=True)["Sweep"].values))
+        wb = openpyxl.load_workbook(out, read_only=True)
+        tables.append(list(wb["Sweep"].values))
+        assert ("Seed of the draws", "1") in [r[:2] for r in wb["Spread"].values]
     assert tables[0] == tables[1] and len(tables[0]) == 9
     assert len({row[0] for row in tables[0][1:]}) == 8  # eight different draws of E40
 

@@ -38,6 +38,7 @@ def test_indices_rank_the_inputs_of_shot_a(tmp_path, capsys):
     assert main(["sweep", str(TEMPLATE), "--sobol", "128", "--sd", "E40=3%", "--sd", "E37=2%",
                  "--sd", "A28=1%", "--seed", "1", "-o", str(out)]) == 0
     ws = openpyxl.load_workbook(out)["Sensitivity"]
+    assert ws["A1"].value.endswith("Seed of the draws: 1.")  # the study repeats from it
     rows = {}
     block = None
     for r in ws.iter_rows(min_row=3, values_only=True):

@@ -111,7 +111,8 @@ def run(args):
     seconds = time.perf_counter() - started
     stats = spread(result.figures[:, 0])
     write_sweep(result, output, args.force, stats if args.mc is not None else None,
-                sensitivity, shot=Path(args.shot).name)
+                sensitivity, shot=Path(args.shot).name,
+                seed=None if result.kind == "grid" else args.seed)
     steps = total * (shot.params.rows - 2)
     print(f"wrote {output}: {total:,} shots in {seconds:.2f} s ({steps / seconds:.3g} "
           f"shot-steps/s); {int(result.diverged.sum())} diverged, "

@@ -46,20 +46,22 @@ def _cell_axis(cell, values):
     return _label(cell, unit), fmt or general_format(values, digits=3)
 
 
-def write_sweep(result, path, force, stats=None, sensitivity=None, shot=None):
+def write_sweep(result, path, force, stats=None, sensitivity=None, shot=None, seed=None):
     """The sweep's workbook at ``path``: the Sweep table and Charts (a grid over two or more
     inputs: a family of curves, one series per level of the second); with ``stats`` (a Monte
     Carlo) the Spread sheet and the band's convergence; with ``sensitivity`` (Sobol) the
-    Sensitivity sheet and its bar charts. ``shot`` names the input in the page headers."""
+    Sensitivity sheet and its bar charts. ``shot`` names the input in the page headers;
+    ``seed``, the draws' seed, is shown on the Spread and Sensitivity pages (the study
+    repeats from it)."""
     with report_workbook(path, force) as wb:
         style = Style(wb)
         # the report pages first (the workbook opens on the Charts), the data sheets after
         family_data = _write_charts(wb, result, shot)
         if stats is not None:
-            _write_spread(wb, result, stats, style, shot)
+            _write_spread(wb, result, stats, style, shot, seed)
             _write_band(wb, result, style, shot)
         if sensitivity is not None:
-            _write_sensitivity(wb, sensitivity, style, shot)
+            _write_sensitivity(wb, sensitivity, style, shot, seed)
         _write_warnings(wb, result, style, shot)
         ws = wb.add_worksheet("Sweep", worksheet_class=ColumnsWorksheet)
         headers = ([_label(c) for c in result.cells]
@@ -216,7 +218,7 @@ def _write_warnings(wb, result, style, shot):
     one_page(ws, row, 1, shot=shot, title="Warnings")
 
 
-def _write_spread(wb, result, stats, style, shot):
+def _write_spread(wb, result, stats, style, shot, seed=None):
     ws = wb.add_worksheet("Spread")
     ws.set_column(0, 0, 30)
     ws.set_column(1, 1, 12)
@@ -228,6 +230,9 @@ def _write_spread(wb, result, stats, style, shot):
         ws.write_string(r, 0, label)
         style.number(ws, r, 1, value, code)
         ws.write_string(r, 2, style.unit(code))
+    if seed is not None:  # an identifier, as text: a seed past 2**53 is no Excel number
+        ws.write_string(6, 0, "Seed of the draws")
+        ws.write_string(6, 1, str(seed))
     peaks = result.figures[:, 0][np.isfinite(result.figures[:, 0])]
     counts, edges = np.histogram(peaks, bins=min(30, max(5, len(peaks) // 20)))
     ws.write_row(7, 0, ["Bin centre (kG)", "Shots"], style.bold)
@@ -251,7 +256,7 @@ SENSITIVITY_TITLES = {"peak_kg": "Peak acceleration", "pulse_duration": "Pulse d
                       "max_crush": "Maximum crush"}
 
 
-def _write_sensitivity(wb, sensitivity, style, shot):
+def _write_sensitivity(wb, sensitivity, style, shot, seed=None):
     """One block of rows a figure (input, S1, S1 +/-, ST, ST +/-) and a bar chart of S1 and ST
     with their 95 % confidence half-widths as error bars."""
     ws = wb.add_worksheet("Sensitivity")
@@ -259,7 +264,8 @@ def _write_sensitivity(wb, sensitivity, style, shot):
     ws.set_column(1, 4, 12)
     ws.write_string(0, 0, "Sobol indices (SALib; Saltelli sample, first and total order): S1 is "
                           "an input's share of the variance alone, ST with its interactions; "
-                          "+/- is the 95 % confidence half-width.")
+                          "+/- is the 95 % confidence half-width."
+                          + (f" Seed of the draws: {seed}." if seed is not None else ""))
     row, k = 2, len(sensitivity.cells)
     for n, (name, found) in enumerate(sensitivity.indices.items()):
         ws.write_row(row, 0, [SENSITIVITY_TITLES[name], "S1", "S1 +/-", "ST", "ST +/-"],
