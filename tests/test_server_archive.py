@@ -727,3 +727,41 @@ def test_the_agent_lost_mid_publication_is_one_line_and_the_next_writer_goes_on(
     assert Archive(root).entries() == [] and not (root / "s").exists()
     assert Archive(root).add("s", {}, {"summary.json": {}}, {}).version == 1
     assert Archive(root).verify() == []
+
+
+def test_an_interrupt_between_request_and_reply_ends_the_agent_and_the_next_starts_anew(
+        tmp_path, capsys, server_env, monkeypatch):
+    """Ctrl-C while the agent works: its reply would answer the next request, so the agent is
+    ended (the server rolls its session back); the next use starts another."""
+    from airgun_xl.archive import agent
+
+    root = _init(tmp_path, capsys)
+    helper = agent.agent()
+
+    def interrupted(self):
+        raise KeyboardInterrupt
+
+    with monkeypatch.context() as m:
+        m.setattr(agent.Agent, "_read", interrupted)
+        with pytest.raises(KeyboardInterrupt):
+            Archive(root).entries()
+    assert not helper.running and agent.agent() is not helper
+    assert Archive(root).add("s", {}, {"summary.json": {}}, {}).version == 1
+    assert [e.ref for e in Archive(root).entries()] == ["s@1"]
+
+
+def test_a_login_made_ahead_of_time_and_lost_since_is_made_again(tmp_path, capsys,
+                                                                server_env):
+    """fill logs in ahead of time (index.preconnect); a server restarted meanwhile has closed
+    that session: the archive logs in again, and the entry is stored."""
+    from airgun_xl.archive import agent, index
+
+    root = _init(tmp_path, capsys)
+    agent.stop()
+    index.preconnect()
+    agent.agent().call("parse", address=server_env.address)  # the login ahead is made
+    assert len(agent.agent().early) == 1
+    server_env.stop("fast")
+    server_env.start()
+    assert Archive(root).add("s", {}, {"summary.json": {}}, {}).version == 1
+    assert Archive(root).verify() == []

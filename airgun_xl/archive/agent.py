@@ -191,7 +191,13 @@ class Agent:
         with self.lock:
             self._prepare()
             self._send(dict(fields, op=op))
-            return self._result(self._read())
+            try:
+                line = self._read()
+            except BaseException as exc:
+                if not isinstance(exc, LinkError):  # an interrupt between request and reply:
+                    self.stop(kill=True)  # its reply would answer the next request
+                raise
+            return self._result(line)
 
     def tell(self, op: str, **fields: Any) -> None:
         """Send a request that has no reply (``close``)."""
@@ -221,8 +227,13 @@ class Agent:
     def _prepare(self):
         """Read the replies sent ahead, and close what was dropped unclosed."""
         while self.ahead:
-            key = self.ahead.pop(0)
-            self.early[key] = self._read()
+            try:
+                reply = self._read()
+            except BaseException as exc:
+                if not isinstance(exc, LinkError):
+                    self.stop(kill=True)
+                raise
+            self.early[self.ahead.pop(0)] = reply
         while self.unused:
             self._send({"op": "close", "conn": self.unused.pop()})
 
@@ -257,11 +268,17 @@ class Agent:
             raise LinkError(**reply["error"])
         return reply["ok"]
 
-    def stop(self):
-        """Close the agent's input (it closes its connections and ends) and reap it."""
+    def stop(self, kill=False):
+        """Close the agent's input (it closes its connections and ends) and reap it; with
+        ``kill``, end it now (the server closes its sessions)."""
         proc, self.proc = self.proc, None
+        self.ahead.clear()
+        self.early.clear()
         if proc is None:
             return
+        if kill:
+            with contextlib.suppress(OSError):
+                proc.kill()
         for stream in (proc.stdin, proc.stdout):
             with contextlib.suppress(Exception):
                 stream.close()  # type: ignore[union-attr]
@@ -342,9 +359,11 @@ class Link:
         The session's settings (``-c statement_timeout=...``).
     """
 
-    def __init__(self, address: str, options: str):
+    def __init__(self, address: str, options: str, fresh: bool = False):
         self.agent = agent()
-        self.number = self.agent.take("connect", **_connect_request(address, options))
+        request = _connect_request(address, options)
+        self.number = (self.agent.call("connect", **request) if fresh
+                       else self.agent.take("connect", **request))
         self.broken = False
 
     @property

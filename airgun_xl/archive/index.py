@@ -458,11 +458,11 @@ class ServerIndex:
         if self._held is None or self._held[1] is not self._conn:
             self.close()
 
-    def _connect(self, check=True):
+    def _connect(self, check=True, fresh=False):
         from .agent import Link, LinkError
 
         try:
-            conn = Link(self.address, session_options())
+            conn = Link(self.address, session_options(), fresh)
         except LinkError as exc:
             if exc.kind == "missing":
                 raise _link_error(exc, self.label) from None
@@ -474,6 +474,9 @@ class ServerIndex:
                 row = conn.execute(f"SELECT format FROM {SERVER_SCHEMA}.archives WHERE "
                                    "identity = %s", (self.identity,)).fetchone()
             except LinkError as exc:
+                if exc.broken and not fresh:  # a login made ahead of time, lost since
+                    conn.close()
+                    return self._connect(check, fresh=True)
                 if exc.kind != "undefined":  # the server went away, or refused the statement
                     conn.close()
                     raise ArchiveError(f"{self.label}: cannot be used ({exc.message})") \
