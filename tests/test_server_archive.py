@@ -99,8 +99,13 @@ def test_fill_history_show_and_verify_work_unchanged_and_agree_with_sqlite(tmp_p
     on_server, on_sqlite = _history(server, capsys), _history(local, capsys)
     assert on_server == on_sqlite and [r["version"] for r in on_server] == [1, 2]
     assert [r["integrator"].split("/")[0] for r in on_server] == ["legacy", "newmark"]
-    assert main(["history", "--archive", str(server), "--where", "E40=2.703e7", "--json"]) == 0
-    assert len(json.loads(capsys.readouterr().out)) == 2
+    for where in ("E40=2.703e7", "E40=1"):  # --where: the same rows on both back ends
+        found = []
+        for root in (server, local):
+            assert main(["history", "--archive", str(root), "--where", where, "--json"]) == 0
+            found.append([(r["shot"], r["version"]) for r in json.loads(capsys.readouterr().out)])
+        assert found[0] == found[1] == ([("shot_a", 1), ("shot_a", 2)] if where != "E40=1"
+                                        else [])
     assert main(["show", "shot_a@2", "--archive", str(server)]) == 0
     assert "newmark" in capsys.readouterr().out
     assert main(["archive", "verify", str(server)]) == 0
@@ -765,3 +770,32 @@ def test_a_login_made_ahead_of_time_and_lost_since_is_made_again(tmp_path, capsy
     server_env.start()
     assert Archive(root).add("s", {}, {"summary.json": {}}, {}).version == 1
     assert Archive(root).verify() == []
+
+
+def test_the_address_and_password_from_libpqs_service_and_password_files(tmp_path, capsys,
+                                                                         server_env,
+                                                                         monkeypatch):
+    """No $AIRGUN_XL_INDEX and no $PGPASSWORD: libpq's service file names the server
+    ($PGSERVICE) and its password file holds the password; init, fill and history work, and
+    the marker names neither."""
+    services = tmp_path / "pg_service.conf"
+    services.write_text(f"[lab]\nhost=127.0.0.1\nport={server_env.port}\ndbname=lab\n"
+                        "user=lab\n")
+    passwords = tmp_path / "pgpass"
+    import pg_server
+
+    passwords.write_text(f"127.0.0.1:{server_env.port}:lab:lab:{pg_server.PASSWORD}\n")
+    passwords.chmod(0o600)
+    monkeypatch.delenv("AIRGUN_XL_INDEX")
+    monkeypatch.delenv("PGPASSWORD")
+    monkeypatch.setenv("PGSERVICEFILE", str(services))
+    monkeypatch.setenv("PGSERVICE", "lab")
+    monkeypatch.setenv("PGPASSFILE", str(passwords))
+    root = tmp_path / "shots"
+    assert main(["archive", "init", str(root), "--index", "service=lab"]) == 0
+    assert "its index on localhost/lab" in capsys.readouterr().out
+    assert "lab" not in json.loads((root / MARKER).read_text()).values()
+    assert main(["fill", str(TEMPLATE), "-o", str(tmp_path / "o.xlsx"), "--archive",
+                 str(root), "--only", "summary"]) == 0
+    capsys.readouterr()
+    assert [r["shot"] for r in _history(root, capsys)] == ["shot_a"]

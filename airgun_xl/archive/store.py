@@ -295,7 +295,7 @@ class Archive:
             if made:
                 shutil.rmtree(root, ignore_errors=True)
             raise ArchiveError(f"{shown}: cannot be written ({exc.strerror})") from None
-        return cls(root)
+        return cls(root, index=index)  # the server it was made on, as given
 
     def migrate(self, index=None):
         """Move this archive's SQLite index to a PostgreSQL server at ``index`` (else
