@@ -620,8 +620,7 @@ def test_every_archive_command_works_unchanged_and_the_password_is_never_written
     out = run("history", "--archive", root)
     assert "LOT-36@1" in out and "verdicts (accept --archive):" in out
     run("history", "--archive", root, "-o", work / "shots.xlsx")
-    rows = list(openpyxl.load_workbook(work / "shots.xlsx", read_only=True).worksheets[0]
-                .values)
+    rows = list(openpyxl.load_workbook(work / "shots.xlsx").worksheets[0].values)
     assert sorted(r[0] for r in rows[3:7]) == ["d0@1", "d1@1", "shot@1", "shot@2"]
     provenance = Archive(root).get("shot@1").load("provenance.json")
     assert provenance["crush_law"]["name"] == "fitted (LOT-36@1)"
