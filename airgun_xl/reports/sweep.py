@@ -232,7 +232,7 @@ def _write_spread(wb, result, stats, style, shot, seed=None):
         ws.write_string(r, 2, style.unit(code))
     if seed is not None:  # an identifier, as text: a seed past 2**53 is no Excel number
         ws.write_string(6, 0, "Seed of the draws")
-        ws.write_string(6, 1, str(seed))
+        ws.write_string(6, 1, str(seed), style.get(align="right"))
     peaks = result.figures[:, 0][np.isfinite(result.figures[:, 0])]
     counts, edges = np.histogram(peaks, bins=min(30, max(5, len(peaks) // 20)))
     ws.write_row(7, 0, ["Bin centre (kG)", "Shots"], style.bold)
