@@ -798,3 +798,28 @@ def test_the_address_and_password_from_libpqs_service_and_password_files(tmp_pat
                  str(root), "--only", "summary"]) == 0
     capsys.readouterr()
     assert [r["shot"] for r in _history(root, capsys)] == ["shot_a"]
+
+
+def test_an_agent_that_cannot_start_or_answers_nonsense_is_one_line(tmp_path, capsys,
+                                                                    server_env, monkeypatch):
+    """No Python to start the agent with: one line, exit 2. An agent whose reply is not JSON
+    (a stray print): the agent is ended and the call fails as a LinkError, never a
+    traceback."""
+    from airgun_xl.archive import agent
+
+    root = _init(tmp_path, capsys)
+    agent.stop()
+    with monkeypatch.context() as m:
+        m.setattr(agent.sys, "executable", str(tmp_path / "no-python"))
+        assert main(["history", "--archive", str(root)]) == 2
+    line = _one_line(capsys)
+    assert "the index's helper process cannot be started" in line, line
+    helper = agent.agent()
+    helper.stop(kill=True)
+    helper.proc = subprocess.Popen(
+        [sys.executable, "-c", "import sys\nfor line in sys.stdin: print('not json', "
+                               "flush=True)"], stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+    with pytest.raises(agent.LinkError) as caught:
+        helper.call("parse", address=server_env.address)
+    assert caught.value.kind == "lost" and not helper.running
+    assert main(["history", "--archive", str(root)]) == 0  # a new agent

@@ -23,7 +23,7 @@ import subprocess
 import sys
 import threading
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 #: The longest reply line read from the agent [bytes] (a history of some 500,000 entries).
 MAX_REPLY = 256 * 2**20
@@ -137,6 +137,7 @@ def serve(stdin=None, stdout=None):
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     stdin = stdin or sys.stdin.buffer
     stdout = stdout or sys.stdout.buffer
+    sys.stdout = sys.stderr  # a stray print goes where the parent does not read
     psycopg: Any = None
     with contextlib.suppress(ImportError):
         import psycopg
@@ -173,9 +174,13 @@ class Agent:
                 f"{str(Path(__file__).resolve())!r}); m = u.module_from_spec(s); "
                 "s.loader.exec_module(m); m.serve(); m.os._exit(0)")  # no teardown to wait on
         self.pid = os.getpid()
-        self.proc: subprocess.Popen | None = subprocess.Popen(
-            [sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-            stderr=subprocess.DEVNULL)
+        try:
+            self.proc: subprocess.Popen | None = subprocess.Popen(
+                [sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                stderr=subprocess.DEVNULL)
+        except (OSError, ValueError) as exc:
+            raise LinkError("lost", f"the index's helper process cannot be started ({exc})",
+                            True) from None
         self.lock = threading.Lock()
         self.unused: list[int] = []  # connections dropped unclosed: closed before the next call
         self.ahead: list[str] = []  # requests sent ahead whose replies are still to be read
@@ -253,14 +258,17 @@ class Agent:
         if proc is not None and proc.stdout is not None:
             with contextlib.suppress(OSError, ValueError):
                 line = proc.stdout.readline(MAX_REPLY)
-        if not line.endswith(b"\n"):
-            self._lost()
-        return json.loads(line)
+        try:
+            if line.endswith(b"\n"):
+                return json.loads(line)
+        except ValueError:
+            pass
+        self._lost()
 
-    def _lost(self):
-        self.stop()
+    def _lost(self) -> NoReturn:
+        self.stop(kill=True)
         raise LinkError("lost", "the index's helper process stopped (or sent more than "
-                                f"{MAX_REPLY >> 20} MiB)", True)
+                                f"{MAX_REPLY >> 20} MiB, or not a reply)", True)
 
     @staticmethod
     def _result(reply):
