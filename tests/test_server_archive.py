@@ -814,12 +814,13 @@ def test_an_agent_that_cannot_start_or_answers_nonsense_is_one_line(tmp_path, ca
         assert main(["history", "--archive", str(root)]) == 2
     line = _one_line(capsys)
     assert "the index's helper process cannot be started" in line, line
-    helper = agent.agent()
-    helper.stop(kill=True)
-    helper.proc = subprocess.Popen(
-        [sys.executable, "-c", "import sys\nfor line in sys.stdin: print('not json', "
-                               "flush=True)"], stdin=subprocess.PIPE, stdout=subprocess.PIPE)
-    with pytest.raises(agent.LinkError) as caught:
-        helper.call("parse", address=server_env.address)
-    assert caught.value.kind == "lost" and not helper.running
+    for nonsense in ("not json", '{"x": 1}', "[1]"):
+        helper = agent.agent()
+        helper.stop(kill=True)
+        helper.proc = subprocess.Popen(
+            [sys.executable, "-c", f"import sys\nfor line in sys.stdin: print({nonsense!r}, "
+                                   "flush=True)"], stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+        with pytest.raises(agent.LinkError) as caught:
+            helper.call("parse", address=server_env.address)
+        assert caught.value.kind == "lost" and not helper.running
     assert main(["history", "--archive", str(root)]) == 0  # a new agent

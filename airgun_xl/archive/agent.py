@@ -270,10 +270,13 @@ class Agent:
         raise LinkError("lost", "the index's helper process stopped (or sent more than "
                                 f"{MAX_REPLY >> 20} MiB, or not a reply)", True)
 
-    @staticmethod
-    def _result(reply):
-        if "error" in reply:
-            raise LinkError(**reply["error"])
+    def _result(self, reply):
+        if isinstance(reply, dict) and isinstance(reply.get("error"), dict):
+            error = reply["error"]
+            raise LinkError(str(error.get("kind")), str(error.get("message")),
+                            bool(error.get("broken")))
+        if not isinstance(reply, dict) or "ok" not in reply:
+            self._lost()
         return reply["ok"]
 
     def stop(self, kill=False):
