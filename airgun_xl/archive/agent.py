@@ -19,18 +19,15 @@ import atexit
 import contextlib
 import json
 import os
-import subprocess
 import sys
-import threading
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
+
+if TYPE_CHECKING:
+    import subprocess
 
 #: The longest reply line read from the agent [bytes] (a history of some 500,000 entries).
 MAX_REPLY = 256 * 2**20
-
-#: The kinds of :class:`LinkError`.
-KINDS = ("missing", "address", "connect", "unique", "undefined", "lost", "other")
-
 
 class LinkError(Exception):
     """A failure on the server or in the agent.
@@ -168,6 +165,9 @@ class Agent:
     """The agent process, and the calls made to it (one at a time)."""
 
     def __init__(self):
+        import subprocess  # here: the archive's light commands do not pay for it
+        import threading
+
         # this file alone, run as a module of its own: the agent imports the standard library
         # and psycopg, not airgun_xl (its start is what a fill waits for)
         code = ("import importlib.util as u; s = u.spec_from_file_location('airgun_xl_agent', "
@@ -293,6 +293,8 @@ class Agent:
         for stream in (proc.stdin, proc.stdout):
             with contextlib.suppress(Exception):
                 stream.close()  # type: ignore[union-attr]
+        import subprocess
+
         try:
             proc.wait(timeout=10)
         except subprocess.TimeoutExpired:
@@ -320,7 +322,7 @@ def agent() -> Agent:
 def prestart(address: str | None = None, options: str | None = None) -> None:
     """Start the agent now, so that its import of psycopg runs while this process works;
     with ``address``, connect ahead of time too (:class:`Link` takes that connection)."""
-    with contextlib.suppress(OSError, LinkError):
+    with contextlib.suppress(LinkError):
         helper = agent()
         if address is not None and options is not None:
             helper.ahead_of_time("connect", **_connect_request(address, options))
@@ -414,6 +416,3 @@ class Link:
         if getattr(self, "number", None) is not None:  # closed before the agent's next call
             self.agent.unused.append(self.number)
 
-
-if __name__ == "__main__":
-    serve()

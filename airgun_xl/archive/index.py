@@ -25,6 +25,7 @@ from typing import Any
 
 from ..errors import ArchiveError, OptionError
 from ..transaction import display
+from .agent import Link, LinkError, agent, prestart
 
 INDEX = "index.sqlite"
 
@@ -293,8 +294,6 @@ def preconnect():
     ``--index`` uses (``$AIRGUN_XL_INDEX`` or libpq's defaults): a fill then waits for neither
     psycopg's import nor the login. Nothing is checked here; the connection is used only by
     a :class:`ServerIndex` that asks for the same address, once that address is checked."""
-    from .agent import prestart
-
     text = os.environ.get(INDEX_ENV)
     prestart("" if text is None else str(text).strip(), session_options())
 
@@ -318,8 +317,6 @@ def server_address(given=None, where="--index"):
     ------
     airgun_xl.errors.OptionError
     """
-    from .agent import LinkError, agent
-
     text = given if given is not None else os.environ.get(INDEX_ENV)
     if text is None:
         return "", "libpq's defaults"
@@ -365,8 +362,6 @@ class _ServerSession(Session):
         self.conn, self.identity, self.label, self.index = conn, identity, label, index
 
     def _run(self, sql, args=()):
-        from .agent import LinkError
-
         try:
             return self.conn.execute(sql, args)
         except LinkError as exc:
@@ -382,8 +377,6 @@ class _ServerSession(Session):
         return int(row[0] or 0)
 
     def insert(self, row):
-        from .agent import LinkError
-
         try:  # in a savepoint: a clash leaves the rest standing
             self.conn.execute(  # the next id of this archive, under its write lock
                 f"INSERT INTO {SERVER_SCHEMA}.entries (archive, id, {', '.join(COLUMNS)}) "
@@ -397,8 +390,6 @@ class _ServerSession(Session):
         return True
 
     def commit(self):
-        from .agent import LinkError
-
         try:
             self.conn.commit()
         except LinkError as exc:
@@ -459,8 +450,6 @@ class ServerIndex:
             self.close()
 
     def _connect(self, check=True, fresh=False):
-        from .agent import Link, LinkError
-
         try:
             conn = Link(self.address, session_options(), fresh)
         except LinkError as exc:
@@ -499,8 +488,6 @@ class ServerIndex:
         """Make the schema (if the role may), this archive's row and ``rows`` (an index
         moved from SQLite, their ids kept apart), in one transaction."""
         import datetime
-
-        from .agent import LinkError
 
         conn = self._connect(check=False)
         try:
@@ -544,8 +531,6 @@ class ServerIndex:
         return session
 
     def rows(self, shot=None, since=None, order="created, shot, version"):
-        from .agent import LinkError
-
         conn = self._connection()
         try:
             where, args = _filters(shot, since, "%s")
@@ -572,8 +557,6 @@ class ServerIndex:
         """Hold, on the index's connection and for as long as it lives, the session lock that
         says this writer's owner token is alive: another host asks the server, not its own
         process table (the server frees the lock when the session ends, the process dead)."""
-        from .agent import LinkError
-
         conn = self._connection()
         if self._held == (owner, conn):
             return
@@ -590,8 +573,6 @@ class ServerIndex:
         (the server drops a session's locks when its process dies, on any host)."""
         from ..transaction import owner_alive
         from ..transaction.owners import host_tag, owner_host
-        from .agent import LinkError
-
         host = owner_host(owner)
         if host is None or host == host_tag():  # this host's process table says
             return not owner_alive(owner)
