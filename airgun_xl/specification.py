@@ -70,9 +70,9 @@ CAPS = {
 DURATION_DEFS = ("base", "width@10%")
 
 #: The defaults by :data:`KEYS` name, applied once after the merge
-#: (:meth:`Specification.resolved`). The record judged has no value default: not given, it is
-#: the tool's noise-bounded low-pass (:mod:`airgun_xl.studies.acceptance`). The corridor's
-#: and the decay's defaults apply only with a shape that draws them (:data:`SHAPE_DEFAULTS`).
+#: (:meth:`Specification.resolved`); the record judged's is the tool's noise-bounded one
+#: (:class:`JudgedRecord`). The corridor's and the decay's defaults apply only with a shape
+#: that draws them (:data:`SHAPE_DEFAULTS`).
 DEFAULTS: dict[str, Any] = {
     "shape": "none", "time_slack": 0.0, "placement": "least-squares",
     "dv_window": ((0.5, "D"), (0.5, "D")), "monitor": ((1.0, "D"), (1.0, "D")),
@@ -86,6 +86,54 @@ SHAPE_DEFAULTS: dict[str, Any] = {"corridor": 0.2, "decay": 0.1}
 
 #: Marks the fields of :class:`Specification` that say where it came from, not what it asks.
 META = {"meta": True}
+
+#: The kinds of record a verdict can judge (:class:`JudgedRecord`).
+RECORD_KINDS = ("default", "unfiltered", "cfc")
+
+
+@dataclass(frozen=True)
+class JudgedRecord:
+    """The record a verdict judges (issue 42), one of three kinds:
+
+    - ``default``, the tool's noise-bounded record, what no source named: the record as it is
+      while its noise at rest is within 0.5 % of its peak, else through a 4-pole Bessel
+      low-pass at K/D both ways (:mod:`airgun_xl.studies.acceptance`);
+    - ``unfiltered``, the record as it is (``--cfc none``, ``unfiltered`` on the sheet);
+    - ``cfc``, through SAE J211 channel frequency class ``cfc`` both ways (``--cfc 600``,
+      ``cfc600``).
+
+    Its text in the grammar is ``unfiltered`` or ``cfcN``; ``default`` is what no source
+    gives, printed so."""
+
+    kind: str = "default"
+    cfc: int | None = None  # the class, with the kind "cfc" only
+
+    def __post_init__(self) -> None:
+        if self.kind not in RECORD_KINDS or (self.kind == "cfc") != (self.cfc is not None) \
+                or (self.cfc is not None and self.cfc not in CFC_CLASSES):
+            raise ValueError(f"a judged record of kind {self.kind!r} and class {self.cfc!r}")
+
+    @property
+    def is_default(self) -> bool:
+        return self.kind == "default"
+
+    @property
+    def is_unfiltered(self) -> bool:
+        return self.kind == "unfiltered"
+
+    def __str__(self) -> str:
+        return f"cfc{self.cfc}" if self.kind == "cfc" else self.kind
+
+
+#: The tool's noise-bounded record, and the record as it is.
+DEFAULT_RECORD = JudgedRecord("default")
+UNFILTERED = JudgedRecord("unfiltered")
+DEFAULTS["record"] = DEFAULT_RECORD
+
+
+def cfc_record(cfc: int | None) -> JudgedRecord:
+    """The record through CFC ``cfc``; None: the unfiltered record (``--cfc none``)."""
+    return UNFILTERED if cfc is None else JudgedRecord("cfc", cfc)
 
 
 @dataclass(frozen=True)
@@ -151,8 +199,10 @@ class Specification:
     decay : float or None
         The terminal-peak sawtooth's decay allowance, a fraction of D (default 0.1): the
         band admits any decay from none to it.
-    cfc : int or None
-        The record judged: 0 unfiltered (the default), or through SAE J211 CFC ``cfc``.
+    record : JudgedRecord or None
+        The record judged: the tool's noise-bounded default, unfiltered, or through SAE J211
+        CFC N (:class:`JudgedRecord`); None until a source gives it (:meth:`resolved` then
+        gives the default).
     placement : str or None
         One of :data:`PLACEMENTS` (default least-squares).
     srs : SrsRequirement or None
@@ -185,7 +235,7 @@ class Specification:
     monitor: tuple | None = None
     duration_def: str | None = None
     decay: float | None = None
-    cfc: int | None = None
+    record: JudgedRecord | None = None
     placement: str | None = None
     srs: SrsRequirement | None = None
     srs_q: float | None = None
@@ -198,6 +248,11 @@ class Specification:
     places: tuple[tuple[str, str], ...] = field(default=(), metadata=META)
     set_aside: tuple[str, ...] = field(default=(), metadata=META)
     units: tuple[tuple[str, str], ...] = field(default=(), metadata=META)
+
+    @property
+    def judged(self) -> JudgedRecord:
+        """The record judged: the one a source gave, else the tool's default."""
+        return self.record if self.record is not None else DEFAULT_RECORD
 
     @property
     def empty(self) -> bool:
@@ -258,8 +313,6 @@ class Specification:
                  f"from {where}: {', '.join(items)}" for where, items in by_source.items()
                  if where != "default"]
         defaults = by_source.get("default", [])
-        if self.cfc is None:
-            defaults.append("record the tool's default (see record judged)")
         if defaults:
             lines.append(f"defaults (the tool's, no source gave them): {', '.join(defaults)}")
         return lines
@@ -411,14 +464,15 @@ def _name(text: str, where: str, names: tuple, what: str) -> str:
     return value
 
 
-def parse_record(text: str, where: str = "record") -> int:
-    """``unfiltered`` -> 0; ``cfc600`` or ``CFC 600`` -> 600."""
+def parse_record(text: str, where: str = "record") -> JudgedRecord:
+    """``unfiltered``, or ``cfc600`` (``CFC 600``): a :class:`JudgedRecord` (the tool's
+    default is what no source gives, not a value to give)."""
     value = str(text).strip().lower()
     match = re.fullmatch(r"cfc\s*(\d{1,5})", value)
     if value == "unfiltered":
-        return 0
+        return UNFILTERED
     if match and int(match.group(1)) in CFC_CLASSES:
-        return int(match.group(1))
+        return JudgedRecord("cfc", int(match.group(1)))
     raise _refuse(where, text, "unfiltered or one of 60, 180, 600, 1000 (cfc600)")
 
 
@@ -580,7 +634,7 @@ KEYS: dict[str, Key] = {
         t, w, DURATION_DEFS, "a duration definition"), str),
     "decay": Key("decay", "%", lambda t, w: _percent(t, w, "a decay allowance", False)[1],
                  _show_fraction),
-    "record": Key("cfc", "", parse_record, lambda c: f"cfc{c}" if c else "unfiltered"),
+    "record": Key("record", "", parse_record, str),
     "placement": Key("placement", "", lambda t, w: _name(t, w, PLACEMENTS, "a placement"),
                      str),
     "srs_q": Key("srs_q", "", parse_q, lambda q: _shortest(q, "1", "")),
@@ -633,6 +687,7 @@ ALIASES = {"window": ("dv_window", "monitor")}
 #: How a verdict names a key where its name is not plain words.
 LABELS = {"dv_window": "velocity-change window", "monitor": "monitoring window",
           "duration_def": "duration definition", "decay": "decay allowance",
+          "record": "record judged",
           "srs_q": "SRS Q", "srs_lower_db": "SRS lower tolerance",
           "srs_upper_db": "SRS upper tolerance", "srs_outside": "SRS outside"}
 

@@ -7,6 +7,7 @@ import pytest
 
 from airgun_xl.cli.commands import build_parser
 from airgun_xl.cli.vocabulary import VOCABULARY, Alias
+from airgun_xl.specification import UNFILTERED, cfc_record
 
 
 def _subparsers(parser, prefix=()):
@@ -233,8 +234,8 @@ def test_cfc_is_the_record_judged_in_every_command_that_judges(words):
     parser = SUBPARSERS[words]
     positionals = ["s.xlsx", "r.csv"] if words == ("accept",) else ["s.xlsx"]
     spec = options_spec(parser.parse_args([*positionals, "--cfc", "600"]))
-    assert spec.cfc == 600 and spec.origin("record") == "options"
-    assert options_spec(parser.parse_args([*positionals, "--cfc", "none"])).cfc == 0
+    assert spec.record == cfc_record(600) and spec.origin("record") == "options"
+    assert options_spec(parser.parse_args([*positionals, "--cfc", "none"])).record == UNFILTERED
     assert options_spec(parser.parse_args(positionals)) is None
     with pytest.raises(Exception, match="--record: found 'cfc7', expected unfiltered or one "
                                         "of 60, 180, 600, 1000"):

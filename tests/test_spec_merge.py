@@ -19,8 +19,10 @@ from airgun_xl.cli import main
 from airgun_xl.errors import AirgunXlError, OptionError
 from airgun_xl.specification import (
     MAX_SRS_ROWS,
+    UNFILTERED,
     Specification,
     Tolerance,
+    cfc_record,
     combine,
     load_profile,
 )
@@ -125,8 +127,8 @@ def test_30_1_a_profiles_srs_fields_without_a_requirement_are_said_not_judged(tm
     (["--time-slack", "0%"], "time_slack", 0.0),
     (["--placement", "least-squares"], "placement", "least-squares"),
     (["--shape", "none"], "shape", "none"),
-    (["--cfc", "none"], "cfc", 0),
-    (["--record", "unfiltered"], "cfc", 0),  # the old spelling, one release
+    (["--cfc", "none"], "record", UNFILTERED),
+    (["--record", "unfiltered"], "record", UNFILTERED),  # the old spelling, one release
 ])
 def test_30_2_an_option_equal_to_the_default_overrides_the_profile(tmp_path, capsys, flags,
                                                                    field, value):
@@ -138,8 +140,7 @@ def test_30_2_an_option_equal_to_the_default_overrides_the_profile(tmp_path, cap
     ns = build_parser().parse_args(["fill", str(TEMPLATE), "--profile", lab, "--peak", "12kG",
                                     "--duration", "5ms", *flags])
     spec = combine(lab, airgun_xl.load(TEMPLATE).spec, options_spec(ns))
-    key = "record" if field == "cfc" else field
-    assert getattr(spec, field) == value and spec.origin(key) == "options"
+    assert getattr(spec, field) == value and spec.origin(field) == "options"
 
 
 def test_30_2_shape_none_over_a_profiles_shape_judges_limits_only_and_says_so(tmp_path,
@@ -293,7 +294,7 @@ def test_30_5_record_unfiltered_is_said_unfiltered(tmp_path, capsys):
     shot = sheet_shot(tmp_path, {"B3": 12, "B4": 10, "B12": "CFC 600"})
     code, out, _ = accept(tmp_path, capsys, "--cfc", "none", shot=shot)
     assert code == 0 and "record judged: unfiltered" in out and "CFC 0" not in out
-    assert re.search(r"from options: .*record unfiltered", out)  # where it came from
+    assert re.search(r"from options: .*record judged unfiltered", out)  # where it came from
     code = main(["accept", str(shot), str(recording(tmp_path)), "-o",
                  str(tmp_path / "v.xlsx"), "--record", "unfiltered", "--cfc", "600"])
     err = capsys.readouterr().err.strip().splitlines()
@@ -379,7 +380,7 @@ def test_the_verdict_prints_where_each_field_came_from_and_the_defaults(tmp_path
     assert "from options: peak 12kG" in out
     assert ("defaults (the tool's, no source gave them): shape none, time slack 0%, "
             "placement least-squares, velocity-change window 0.5D,0.5D, monitoring window "
-            "1D,1D, duration definition base, record the tool's default") in out
+            "1D,1D, duration definition base, record judged default") in out
 
 
 def test_the_documented_profile_example_loads_as_documented(tmp_path):
@@ -392,7 +393,7 @@ def test_the_documented_profile_example_loads_as_documented(tmp_path):
     path.write_text(example)
     spec = load_profile(str(path))
     assert math.isnan(spec.peak.nominal) and (spec.peak.minus, spec.peak.plus) == (0.1, 0.2)
-    assert (spec.shape, spec.corridor, spec.cfc) == ("half-sine", 0.15, 1000)
+    assert (spec.shape, spec.corridor, spec.record) == ("half-sine", 0.15, cfc_record(1000))
     assert (spec.srs_lower_db, spec.srs_upper_db) == (-1.0, 1.0)
     assert spec.duration.minus == spec.duration.plus == 0.1
 

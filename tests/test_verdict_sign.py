@@ -23,6 +23,7 @@ from airgun_xl.studies.acceptance import (
     judge_rows,
     judged_record,
 )
+from airgun_xl.studies.recording_quality import assess
 from airgun_xl.units import KG_MS2, G
 
 A_G, D = 40.0, 11e-3  # the 40 g, 11 ms pulses
@@ -200,9 +201,12 @@ def test_31_3_a_single_sample_glitch_does_not_lift_the_peak_and_is_warned():
 def test_31_3_a_clipped_record_cannot_show_its_peak():
     t, kg = pulse(rate=51_200.0)
     kg = np.minimum(kg, 0.9 * A)  # the recorder's range
-    v = judged(t, kg, noise=0.0)
+    quality = assess(t, kg, "the pulse")  # the recording's quality stage, as accept runs it
+    v = judge_record(t, kg, spec(**NOMINAL), "the pulse", noise=0.0, warnings=quality.warnings,
+                     quality=quality)
     c = by_name(v)["peak"]
-    assert not v.passed and not c.passed and c.detail == "not measurable: the record is clipped"
+    assert not v.passed and not c.passed
+    assert c.detail == "not measurable: the record is clipped (top)"
     assert any("clipped" in w and "samples from" in w for w in v.warnings)
 
 

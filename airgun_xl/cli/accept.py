@@ -38,7 +38,7 @@ def run(args):
     from ..errors import OptionError
     from ..readers.recording import input_file, read_trace
     from ..shot import Shot
-    from ..studies.acceptance import judge_record
+    from ..studies.acceptance import expectations, judge_record
     from ..studies.measured import prepare
     from ..transaction import check_output
     from .messages import warn
@@ -58,16 +58,22 @@ def run(args):
         raise OptionError(f"{args.shot}: its Specification sheet is empty and no option gives"
                           " a criterion; expected --peak, --duration, --velocity-change, --srs"
                           " or --profile")
-    cfc = spec.cfc  # --cfc is the specification's record field, over the sheet's
+    cfc = spec.judged.cfc  # --cfc is the specification's record field, over the sheet's
     trace = read_trace(args.recording, args.time_unit, args.accel_unit, args.sign,
                        args.channel)
     from ..studies.shock import check_cfc
 
     filtering = check_cfc(cfc, trace.dt) if cfc else []
-    rec = prepare(trace, None, anti_alias="none")  # zeroed; the record judged is made below
+    expected, notes = expectations(shot, spec)
+    # zeroed and its quality read; the record judged is made below
+    rec = prepare(trace, None, anti_alias="none", flat_top=spec.shape == "trapezoid",
+                  expected=expected,
+                  nominal_duration=spec.duration.nominal if spec.duration else None)
     verdict = judge_record(rec.trace.time, rec.corrected, spec, trace.name,
                            noise=rec.base.noise,
-                           warnings=shot.warnings + filtering + rec.warnings)
+                           warnings=shot.warnings + filtering + rec.warnings,
+                           quality=rec.quality)
+    verdict.definitions += notes
     assert verdict.record is not None
     time, kg = verdict.record
     pulse, spectra = report_data(time, kg, spec, verdict)
@@ -121,7 +127,7 @@ def report_data(time, kg, spec, verdict):
     import numpy as np
 
     from ..studies.acceptance import corridor_limits, equivalent_half_sine, ideal, pseudo_velocity
-    from ..studies.shock import default_frequencies, srs
+    from ..studies.shock import decimated_for, default_frequencies, srs
 
     pulse = {"time": time, "kg": kg}
     if spec.corridor is not None and verdict.onset is not None:
@@ -143,10 +149,15 @@ def report_data(time, kg, spec, verdict):
     else:  # 100 Hz to 10 kHz, or below a tenth of a slow record's rate
         hi = min(10_000.0, top)
         frequencies = default_frequencies(min(100.0, hi / 16), hi)
-    levels = srs(kg, dt, frequencies, q)
+    # on the record decimated to what the frequencies need: a 1 GHz record's would take
+    # minutes and gigabytes at its own step, for the same spectrum
+    spectral, step, factor = decimated_for(kg, dt, float(np.max(frequencies)))
+    levels = srs(spectral, step, frequencies, q)
     spectra = {"frequencies": frequencies, "srs": levels, "q": q,
                "pv": pseudo_velocity(frequencies, levels),
-               "equivalent": equivalent_half_sine(time, kg, frequencies, q)}
+               "equivalent": equivalent_half_sine(
+                   step * np.arange(len(spectral)), spectral, frequencies, q),
+               "step": (step, factor)}
     if spec.srs is not None:  # log-log between the requirement's rows
         required = np.exp(np.interp(np.log(frequencies), np.log(required_f),
                                     np.log(np.array(spec.srs.levels_kg))))

@@ -16,8 +16,10 @@ PLAIN_OPTIONS = tuple((key, option) for key, option in OPTIONS.items()
                       and option not in ("--srs-tol", "--cfc"))
 
 #: The help of the record judged, where ``--cfc`` is a field of the specification.
-RECORD_HELP = ("the record judged: a SAE J211 class (60, 180, 600 or 1000), or none for the "
-               "unfiltered record (the default); the Specification sheet's 'record' field")
+RECORD_HELP = ("the record judged: N through SAE J211 CFC N (60, 180, 600 or 1000), none "
+               "the unfiltered record; given by no source, the tool's default (noise-bounded: "
+               "unfiltered while its noise at rest is within 0.5 %% of its peak, else a "
+               "4-pole Bessel low-pass at K/D); the Specification sheet's 'record' field")
 
 
 def add_spec_options(p, cfc=True):
@@ -91,6 +93,7 @@ def options_spec(args):
         OPTIONS,
         SHOWN_UNITS,
         SrsRequirement,
+        cfc_record,
         parse_db_pair,
         parse_window,
         spec_of_keys,
@@ -111,7 +114,7 @@ def options_spec(args):
         for key in ALIASES["window"]:
             parsed.setdefault(key, window)
     if getattr(args, "cfc_given", None):  # --cfc none: the unfiltered record, said
-        parsed["record"] = args.cfc or 0
+        parsed["record"] = cfc_record(args.cfc)
     if getattr(args, "srs_tol", None) is not None:
         parsed["srs_lower_db"], parsed["srs_upper_db"] = parse_db_pair(args.srs_tol)
     srs = None

@@ -74,6 +74,24 @@ def write_verdict_table(wb, ws, verdict, row, bold):
     return row
 
 
+def write_recording_block(wb, ws, verdict, row, bold):
+    """"The recording": what it says about itself (rate, samples across D, step, noise at
+    rest and its colour, clipping, dropouts, start and end), a row each from ``row``; the
+    next free row."""
+    wrap = wb.add_format({"text_wrap": True, "valign": "top"})
+    top = wb.add_format({"bold": True, "valign": "top"})
+    ws.write_string(row, 0, "The recording, as read before it was judged", bold)
+    row += 1
+    nominal = verdict.spec.duration.nominal if verdict.spec.duration else None
+    for label, text in verdict.quality.block(nominal):
+        ws.write_string(row, 0, label, top)
+        ws.merge_range(row, 1, row, VERDICT_COLS - 1, "", wrap)
+        ws.write_string(row, 1, text, wrap)
+        ws.set_row(row, 15 * max(1, -(-len(text) // (VERDICT_LINE_CHARS - 40))))
+        row += 1
+    return row
+
+
 def _pulse_chart(wb, n, t_ms, values, has_corridor):
     chart = wb.add_chart({"type": "scatter", "subtype": "straight"})
     line_series(chart, "Pulse data", "Record judged", 1, n, 0, 1, RECORD)
@@ -144,6 +162,8 @@ def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=Non
         ws.set_column(7, 7, 60)
         row = write_about(ws, about, bold) + 1
         row = write_verdict_table(wb, ws, verdict, row, bold)
+        if verdict.quality is not None:
+            row = write_recording_block(wb, ws, verdict, row + 1, bold)
         row = write_warnings(wb, ws, row + 1, verdict.warnings, VERDICT_COLS - 1,
                              line_chars=160)
         one_page(ws, row, VERDICT_COLS - 1, shot=shot, title="Verdict")
@@ -202,7 +222,11 @@ def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=Non
             srs_ws.write_string(row, 0, label)
             srs_ws.write_number(row, 8, value, form)
             row += 1
+        step, factor = spectra.get("step", (None, 1))
+        decimated = (f"; computed on the record decimated 1 in {factor:,} to "
+                     f"{1 / step:,.0f} samples a second, what its highest frequency needs"
+                     if factor > 1 else "")
         srs_ws.write_string(0, 0, f"SRS at Q = {spectra['q']:g}; pseudo-velocity = SRS / "
-                                  "(2 pi f)", bold)
+                                  f"(2 pi f){decimated}", bold)
         one_page(srs_ws, row, CHART_COLS - 1, shot=shot, title="SRS")
 

@@ -52,6 +52,7 @@ import numpy as np
 from ..errors import OptionError
 from ..specification import Specification, shown_unit
 from ..units import KG_MS2
+from .recording_quality import Expected, RecordingQuality
 
 #: Crossing level of the duration, a fraction of the peak (and the sawtooth rise's top).
 DURATION_LEVEL = 0.10
@@ -72,6 +73,10 @@ LOWPASS_ORDER = 4
 #: Above this fraction of the sample rate a cut-off would not filter: the record is judged as
 #: it is, and the verdict says so.
 LOWPASS_MAX_RATE = 0.4
+
+#: Samples of rest prepended before a filter's start (REST_BEFORE) past which a fast record
+#: gets only ten periods of the filter's cut-off (a 1 GHz record would take 2 million).
+MAX_PAD = 20_000
 
 #: The default record is low-passed only when its noise at rest passes this fraction of its
 #: peak (1 sigma): a clean record (a prediction, a quiet recorder) is judged as it is, its
@@ -176,6 +181,7 @@ class Verdict:
     window: tuple[float, float] | None = None  # [s], the span monitored
     record: tuple[np.ndarray, np.ndarray] | None = None  # (t [s], kg) of the record judged
     span: tuple[float, float] = (math.nan, math.nan)  # [s], the velocity change's window
+    quality: RecordingQuality | None = None  # a recording's, as read before it was judged
 
     @property
     def passed(self) -> bool:
@@ -374,11 +380,19 @@ def _window_seconds(window: tuple, reference) -> tuple:
     return tuple(value * reference if unit == "D" else value for value, unit in window)
 
 
-def judge_rows(t: np.ndarray, kg: np.ndarray, spec: Specification, refine: bool = False
-               ) -> dict[str, np.ndarray]:
+def judge_rows(t: np.ndarray, kg: np.ndarray, spec: Specification, refine: bool = False,
+               recorded: tuple[float, float] | None = None) -> dict[str, np.ndarray]:
     """Each criterion's value for each row of ``kg`` (pulses [kG] on the grid ``t`` [s]);
     with ``refine`` (a verdict's, not a Monte Carlo's blocks) the least-squares placement is
     the minimum over every sample, not the decimated correlation's estimate.
+
+    No figure rests on what was not recorded: ``recorded`` is the span [s] the samples were
+    recorded over (the rest of ``t`` padding a filter's start; default all of it). A
+    criterion that needs samples outside it is NaN (not measurable): a duration whose 10 %
+    crossings (a sawtooth's rise) are not both inside; a velocity change or a corridor whose
+    placed pulse is not, or whose window reaches past it by more than a sample. A window the
+    specification did not give (the tool's default) is cut to the span round a recorded
+    pulse instead, and ``span`` and ``monitored`` say where it was.
 
     Returns
     -------
@@ -386,20 +400,26 @@ def judge_rows(t: np.ndarray, kg: np.ndarray, spec: Specification, refine: bool 
         ``peak`` [kG], ``duration`` [s], ``velocity change`` [m/s], ``corridor`` (least
         margin, a fraction of the nominal peak; only with a corridor), ``onset`` [s],
         ``span`` (start and end [s] of the velocity change's window) and ``monitored`` (of
-        the corridor's).
+        the corridor's, as judged).
     """
     spec = spec.resolved()
     t = np.asarray(t, dtype=float)
     kg = np.atleast_2d(np.asarray(kg, dtype=float))
     dt = t[1] - t[0]
+    lo_t, hi_t = (float(t[0]), float(t[-1])) if recorded is None else recorded
     peak_index = np.argmax(kg, axis=1)
     peak = kg[np.arange(len(kg)), peak_index]
+    peak = np.where((t[peak_index] >= lo_t) & (t[peak_index] <= hi_t), peak, np.nan)
     start, end = _crossings(t, kg, peak_index, peak)
+    # a crossing interpolated from a sample that was not recorded is not measured
+    start = np.where(start > lo_t, start, np.nan)
+    end = np.where(end < hi_t, end, np.nan)
     width = end - start
     if spec.duration_def == "width@10%":
         duration = width
-    elif spec.shape == "sawtooth":
-        duration = peak / _rise_fits(t, kg, peak_index)[1]
+    elif spec.shape == "sawtooth":  # its rise, from a recorded 10 % crossing
+        duration = np.where(np.isfinite(start), peak / _rise_fits(t, kg, peak_index)[1],
+                            np.nan)
     else:
         duration = width / width_fraction(spec.shape)
     out = {"peak": peak, "duration": duration}
@@ -418,6 +438,11 @@ def judge_rows(t: np.ndarray, kg: np.ndarray, spec: Specification, refine: bool 
     assert spec.dv_window is not None and spec.monitor is not None  # resolved
     before, after = _window_seconds(spec.dv_window, reference)
     lo, hi = onset - before, onset + ending + after
+    # the pulse itself must be recorded; a window the specification did not give (the
+    # tool's default) is cut to the record round it, one it gave is judged whole or not at all
+    pulse_in = (onset >= lo_t - dt) & (onset + ending <= hi_t + dt)
+    if spec.origin("dv_window") == "default":
+        lo, hi = np.maximum(lo, lo_t), np.minimum(hi, hi_t)
     out["onset"] = onset
     out["span"] = np.stack([lo, hi], axis=1)
     # the trapezoidal rule over the samples inside the span [lo, hi], row by row: partial
@@ -427,16 +452,23 @@ def judge_rows(t: np.ndarray, kg: np.ndarray, spec: Specification, refine: bool 
     sums = np.zeros((len(kg), len(t)))
     np.cumsum(0.5 * (kg[:, 1:] + kg[:, :-1]), axis=1, out=sums[:, 1:])
     rows = np.arange(len(kg))
-    out["velocity change"] = np.where(
-        last > first, sums[rows, last] - sums[rows, np.minimum(first, last)], 0.0) * dt * KG_MS2
+    dv = np.where(last > first, sums[rows, last] - sums[rows, np.minimum(first, last)],
+                  0.0) * dt * KG_MS2
+    recorded_dv = pulse_in & (lo >= lo_t - dt) & (hi <= hi_t + dt)  # to within a sample
+    out["velocity change"] = np.where(recorded_dv, dv, np.nan)
     m_before, m_after = _window_seconds(spec.monitor, reference)
     m_lo, m_hi = onset - m_before, onset + ending + m_after
+    given = spec.origin("monitor") != "default"
+    if not given:  # the tool's default window: what the record holds of it
+        m_lo, m_hi = np.maximum(m_lo, lo_t), np.minimum(m_hi, hi_t)
     out["monitored"] = np.stack([m_lo, m_hi], axis=1)
     if spec.corridor is not None and placed:
         inside = (t[None, :] >= m_lo[:, None]) & (t[None, :] <= m_hi[:, None])
         upper, lower = corridor_limits(spec, t[None, :] - onset[:, None])
         room = np.minimum(upper - kg, kg - lower)
-        out["corridor"] = np.min(np.where(inside, room, np.inf), axis=1) / _nominals(spec)[0]
+        margin = np.min(np.where(inside, room, np.inf), axis=1) / _nominals(spec)[0]
+        judged = pulse_in & (m_lo >= lo_t - dt) & (m_hi <= hi_t + dt)
+        out["corridor"] = np.where(judged, margin, np.nan)
     return out
 
 
@@ -474,13 +506,21 @@ def srs_criterion(t: np.ndarray, kg: np.ndarray, spec: Specification) -> tuple[C
                           f"over it); expected rows from {1 / length:,.3g} Hz, or a longer "
                           "record")
     from .. import limits
+    from .shock import decimated_for
 
-    steps = len(r.frequencies) * len(kg)
-    if steps > limits.MAX_SRS_STEPS:  # the cost, estimated before any is run
+    def cost(samples, step):  # the record and srs()'s rest after it, a filter step each
+        return len(r.frequencies) * (samples + 1.5 / (low * step))
+
+    values, step, factor = np.asarray(kg, dtype=float), dt, 1
+    steps = cost(len(kg), dt)
+    if steps > limits.MAX_SRS_STEPS:  # a fast record: on what its frequencies need
+        values, step, factor = decimated_for(values, dt, top)
+    if cost(len(values), step) > limits.MAX_SRS_STEPS:  # estimated before any is run
         raise OptionError(f"{named}: found {len(r.frequencies):,} rows over the record's "
-                          f"{len(kg):,} samples ({steps:.2g} filter steps), expected at most "
-                          f"{limits.MAX_SRS_STEPS:.2g}: fewer rows, or a shorter record")
-    levels = srs(np.asarray(kg, dtype=float), dt, np.array(r.frequencies), q)
+                          f"{len(kg):,} samples ({steps:.2g} filter steps with the rest after "
+                          f"it), expected at most {limits.MAX_SRS_STEPS:.2g}: fewer rows, or a "
+                          "shorter record")
+    levels = srs(values, step, np.array(r.frequencies), q)
     with np.errstate(divide="ignore"):
         margins = 20 * np.log10(levels / np.array(r.levels_kg))
     inside = within(margins, lower_db, upper_db)
@@ -494,7 +534,9 @@ def srs_criterion(t: np.ndarray, kg: np.ndarray, spec: Specification) -> tuple[C
     names = ", ".join(f"{f:,.0f} Hz ({m:+.2f} dB)" for f, m in
                       zip(np.array(r.frequencies)[~inside], margins[~inside], strict=True))
     detail = (f"{int((~inside).sum())} of {len(margins)} frequencies outside (allowed "
-              f"{allowed})" + (f": {names}" if names else ""))
+              f"{allowed})" + (f": {names}" if names else "") + (
+        f"; on the record decimated 1 in {factor:,} ({1 / step:,.0f} samples a second)"
+        if factor > 1 else ""))
     worst = float(margins[np.argmin(room)])
     return Criterion("SRS", worst, "dB", lower_db, upper_db, margin, "dB", passed,
                      detail + f"; Q {q:g}"), margins
@@ -513,12 +555,15 @@ def _window_words(window: tuple) -> str:
 
 
 def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
-          warnings: list[str] | None = None, record: str | None = None) -> Verdict:
+          warnings: list[str] | None = None, record: str | None = None,
+          recorded: tuple[float, float] | None = None) -> Verdict:
     """The verdict on one pulse ``kg`` [kG] sampled at ``t`` [s] (the record judged: already
-    zeroed and filtered as the specification asks; ``record`` says how, in words)."""
+    zeroed and filtered as the specification asks; ``record`` says how, in words; ``recorded``
+    the span [s] its samples were recorded over, :func:`judge_rows`)."""
     spec = spec.resolved()
-    values = judge_rows(t, kg, spec, refine=True)
+    values = judge_rows(t, kg, spec, refine=True, recorded=recorded)
     row = {k: v[0] for k, v in values.items()}
+    lo_t, hi_t = (float(t[0]), float(t[-1])) if recorded is None else recorded
     criteria = []
     assert spec.dv_window is not None and spec.monitor is not None  # resolved
     definitions = [f"record judged: {record or describe_record(spec)}",
@@ -560,12 +605,64 @@ def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
     verdict.definitions += verdict.sources()
     if not criteria:
         verdict.warnings.append("the specification gives no criterion: nothing was judged")
+    reference = spec.duration.nominal if spec.duration else (
+        row["duration"] if math.isfinite(row["duration"]) else 0.0)
+    ending = (base_duration(spec) if "corridor" in row or spec.shape not in (None, "none")
+              and spec.peak is not None and spec.duration is not None
+              else reference) * (1 + ((spec.decay or 0.0) if spec.shape == "sawtooth" else 0.0))
+    for key, name, (a, b) in (("dv_window", "velocity change", (lo, hi)),
+                              ("monitor", "corridor", (m_lo, m_hi))):
+        judged = "corridor" in row if name == "corridor" else spec.velocity_change is not None
+        if spec.origin(key) != "default" or not judged or not (
+                math.isfinite(a) and math.isfinite(b)):
+            continue
+        wanted = _window_seconds(getattr(spec, key), reference)
+        start, stop = row["onset"] - wanted[0], row["onset"] + ending + wanted[1]
+        if a > start + 1e-12 or b < stop - 1e-12:
+            option = "--dv-window" if key == "dv_window" else "--monitor"
+            verdict.warnings.append(
+                f"{name}: {'integrated' if key == 'dv_window' else 'monitored'} from "
+                f"{a * 1e3:.4f} to {b * 1e3:.4f} ms only, what the record holds of the tool's "
+                f"default window ({start * 1e3:.4f} to {stop * 1e3:.4f} ms, "
+                f"{_window_words(getattr(spec, key))} the pulse): give {option} to judge a "
+                "window of your own")
+    reasons = _unmeasured(row, spec, (lo_t, hi_t))
     for c in criteria:
         if not math.isfinite(c.value):
-            verdict.warnings.append(f"{c.name}: could not be measured on this pulse (it starts"
-                                    " or ends above 10 % of its peak): judged FAIL")
-            c.passed = False
+            why = reasons.get(c.name, "it could not be measured on this pulse")
+            c.passed, c.margin = False, -math.inf
+            c.detail = f"not measurable: {why}" + (f"; {c.detail}" if c.detail else "")
+            verdict.warnings.append(f"{c.name}: not measurable: {why}: judged FAIL")
     return verdict
+
+
+def _span_words(lo: float, hi: float) -> str:
+    return f"{lo * 1e3:.4f} to {hi * 1e3:.4f} ms"
+
+
+def _unmeasured(row: dict, spec: Specification, recorded: tuple[float, float]
+                ) -> dict[str, str]:
+    """Why each criterion :func:`judge_rows` left NaN was not measured, in words."""
+    lo_t, hi_t = recorded
+    span = (f"the record, {_span_words(lo_t, hi_t)}" if math.isfinite(lo_t) else
+            f"the run, which ends at {hi_t * 1e3:.4f} ms")
+    level = f"{DURATION_LEVEL:.0%}"
+    out = {"peak": f"the record's largest sample lies outside {span}",
+           "duration": f"a {level} crossing of the pulse is not inside {span} (it starts or "
+                       f"ends above {level} of its peak)"}
+    lo, hi = row["span"]
+    if math.isfinite(lo) and math.isfinite(hi):
+        out["velocity change"] = (f"its window, {_span_words(lo, hi)}, reaches past {span}")
+    else:
+        out["velocity change"] = "its window could not be placed (no pulse start recorded)"
+    onset = row["onset"]
+    m_lo, m_hi = row["monitored"]
+    if not math.isfinite(onset):
+        out["corridor"] = "the ideal pulse could not be placed"
+    else:
+        out["corridor"] = (f"the ideal pulse placed from {onset * 1e3:.4f} ms or the monitored "
+                           f"window, {_span_words(m_lo, m_hi)}, reaches past {span}")
+    return out
 
 
 # -- the record judged ---------------------------------------------------------------------------
@@ -579,9 +676,9 @@ def describe_record(spec: Specification, duration: float | None = None,
                     dt: float | None = None, quiet: str | None = None) -> str:
     """The record judged, in words, as the verdict prints it; ``quiet`` says why the default
     record needed no low-pass."""
-    if spec.cfc:
-        return f"CFC {spec.cfc} (SAE J211), both ways"
-    if spec.cfc == 0:
+    if spec.judged.cfc:
+        return f"CFC {spec.judged.cfc} (SAE J211), both ways"
+    if spec.judged.is_unfiltered:
         return "unfiltered"
     if quiet:
         return f"unfiltered, the tool's default for a record {quiet} (no record named)"
@@ -618,9 +715,10 @@ def judged_record(t: np.ndarray, kg: np.ndarray, spec: Specification, noise: flo
     from .shock import cfc_filter
 
     kg = np.asarray(kg, dtype=float)
-    if spec.cfc == 0:  # unfiltered: the record as it is
+    record = spec.judged
+    if record.is_unfiltered:  # the record as it is
         return t, kg, describe_record(spec)
-    if spec.cfc is None:
+    if record.is_default:
         peak = float(np.max(kg)) if kg.size else 0.0
         if not math.isfinite(noise):
             return t, kg, describe_record(spec, quiet="whose noise is unknown")
@@ -630,13 +728,17 @@ def judged_record(t: np.ndarray, kg: np.ndarray, spec: Specification, noise: flo
                 f"whose noise at rest, {noise:.3g} kG, is within {NOISE_BOUND:.1%} of its "
                 "peak"))
     dt = float(t[1] - t[0])
-    n = int(round(REST_BEFORE / dt))
     rows = np.atleast_2d(kg)
-    durations = _reference_duration(t, rows, spec) if not spec.cfc else None
+    durations = _reference_duration(t, rows, spec) if not record.cfc else None
+    n = int(round(REST_BEFORE / dt))
+    if n > MAX_PAD:  # a fast record: ten periods of the filter's cut-off lead it in
+        longest = float(np.max(durations)) if durations is not None else 0.0
+        hz = record.cfc * 1.65 if record.cfc else lowpass_hz(spec, longest or math.inf)
+        n = min(n, max(MAX_PAD, int(math.ceil(10 / (hz * dt)))) if hz > 0 else n)
     t = np.concatenate([t[0] - dt * np.arange(n, 0, -1), t])
     padded = np.concatenate([np.zeros(kg.shape[:-1] + (n,)), kg], axis=-1)
-    if spec.cfc:
-        return t, cfc_filter(padded, dt, spec.cfc), describe_record(spec)
+    if record.cfc:
+        return t, cfc_filter(padded, dt, record.cfc), describe_record(spec)
     from scipy.signal import bessel, sosfiltfilt
 
     assert durations is not None
@@ -650,17 +752,32 @@ def judged_record(t: np.ndarray, kg: np.ndarray, spec: Specification, noise: flo
     return t, (out if kg.ndim > 1 else out[0]), words
 
 
-def sampling_checks(dt: float, spec: Specification, what: str) -> list[str]:
+def sampling_checks(dt: float, spec: Specification, what: str, t: np.ndarray | None = None,
+                    kg: np.ndarray | None = None) -> list[str]:
     """Refuse a record with fewer than :data:`MIN_SAMPLES` samples across the nominal
-    duration; warn below :data:`FEW_SAMPLES`, stating the duration's resolution."""
+    duration (naming a probable unit error of its time column where the pulse in ``t``,
+    ``kg`` is as much wider than the nominal as a unit makes it); warn below
+    :data:`FEW_SAMPLES`, stating the duration's resolution."""
     if spec.duration is None:
         return []
     d = spec.duration.nominal
     n = d / dt
     if n < MIN_SAMPLES:
+        hint = ""
+        if t is not None and kg is not None:
+            from .recording_quality import TIME_FACTORS, UNIT_BAND
+
+            body = np.flatnonzero(kg >= DURATION_LEVEL * np.max(kg))
+            width = float(t[body[-1]] - t[body[0]]) if len(body) > 1 else 0.0
+            for factor, words in TIME_FACTORS if width > 0 else ():
+                if abs(math.log(width / d / factor)) < math.log(UNIT_BAND):
+                    hint = (f"; its pulse is {width * 1e3:.4g} ms wide, {width / d:.4g} times "
+                            f"the nominal: a probable unit error of the time column "
+                            f"({words}): check its header or give --time-unit")
+                    break
         raise OptionError(f"{what}: found {1 / dt:,.0f} samples a second, {n:.2g} across the "
                           f"nominal duration {d * 1e3:.4g} ms, expected at least "
-                          f"{MIN_SAMPLES} (a rate of {MIN_SAMPLES / d:,.0f} or more)")
+                          f"{MIN_SAMPLES} (a rate of {MIN_SAMPLES / d:,.0f} or more){hint}")
     if n < FEW_SAMPLES:
         return [f"{what}: {n:.3g} samples across the nominal duration {d * 1e3:.4g} ms "
                 f"({1 / dt:,.0f} a second), fewer than {FEW_SAMPLES}: its crossings are "
@@ -668,18 +785,6 @@ def sampling_checks(dt: float, spec: Specification, what: str) -> list[str]:
                 f"about ±{dt * 1e3:.3g} ms ({100 * dt / d:.0f} % of D); the peak may fall "
                 "between samples"]
     return []
-
-
-def clipped_samples(kg: np.ndarray) -> np.ndarray:
-    """Indices of the record's runs of :data:`CLIPPED_RUN` or more samples at exactly its
-    largest value: a record held at its range, whose peak it cannot show."""
-    kg = np.asarray(kg, dtype=float)
-    at_top = np.flatnonzero(kg == np.max(kg))
-    if len(at_top) < CLIPPED_RUN:
-        return np.array([], dtype=int)
-    runs = np.split(at_top, np.flatnonzero(np.diff(at_top) != 1) + 1)
-    long = [r for r in runs if len(r) >= CLIPPED_RUN]
-    return np.concatenate(long) if long else np.array([], dtype=int)
 
 
 def glitches(kg: np.ndarray, noise: float) -> np.ndarray:
@@ -696,23 +801,31 @@ def glitches(kg: np.ndarray, noise: float) -> np.ndarray:
 
 
 def judge_record(t: np.ndarray, kg: np.ndarray, spec: Specification, what: str,
-                 noise: float = math.nan, warnings: list[str] | None = None) -> Verdict:
+                 noise: float = math.nan, warnings: list[str] | None = None,
+                 quality: RecordingQuality | None = None, prediction: bool = False
+                 ) -> Verdict:
     """The verdict on a recorded or predicted pulse ``kg`` [kG] (zeroed, unfiltered) at
     ``t`` [s], named ``what`` in messages; ``noise`` is its rest's standard deviation [kG]
-    (NaN: unknown). The sampling is checked, a clipped peak fails as not measurable,
-    single-sample glitches are taken out of the default record (and warned either way),
-    and a criterion the noise could move across its limit is warned."""
+    (NaN: unknown). The sampling is checked, single-sample glitches are taken out of the
+    default record (and warned either way), a criterion the noise could move across its
+    limit is warned, and no figure rests on samples that were not recorded (the padding a
+    filter starts from; before a ``prediction``'s first sample it is at rest, known).
+
+    ``quality`` (a recording's, :func:`~.recording_quality.assess`; its findings are
+    already among ``warnings``): a clipped record or one with a dropout inside the pulse
+    measures no criterion (each FAIL, not measurable); one that starts or ends inside the
+    pulse measures no SRS (the spectrum of a pulse cut short)."""
     spec = spec.resolved()
     t = np.asarray(t, dtype=float)
     kg = np.asarray(kg, dtype=float)
     dt = float(t[1] - t[0])
-    said = list(warnings or []) + sampling_checks(dt, spec, what)
-    clipped = clipped_samples(kg)
+    recorded = (-math.inf if prediction else float(t[0]), float(t[-1]))
+    said = list(warnings or []) + sampling_checks(dt, spec, what, t, kg)
     spikes = glitches(kg, noise)
     if len(spikes):
         shown = ", ".join(f"{t[i] * 1e3:.4f} ms ({kg[i]:.4g} kG)" for i in spikes[:5])
         more = f" and {len(spikes) - 5} more" if len(spikes) > 5 else ""
-        if spec.cfc is None:  # the default record: taken out, each by its neighbours' mean
+        if spec.judged.is_default:  # taken out, each by its neighbours' mean
             kg = kg.copy()
             kg[spikes] = 0.5 * (kg[spikes - 1] + kg[np.minimum(spikes + 1, len(kg) - 1)])
             said.append(f"{what}: {len(spikes)} single-sample glitch"
@@ -723,23 +836,22 @@ def judge_record(t: np.ndarray, kg: np.ndarray, spec: Specification, what: str,
                         f"{'es' * (len(spikes) != 1)} at {shown}{more}, kept in the record "
                         f"judged ({describe_record(spec)}, as the specification names it): "
                         "it may lift the peak")
-    if spec.cfc is None and not math.isfinite(noise):
+    if spec.judged.is_default and not math.isfinite(noise):
         said.append(f"{what}: its noise is unknown (no record at rest before or after the "
                     "pulse), so it is judged unfiltered: noise would lift its peak; name the "
-                    "record judged (--record) to filter it")
+                    "record judged (--cfc) to filter it")
     tj, kj, words = judged_record(t, kg, spec, noise)
-    verdict = judge(tj, kj, spec, said, record=words)
+    verdict = judge(tj, kj, spec, said, record=words, recorded=recorded)
     verdict.record = (tj, kj)
-    if len(clipped):
-        for c in verdict.criteria:
-            if c.name == "peak":
-                c.passed, c.detail = False, "not measurable: the record is clipped"
-                c.value, c.margin = math.nan, -math.inf
-        verdict.warnings.append(
-            f"{what}: clipped: {len(clipped)} samples from {t[clipped[0]] * 1e3:.4f} to "
-            f"{t[clipped[-1]] * 1e3:.4f} ms sit at exactly its largest value, "
-            f"{kg[clipped[0]]:.6g} kG (the recorder's range): the peak is not measurable "
-            "and judged FAIL")
+    verdict.quality = quality
+    damaged = quality.damaged if quality is not None else None
+    cut = quality is not None and (quality.starts_inside or quality.ends_inside)
+    for c in verdict.criteria:
+        why = damaged or ("the record starts or ends inside the pulse: the spectrum of a "
+                          "pulse cut short" if cut and c.name == "SRS" else None)
+        if why and math.isfinite(c.value):
+            c.passed, c.value, c.margin = False, math.nan, -math.inf
+            c.detail = f"not measurable: {why}"
     if math.isfinite(noise) and noise > 0:
         verdict.warnings += noise_could_flip(verdict, tj, kj, spec, noise, what)
     return verdict
@@ -751,10 +863,11 @@ def noise_could_flip(verdict: Verdict, t: np.ndarray, kg: np.ndarray, spec: Spec
     could move across a limit: within :data:`NOISE_FLIP_SIGMAS` of its effect on each."""
     dt = float(t[1] - t[0])
     peak = float(np.max(kg))
-    if spec.cfc == 0 or (spec.cfc is None and noise <= NOISE_BOUND * peak):
+    record = spec.judged
+    if record.is_unfiltered or (record.is_default and noise <= NOISE_BOUND * peak):
         hz = None  # judged as it is
     else:  # J211's -3 dB point is 1.65 x its class; the low-pass's is its cut-off
-        hz = spec.cfc * 1.65 if spec.cfc else lowpass_hz(
+        hz = record.cfc * 1.65 if record.cfc else lowpass_hz(
             spec, float(_reference_duration(t, np.atleast_2d(kg), spec)[0]) or math.inf)
     sigma = noise * math.sqrt(min(1.0, 2 * hz * dt)) if hz else noise  # after the filter
     slope = np.abs(np.gradient(kg, dt))
@@ -794,14 +907,42 @@ def predicted_verdict(result, spec: Specification) -> Verdict:
     ok = np.isfinite(result.accel_kg)
     t, kg = result.history.time[ok], result.accel_kg[ok]
     warnings: list[str] = []
-    if spec.cfc:
+    if spec.judged.cfc:
         try:
-            warnings += check_cfc(spec.cfc, float(t[1] - t[0]))
+            warnings += check_cfc(spec.judged.cfc, float(t[1] - t[0]))
         except OptionError as exc:
-            raise OptionError(f"the specification's record (CFC {spec.cfc}): {exc}") from None
-    verdict = judge_record(t, kg, spec, "the predicted pulse", noise=0.0, warnings=warnings)
+            raise OptionError(f"the specification's record (CFC {spec.judged.cfc}): {exc}"
+                              ) from None
+    verdict = judge_record(t, kg, spec, "the predicted pulse", noise=0.0, warnings=warnings,
+                           prediction=True)
     verdict.definitions.insert(0, "judged: the predicted pulse (the test item's acceleration)")
     return verdict
+
+
+#: accept runs the shot's prediction, to tell a recording's unit error, up to this many rows
+#: (about a second); past it the specification's nominals alone are its reference.
+PREDICTION_ROWS = 2_000_000
+
+
+def expectations(shot, spec: Specification) -> tuple[list[Expected], list[str]]:
+    """What a recording judged against ``spec`` for ``shot`` is expected to show (to tell a
+    probable unit error): the specification's nominals, and the shot's prediction where it
+    runs in :data:`PREDICTION_ROWS` rows or fewer; and a note for what was not used."""
+    out, notes = [], []
+    if not spec.empty:
+        out.append(Expected(spec.peak.nominal if spec.peak else None,
+                            spec.duration.nominal if spec.duration else None,
+                            spec.velocity_change.nominal if spec.velocity_change else None,
+                            "the specification's nominal"))
+    rows = shot.params.rows
+    if rows <= PREDICTION_ROWS:
+        result = shot.run(track=())
+        out.append(Expected.of_pulse(result.history.time, result.accel_kg))
+    else:
+        notes.append(f"the shot's prediction was not run to check the recording's units "
+                     f"({rows:,} rows, over {PREDICTION_ROWS:,}): the specification's "
+                     "nominals alone were")
+    return out, notes
 
 
 def pass_flags(values: dict[str, np.ndarray], spec: Specification) -> dict[str, np.ndarray]:
@@ -832,8 +973,9 @@ class BlockJudge:
 
     def __call__(self, t: np.ndarray, kg: np.ndarray) -> np.ndarray:
         spec = self.spec.resolved()
+        last = float(t[-1])  # a prediction: at rest before its first sample, known
         t, kg, _ = judged_record(t, kg, spec)
-        values = judge_rows(t, kg, spec)
+        values = judge_rows(t, kg, spec, recorded=(-math.inf, last))
         return np.column_stack([values.get(name, np.full(len(kg), np.nan))
                                 for name in BLOCK_VALUES])
 

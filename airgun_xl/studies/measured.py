@@ -16,7 +16,17 @@ import numpy as np
 from .. import limits, units
 from ..engine.summary import pulse
 from ..errors import OptionError
+from .recording_quality import (
+    MIN_PRE_SAMPLES,
+    Baseline,
+    Expected,
+    RecordingQuality,
+    assess,
+    baseline,
+)
 from .shock import cfc_filter
+
+__all__ = ["Baseline", "baseline"]  # the rest and noise, read with the recording's quality
 
 #: The impact instant: the first sample at or above this fraction of the trace's peak.
 IMPACT_FRACTION = 0.05
@@ -70,14 +80,6 @@ class Comparison:
 #: the impact, and filtfilt's own edge padding (an odd reflection) would bend the rise.
 REST_BEFORE = 2e-3
 
-#: The pre-trigger record: the samples before the pulse first passes this fraction of its
-#: excursion from the record's opening median, less :data:`PRE_GUARD` [s] for the rise.
-PULSE_EDGE = 0.25
-PRE_GUARD = 1e-4
-
-#: Fewest pre-trigger samples that give a baseline and a noise level.
-MIN_PRE_SAMPLES = 16
-
 #: The impact level is at least this many standard deviations of the pre-trigger noise (after
 #: the filter), so noise alone does not trigger it: 5 sigma is passed by chance once in 3.5
 #: million samples.
@@ -98,108 +100,6 @@ AGREE_SAMPLES = 2
 ANTI_ALIAS_ORDER = 4
 ANTI_ALIAS_FRACTION = 0.2
 
-
-#: A stretch of record is at rest when a straight line through it rises by no more than this
-#: fraction of the pulse's excursion, or than :data:`REST_SIGMAS` standard errors of such a
-#: line through its own noise (a pulse's rise or tail is not a baseline).
-REST_DRIFT, REST_SIGMAS = 0.02, 4.0
-
-#: After the pulse, a stretch is at rest only if its spread is noise, not the item ringing:
-#: within this factor of its sample-to-sample noise (from its second differences, which a
-#: ringing many samples long hardly has).
-REST_WHITE = 2.0
-
-
-@dataclass
-class Baseline:
-    """The recording's zero and noise, from where it is at rest: before the pulse, or (with
-    no quiet pre-trigger) after it.
-
-    Attributes
-    ----------
-    offset : float
-        Median of the samples at rest [kG], removed from the recording (0 without any).
-    noise : float
-        Their standard deviation about it [kG] (NaN without a record at rest).
-    samples : int
-        Samples at rest used.
-    where : str
-        "before" or "after" the pulse, or "none".
-    start : int
-        Index of the first of them.
-    """
-
-    offset: float
-    noise: float
-    samples: int
-    where: str = "before"
-    start: int = 0
-
-    def words(self) -> str:
-        """The baseline as a verdict or a comparison prints it."""
-        if self.where == "none":
-            return ("no record at rest before or after the pulse: offset taken as 0, noise "
-                    "unknown")
-        return (f"{self.offset:.4g} kG removed, noise {self.noise:.3g} kG (1 sigma): "
-                f"{self.samples:,} samples at rest {self.where} the pulse")
-
-
-def _at_rest(segment, excursion, white=False):
-    """How many samples of ``segment`` from its start (``segment`` reversed: from its end)
-    are at rest: the stretch is cut by a fifth until a line through it stays flat
-    (:data:`REST_DRIFT`, :data:`REST_SIGMAS`) and, with ``white``, its spread is its
-    sample-to-sample noise (:data:`REST_WHITE`)."""
-    n = len(segment)
-    while n >= MIN_PRE_SAMPLES:
-        part = segment[:n]
-        x = np.arange(n, dtype=float)
-        slope, intercept = np.polyfit(x, part, 1)
-        resid = float(np.std(part - (slope * x + intercept)))
-        rise = abs(slope) * (n - 1)
-        flat = rise <= max(REST_DRIFT * excursion, REST_SIGMAS * resid * math.sqrt(12.0 / n))
-        if flat and (not white or resid <= REST_WHITE * _sample_noise(part)):
-            return n
-        n = int(n * 0.8)
-    return 0
-
-
-def _sample_noise(part):
-    """The sample-to-sample noise of a stretch (1 sigma): its second differences' median
-    absolute deviation, scaled for white noise (their variance is 6 sigma^2)."""
-    d2 = np.diff(part, 2)
-    return 1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / math.sqrt(6.0)
-
-
-def baseline(accel, dt):
-    """The :class:`Baseline` of a recording (``accel`` [kG] at step ``dt`` [s]): the samples
-    at rest before its pulse, else those after it; with neither, offset 0 and noise NaN."""
-    accel = np.asarray(accel, dtype=float)
-    # the level at rest: the median of the quieter end (a record may start in its pulse)
-    m = max(MIN_PRE_SAMPLES, len(accel) // 10)
-    ends = [accel[:m], accel[-m:]]
-    opening = float(np.median(min(ends, key=lambda e: float(np.std(e)))))
-    excursion = accel - opening
-    top = float(np.max(np.abs(excursion))) if len(accel) else 0.0
-    above = np.flatnonzero(np.abs(excursion) >= PULSE_EDGE * top) if top > 0 else \
-        np.array([], dtype=int)
-    if len(above) == 0:
-        return Baseline(0.0, np.nan, 0, "none")
-    guard = int(round(PRE_GUARD / dt))
-    end = int(above[0]) - guard
-    quiet = _at_rest(accel[:max(end, 0)], top)
-    if quiet >= MIN_PRE_SAMPLES:
-        pre = accel[:quiet]
-        offset = float(np.median(pre))
-        return Baseline(offset, float(np.std(pre - offset)), quiet, "before", 0)
-    start = int(above[-1]) + 1 + guard
-    tail = accel[start:]
-    quiet = _at_rest(tail[::-1], top, white=True)
-    if quiet >= MIN_PRE_SAMPLES:
-        post = accel[len(accel) - quiet:]
-        offset = float(np.median(post))
-        return Baseline(offset, float(np.std(post - offset)), quiet, "after",
-                        len(accel) - quiet)
-    return Baseline(0.0, np.nan, max(end, 0), "none")
 
 
 def anti_aliased(time, values, hz):
@@ -278,11 +178,15 @@ class Recording:
     cfc: object
     warnings: list = field(default_factory=list)
     anti_alias: float | None = None  # [Hz] modelled on the prediction, or None
+    quality: RecordingQuality | None = None  # what the record says about itself
 
 
-def prepare(trace, cfc=None, anti_alias=None, dt_model=None):
+def prepare(trace, cfc=None, anti_alias=None, dt_model=None, flat_top=False, expected=None,
+            nominal_duration=None):
     """Zero, check and filter a recording; the impact level above its noise; the anti-alias
-    frequency to model on predictions of step ``dt_model`` (:func:`check_anti_alias`).
+    frequency to model on predictions of step ``dt_model`` (:func:`check_anti_alias`). The
+    recording's quality is read once here (:func:`~.recording_quality.assess`, with
+    ``flat_top``, ``expected`` and ``nominal_duration``), its findings among the warnings.
 
     Raises
     ------
@@ -300,7 +204,9 @@ def prepare(trace, cfc=None, anti_alias=None, dt_model=None):
                           f"{float(trace.time[k]) * 1e3:.4f} ms ({len(huge):,} such sample"
                           f"{'s' * (len(huge) != 1)}), expected a recording within "
                           f"±{limits.MAX_RECORD_KG:.0e} kG (a recorder's range)")
-    base = baseline(trace.accel_kg, trace.dt)
+    quality = assess(trace.time, trace.accel_kg, trace.name, flat_top, expected,
+                     nominal_duration)
+    base = quality.base
     if base.where == "none":
         warnings.append(f"{trace.name}: no {MIN_PRE_SAMPLES} samples at rest before or after "
                         "the pulse: no baseline (offset taken as 0) and the noise unknown; "
@@ -335,7 +241,7 @@ def prepare(trace, cfc=None, anti_alias=None, dt_model=None):
     sustain = max(3, int(round(SUSTAIN / trace.dt)))
     hz = check_anti_alias(anti_alias, dt_model or trace.dt, trace.dt)
     return Recording(trace, corrected, filtered, base, noise, fraction, sustain, cfc,
-                     warnings, hz)
+                     warnings + quality.warnings, hz, quality)
 
 
 def check_prediction(pred_kg):
@@ -437,7 +343,8 @@ def compare(pred_time, pred_kg, trace, cfc=None, alignment="threshold", rigid=No
     if alignment not in ALIGNMENTS:
         raise OptionError(f"--align: found {alignment!r}, expected one of "
                           f"{', '.join(ALIGNMENTS)}")
-    rec = prepare(trace, cfc, anti_alias, float(pred_time[1] - pred_time[0]))
+    rec = prepare(trace, cfc, anti_alias, float(pred_time[1] - pred_time[0]),
+                  expected=Expected.of_pulse(pred_time, pred_kg))
     hz = rec.anti_alias
     shift, impact_pred, shifts, said = alignment_shift(pred_time, pred_kg, rec, alignment)
     time = trace.time + shift

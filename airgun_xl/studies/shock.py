@@ -172,3 +172,33 @@ def srs(values, dt, frequencies, q=DEFAULT_Q):
         b, a = smallwood_coefficients(fn, dt, q)
         out[i] = np.max(np.abs(lfilter(b, a, x)))
     return out
+
+
+#: A record decimated for a spectrum keeps this many samples a period of its highest
+#: frequency (four times the tenth of the rate :func:`srs` asks for: a pulse far shorter than
+#: a period then keeps its SRS there to 0.5 %, as tests/test_recording_quality.py measures).
+SPECTRUM_SAMPLES_PER_PERIOD = 40
+
+
+#: Samples of the decimated record added at rest each side (resample_poly's filter reaches
+#: 10 of them), so a record shorter than a decimated step still has a pulse to show.
+DECIMATION_REST = 16
+
+
+def decimated_for(values, dt, top):
+    """``values`` at step ``dt`` [s] decimated to what a spectrum up to ``top`` [Hz] needs:
+    (values, step [s], factor). The factor is the largest whole one keeping
+    :data:`SPECTRUM_SAMPLES_PER_PERIOD` samples a period of ``top`` (1: unchanged); the
+    low-pass before it is scipy's polyphase FIR (resample_poly, a Kaiser window), whose gain
+    at zero frequency is 1, so the record's integral (its velocity change) is kept; the
+    record is taken as at rest beyond its ends (:data:`DECIMATION_REST` decimated samples
+    of rest are added each side)."""
+    values = np.asarray(values, dtype=float)
+    factor = int(1 / (SPECTRUM_SAMPLES_PER_PERIOD * top * dt))
+    if factor < 2:
+        return values, dt, 1
+    from scipy.signal import resample_poly
+
+    rest = np.zeros(DECIMATION_REST * factor)  # the filter's reach, at rest, each side
+    out = resample_poly(np.concatenate([rest, values, rest]), 1, factor, padtype="constant")
+    return out, dt * factor, factor
