@@ -25,9 +25,17 @@ def setup():
     return shot, truth
 
 
-def recordings(shot, changes, seed, shots=tuple(zip(SPEEDS, RATES, strict=True))):
+#: The noise of the recorder model's recordings: white (3 % of the peak, the trust tests'),
+#: and the same variance half white and half an AR(1) of 0.6, or all an AR(1) of 0.8.
+NOISES = {"white": {}, "ar0.6": {"colour": 0.6, "colour_share": 0.5},
+          "ar0.8": {"colour": 0.8, "colour_share": 1.0}}
+
+
+def recordings(shot, changes, seed, shots=tuple(zip(SPEEDS, RATES, strict=True)),
+               noise="white"):
     """Each (speed, rate)'s run with ``changes`` through the recorder model (seed + its
-    index), read with the recorder's axis reversed (as --sign -1)."""
+    index, noise as :data:`NOISES` names it), read with the recorder's axis reversed (as
+    --sign -1)."""
     import airgun_xl
     from airgun_xl.readers.recording import Trace
     from airgun_xl.studies.recorder import Recorder
@@ -35,26 +43,60 @@ def recordings(shot, changes, seed, shots=tuple(zip(SPEEDS, RATES, strict=True))
     out = []
     for i, (v, rate) in enumerate(shots):
         run = airgun_xl.Shot(shot.replace(v31=v, v32=v, v33=v, **changes)).run(track=())
-        trace = Recorder(rate=rate).record(run, seed=seed + i)
+        trace = Recorder(rate=rate, **NOISES[noise]).record(run, seed=seed + i)
         out.append(Trace(trace.time, -trace.accel_kg, trace.dt, f"s{i}", trace.units))
     return out
 
 
 def one_seed(job):
-    """``job`` = (what, cfc, seed): "law" (the law from the macro's, as the trust test) or
-    "E40" (sigma_y x 1.07 and zeta 0.04 in the shots, E40 fitted alone, as the trust
-    test). Returns (estimates, truths, standard errors, nodes or None)."""
+    """``job`` = (what, cfc, seed[, noise]): "law" (the law from the macro's, as the trust
+    test) or "E40" (sigma_y x 1.07 and zeta 0.04 in the shots, E40 fitted alone, as the
+    trust test); the noise a :data:`NOISES` key (white by default). Returns (estimates,
+    truths, standard errors, nodes or None, each node weakly pinned or None)."""
     from airgun_xl.studies.calibrate import calibrate
 
-    what, cfc, seed = job
+    what, cfc, seed, *rest = job
+    noise = rest[0] if rest else "white"
     shot, truth = setup()
     starts = [shot.replace(v31=v, v32=v, v33=v) for v in SPEEDS]
     if what == "law":
-        cal = calibrate(starts, recordings(shot, {"crush_law": truth}, seed), law=True,
-                        cfc=cfc)
+        cal = calibrate(starts, recordings(shot, {"crush_law": truth}, seed, noise=noise),
+                        law=True, cfc=cfc)
         nodes = np.asarray(cal.law_nodes)
-        return cal.params[0].crush_law(nodes), truth(nodes), np.asarray(cal.law_errors), nodes
+        return (cal.params[0].crush_law(nodes), truth(nodes), np.asarray(cal.law_errors),
+                nodes, np.array([n.weak for n in cal.law_intervals]))
     changes = {"sigmay": shot.sigmay * 1.07, "zeta": 0.04}
-    cal = calibrate(starts, recordings(shot, changes, seed), law=False, fit=["E40"], cfc=cfc)
+    cal = calibrate(starts, recordings(shot, changes, seed, noise=noise), law=False,
+                    fit=["E40"], cfc=cfc)
     return (np.array([cal.fitted["E40"]]), np.array([changes["sigmay"]]),
-            np.array([cal.errors["E40"]]), None)
+            np.array([cal.errors["E40"]]), None, None)
+
+
+def main():
+    """Print each study's coverage at each node, and its weak flags' rate, over 200 seeds
+    (what tests/test_calibration_intervals.py asserts; docs/studies.md quotes it)."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from airgun_xl.studies.calibrate import Z95
+
+    studies = (("law", None, "white"), ("law", None, "ar0.6"), ("law", None, "ar0.8"),
+               ("law", 600, "ar0.8"), ("E40", None, "white"), ("E40", None, "ar0.8"))
+    jobs = [(w, c, 1000 * s, n) for w, c, n in studies for s in range(200)]
+    with ProcessPoolExecutor(2, multiprocessing.get_context("spawn")) as pool:
+        results = list(pool.map(one_seed, jobs, chunksize=8))
+    for k, study in enumerate(studies):
+        rows = results[200 * k:200 * (k + 1)]
+        est, truth, err = (np.array([r[i] for r in rows]) for i in range(3))
+        hits = (np.abs(est - truth) <= Z95 * err).sum(axis=0)
+        weak = np.array([r[4] for r in rows]).mean(axis=0) if rows[0][4] is not None else None
+        print(study, "hits", hits.tolist(), "weak", None if weak is None else
+              np.round(100 * weak).astype(int).tolist())
+
+
+if __name__ == "__main__":
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    main()
