@@ -76,6 +76,10 @@ SCHEMAS: dict[str, dict] = {
                        "tolerances": _TEXTS, "definitions": _TEXTS, "specification": _TEXT,
                        "notes": _TEXTS, "warnings": _TEXTS, "recording": _TEXT,
                        "recording_sha256": {"type": ["string", "null"]}, "report": _TEXT,
+                       "recording_read": {"type": ["object", "null"],
+                                          "additionalProperties": _TEXT,
+                                          "description": "what the recording said of "
+                                                         "itself, text by label"},
                        "created": _TEXT, "command": _TEXTS}},
     "summary": {
         "type": "object", "description": "an entry's figures",

@@ -315,6 +315,8 @@ def test_the_verdict_goes_into_the_archive(tmp_path, recording, capsys):
         "peak", "duration"]
     assert record["recording_sha256"] == hashlib.sha256(recording.read_bytes()).hexdigest()
     assert record["tolerances"][0].startswith("peak: 8.55 to 10.45 kG")
+    read = record["recording_read"]  # what the recording said of itself (issue 42)
+    assert read["Rate"].startswith("50,000 samples a second") and read["Clipping"] == "none seen"
     capsys.readouterr()
     assert main(["history", "--archive", str(archive)]) == 0
     assert "verdicts (accept --archive):" in capsys.readouterr().out

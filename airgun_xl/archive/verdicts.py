@@ -37,6 +37,9 @@ def verdict_record(verdict, shot, recording, report, command=()):
             "tolerances": verdict.tolerances(), "definitions": verdict.definitions,
             "specification": verdict.spec.source, "notes": list(verdict.spec.notes),
             "warnings": list(verdict.warnings), "recording": str(recording),
+            "recording_read": dict(verdict.quality.block(
+                verdict.spec.duration.nominal if verdict.spec.duration else None))
+            if verdict.quality is not None else None,
             "recording_sha256": digest, "report": str(report),
             "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
             "command": list(command)}
