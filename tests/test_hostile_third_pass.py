@@ -51,8 +51,8 @@ def test_32_1_a_law_folder_that_links_out_of_the_archive_is_refused(tmp_path):
     law(root, "OTHER")  # the archive exists
     outside.mkdir()
     (root / ".laws" / "LOT").symlink_to(outside, target_is_directory=True)
-    with pytest.raises(ArchiveError, match=r"LOT: is a link, expected the law inside the "
-                                           r"archive"):
+    with pytest.raises(ArchiveError, match=r"LOT: is a link to .*outside, expected the law "
+                                           r"inside the archive"):
         law(root)
     assert list(outside.iterdir()) == []
 
@@ -226,7 +226,8 @@ def test_32_7_show_refuses_an_edited_summary_and_history_flags_it(entry, capsys,
     try:
         summary.write_text(json.dumps(EDITS[name](json.loads(kept))))
         code = main(["show", "shot@1", "--archive", str(root)])
-        one_line(capsys, code, "shot@1: summary.json: ")
+        # refused as verify reports it (issue 43): altered, before its schema is read
+        one_line(capsys, code, "shot@1: summary.json altered (SHA-256 differs)")
         assert main(["history", "--archive", str(root)]) == 0
         assert "unreadable: shot@1: summary.json" in capsys.readouterr().out
     finally:
@@ -241,7 +242,7 @@ def test_32_5_a_summary_that_links_to_dev_zero_is_refused(entry, capsys):
     try:
         summary.symlink_to("/dev/zero")
         code = main(["show", "shot@1", "--archive", str(root)])
-        one_line(capsys, code, "summary.json is a link")
+        one_line(capsys, code, "summary.json is a link to /dev/zero")
     finally:
         summary.unlink()
         summary.write_bytes(kept)

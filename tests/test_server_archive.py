@@ -86,10 +86,20 @@ def _history(root, capsys):
     return [{k: r.get(k) for k in keep} for r in rows]
 
 
+def _local(root, monkeypatch):
+    """An SQLite archive made at ``root`` with $AIRGUN_XL_INDEX unset for the moment (with it
+    set, a command refuses to make a local index: issue 43.14)."""
+    with monkeypatch.context() as m:
+        m.delenv("AIRGUN_XL_INDEX")
+        Archive(root, create=True)
+    return root
+
+
 def test_fill_history_show_and_verify_work_unchanged_and_agree_with_sqlite(tmp_path, capsys,
-                                                                           server_env):
+                                                                           server_env,
+                                                                           monkeypatch):
     server = _init(tmp_path, capsys)
-    local = tmp_path / "local"
+    local = _local(tmp_path / "local", monkeypatch)
     for root in (server, local):
         for k, extra in enumerate(([], ["--integrator", "newmark"])):
             out = tmp_path / f"o{k}.xlsx"
@@ -263,10 +273,11 @@ def _history_rows(root, capsys):
     return json.loads(capsys.readouterr().out)
 
 
-def test_migrate_moves_the_index_and_history_reads_the_same(tmp_path, capsys, server_env):
+def test_migrate_moves_the_index_and_history_reads_the_same(tmp_path, capsys, server_env,
+                                                            monkeypatch):
     """An SQLite archive of three runs moved to the server: history is the same, ids
     included; the SQLite index is kept as a backup; the next fill goes to the server."""
-    root = tmp_path / "local"
+    root = _local(tmp_path / "local", monkeypatch)
     for extra in ([], ["--integrator", "newmark"], ["--name", "other"]):
         assert main(["fill", str(TEMPLATE), "-o", str(tmp_path / "o.xlsx"), "--force",
                      "--archive", str(root), "--only", "summary", *extra]) == 0
@@ -291,8 +302,8 @@ def test_migrate_moves_the_index_and_history_reads_the_same(tmp_path, capsys, se
 
 
 def test_migrate_refuses_a_row_that_does_not_match_its_manifest_and_moves_nothing(
-        tmp_path, capsys, server_env):
-    root = tmp_path / "local"
+        tmp_path, capsys, server_env, monkeypatch):
+    root = _local(tmp_path / "local", monkeypatch)
     archive = Archive(root, create=True)
     note = tmp_path / "n.txt"
     note.write_text("x")
@@ -307,12 +318,12 @@ def test_migrate_refuses_a_row_that_does_not_match_its_manifest_and_moves_nothin
 
 
 def test_a_writer_that_waited_on_the_lock_through_a_migrate_stops_and_publishes_nothing(
-        tmp_path, server_env):
+        tmp_path, server_env, monkeypatch):
     """Writers are kept out: one that held its scratch folder and waited for the SQLite lock
     while the index moved finds the marker changed, stops in one line, and leaves nothing."""
     from airgun_xl.errors import ArchiveError
 
-    root = tmp_path / "local"
+    root = _local(tmp_path / "local", monkeypatch)
     archive = Archive(root, create=True)
     archive.add("a", {}, {"summary.json": {}}, {})
     pending = archive.prepare("a", {}, {"summary.json": {"late": True}}, {})
@@ -417,7 +428,8 @@ def test_a_share_that_turns_read_only_is_one_line_and_publishes_nothing(
     real = os.mkdir if stage == "scratch" else os.rename
 
     def read_only(src, *args, **kwargs):
-        if ".airgun-xl-scratch" in str(src):
+        # the entry's rename is made between folder descriptors (src_dir_fd: the scratch)
+        if ".airgun-xl-scratch" in str(src) or kwargs.get("src_dir_fd") is not None:
             raise OSError(errno.EROFS, os.strerror(errno.EROFS), str(src))
         return real(src, *args, **kwargs)
 

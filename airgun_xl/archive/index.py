@@ -104,17 +104,136 @@ class Session:
         raise NotImplementedError
 
 
-def _filters(shot, since, mark):
-    """The history's filters as SQL (`` AND shot = ?``...) with their values as parameters;
-    ``mark`` is the driver's placeholder (``?`` or ``%s``)."""
-    where, args = "", []
-    if shot:
-        where += f" AND shot = {mark}"
-        args.append(shot)
-    if since:
-        where += f" AND created >= {mark}"
-        args.append(since)
-    return where, args
+def _filters(shot, mark):
+    """The history's shot filter as SQL (`` AND shot = ?``) with its value as a parameter;
+    ``mark`` is the driver's placeholder (``?`` or ``%s``). The date filter is applied to the
+    rows read, as dates (:func:`since_filter`): compared as text, ``not-a-date`` sorts after
+    every date."""
+    return (f" AND shot = {mark}", [shot]) if shot else ("", [])
+
+
+# -- the rows, read as untrusted ----------------------------------------------------------------
+
+#: The longest text a column of a row may hold [characters] (a shot name is at most 100, a
+#: path 110, a date 40, a hash 64): past it the row is refused, and the server sends no more
+#: than this of it (``left()``), so a row of 280 MB costs no memory.
+TEXT_CAP = 1000
+
+#: The highest version an archive numbers (its folders are ``v0001`` ... ``v999999``).
+MAX_VERSION = 999_999
+
+#: What each column of a row must hold: "id" (a whole number), "version" (1 to MAX_VERSION),
+#: "text", "date" (ISO 8601), "real" (a finite number); "?" where it may be empty (NULL).
+ROW_TYPES = {"id": "id", "shot": "text", "version": "version", "path": "text",
+             "created": "date", "input_sha256": "text?", "v0": "real?", "delta": "real?",
+             "max_time": "real?", "sigmay": "real?", "rcone": "real?", "peak_kg": "real?",
+             "integrator": "text?", "model": "text?", "engine": "text?"}
+
+
+def _shown(value):
+    """A value as a message quotes it: its repr, cut to 40 characters."""
+    text = repr(value)
+    return text if len(text) <= 40 else f"{text[:30]}... ({len(text):,} characters)"
+
+
+def checked_row(raw, label):
+    """A row of the index as untrusted data: each column of :data:`ROW_TYPES` converted to
+    its type (from the value, or from text as the server sends it) and checked; the parsed
+    creation date under ``_created``.
+
+    Raises
+    ------
+    ArchiveError
+        One line naming the row, the column, what it holds and what is expected.
+    """
+    import datetime
+    import math
+
+    out: dict[str, Any] = {}
+    ident = raw.get("id")
+    shown = ident if isinstance(ident, (int, str)) and len(str(ident)) < 25 else "?"
+    name = f"{label}: row #{shown}"
+    for column, declared in ROW_TYPES.items():
+        value = raw.get(column)
+        optional = declared.endswith("?")
+        kind = declared.rstrip("?")
+        if value is None:
+            if optional:
+                out[column] = None
+                continue
+            raise ArchiveError(f"{name}: {column}: found none (NULL), expected "
+                               f"{_EXPECTED[kind]}")
+        try:
+            if kind in ("id", "version"):
+                if isinstance(value, bool) or isinstance(value, float):
+                    raise ValueError
+                whole = int(value) if isinstance(value, int) else int(str(value), 10)
+                low, high = (1, MAX_VERSION) if kind == "version" else (0, 2 ** 63 - 1)
+                if not low <= whole <= high:
+                    raise ValueError
+                out[column] = whole
+            elif kind == "real":
+                if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+                    raise ValueError
+                number = float(value)
+                if not math.isfinite(number):
+                    raise ValueError
+                out[column] = number
+            else:
+                if not isinstance(value, str) or len(value) > TEXT_CAP or not value:
+                    raise ValueError
+                if kind == "date":
+                    stamp = datetime.datetime.fromisoformat(value)
+                    if stamp.tzinfo is None:
+                        stamp = stamp.replace(tzinfo=datetime.UTC)
+                    out["_created"] = stamp
+                out[column] = value
+        except (ValueError, TypeError, OverflowError):
+            raise ArchiveError(f"{name}: {column}: found {_shown(value)}, expected "
+                               f"{_EXPECTED[kind]}") from None
+    return out
+
+
+_EXPECTED = {"id": "a whole number", "version": f"a whole number from 1 to {MAX_VERSION:,}",
+             "text": f"text of 1 to {TEXT_CAP:,} characters",
+             "date": "an ISO 8601 date, such as 2026-11-26T14:00:00+00:00",
+             "real": "a finite number"}
+
+
+def since_filter(rows, since):
+    """The rows created on or after ``since`` (an ISO date or date and time; UTC unless it
+    says), compared as dates."""
+    if not since:
+        return rows
+    import datetime
+
+    start = datetime.datetime.fromisoformat(str(since))
+    if start.tzinfo is None:
+        start = start.replace(tzinfo=datetime.UTC)
+    return [r for r in rows if r["_created"] >= start]
+
+
+def ordered(rows, order):
+    """``rows`` sorted by the columns ``order`` names (``created, shot, version``), as their
+    types compare (a version as a number, a date as a date), the id last."""
+    names = [n.strip() for n in order.split(",")]
+    found = sorted(rows, key=lambda r: tuple(r["_created"] if n == "created" else r[n]
+                                             for n in names) + (r["id"],))
+    return [{k: v for k, v in r.items() if k != "_created"} for r in found]
+
+
+def checked_rows(raw_rows, label, bad=None):
+    """:func:`checked_row` of each row; a bad row raises, or with ``bad`` (a list) is added
+    to it, as its message, and left out."""
+    out = []
+    for raw in raw_rows:
+        try:
+            out.append(checked_row(raw, label))
+        except ArchiveError as exc:
+            if bad is None:
+                raise
+            bad.append(str(exc))
+    return out
 
 
 # -- SQLite ------------------------------------------------------------------------------------
@@ -153,17 +272,55 @@ def is_sqlite_index(path):
     return row is not None
 
 
+#: The columns as SQLite reads them: a number as it is, anything else as at most TEXT_CAP + 1
+#: characters of text (a column may hold any type in SQLite, a blob of 280 MB included).
+_SQLITE_COLUMNS = ", ".join(
+    f"CASE WHEN typeof({c}) IN ('integer', 'real', 'null') THEN {c} ELSE "
+    f"substr(CAST({c} AS TEXT), 1, {TEXT_CAP + 1}) END AS {c}" for c in ("id", *COLUMNS))
+
+
+#: An index.sqlite larger than this [bytes] may hold a value too large to read whole: its
+#: text and blob values are measured first (:func:`_oversized`). Below it, no value can cost
+#: more memory than the file's size.
+BIG_INDEX = 64 * 2 ** 20
+
+
+def _oversized(conn, path):
+    """``(rowid, column, bytes)`` of each text or blob value of ``entries`` longer than a
+    column may be (4 bytes a character of :data:`TEXT_CAP`), measured without reading it
+    (incremental blob I/O: its size only); none for an index under :data:`BIG_INDEX`."""
+    try:
+        if os.path.getsize(path) <= BIG_INDEX:
+            return []
+    except OSError:
+        return []
+    names = ("id", *COLUMNS)
+    found = []
+    kinds = conn.execute(f"SELECT rowid, {', '.join(f'typeof({c})' for c in names)} "
+                         "FROM entries").fetchall()
+    for row in kinds:
+        rowid = row[0]
+        for column, kind in zip(names, tuple(row)[1:], strict=True):
+            if kind in ("text", "blob"):
+                with conn.blobopen("entries", column, rowid, readonly=True) as blob:
+                    size = len(blob)
+                if size > 4 * (TEXT_CAP + 1):
+                    found.append((rowid, column, size))
+    return found
+
+
 class _SqliteSession(Session):
     def __init__(self, conn, label):
         self.conn, self.label = conn, label
 
     def paths(self):
-        return {r[0] for r in self.conn.execute("SELECT path FROM entries")}
+        return {r[0] for r in self.conn.execute(
+            f"SELECT substr(CAST(path AS TEXT), 1, {TEXT_CAP + 1}) FROM entries")}
 
     def last_version(self, shot):
-        row = self.conn.execute("SELECT MAX(version) FROM entries WHERE shot = ?",
-                                (shot,)).fetchone()
-        return int(row[0] or 0)
+        rows = [dict(r) for r in self.conn.execute(
+            f"SELECT {_SQLITE_COLUMNS} FROM entries WHERE shot = ?", (shot,))]
+        return max((r["version"] for r in checked_rows(rows, self.label)), default=0)
 
     def insert(self, row):
         try:
@@ -175,9 +332,10 @@ class _SqliteSession(Session):
         return True
 
     def all_rows(self):
-        """Every row, read under the write lock (archive migrate)."""
+        """Every row, checked, read under the write lock (archive migrate)."""
         self.conn.row_factory = sqlite3.Row
-        return [dict(r) for r in self.conn.execute("SELECT * FROM entries ORDER BY id")]
+        return checked_rows([dict(r) for r in self.conn.execute(
+            f"SELECT {_SQLITE_COLUMNS} FROM entries ORDER BY id")], self.label)
 
     def commit(self):
         try:
@@ -225,19 +383,30 @@ class SqliteIndex:
             raise ArchiveError(f"{self.label}: cannot be used ({exc})") from None
         return _SqliteSession(conn, self.label)
 
-    def rows(self, shot=None, since=None, order="created, shot, version"):
-        """The entries' rows as dicts, filtered by shot and creation date."""
+    def rows(self, shot=None, since=None, order="created, shot, version", bad=None):
+        """The entries' rows as dicts, checked (:func:`checked_row`), filtered by shot and
+        creation date; a bad row raises, or with ``bad`` is listed there."""
         if not self.exists():
             return []
         conn = self._connect()
         try:
-            where, args = _filters(shot, since, "?")
-            return [dict(r) for r in conn.execute(
-                f"SELECT * FROM entries WHERE 1=1{where} ORDER BY {order}", args)]
+            where, args = _filters(shot, "?")
+            oversized = _oversized(conn, self.path)
+            for rowid, column, size in oversized:
+                message = (f"{self.label}: row #{rowid}: {column}: found text of {size:,} "
+                           f"bytes, expected {_EXPECTED['text']}")
+                if bad is None:
+                    raise ArchiveError(message)
+                bad.append(message)
+            skip = " AND rowid NOT IN (" + ", ".join(str(r) for r, _, _ in oversized) + ")" \
+                if oversized else ""
+            raw = [dict(r) for r in conn.execute(
+                f"SELECT {_SQLITE_COLUMNS} FROM entries WHERE 1=1{where}{skip}", args)]
         except sqlite3.Error as exc:
             raise ArchiveError(f"{self.label}: cannot be read ({exc})") from None
         finally:
             conn.close()
+        return ordered(since_filter(checked_rows(raw, self.label, bad), since), order)
 
     def problems(self):
         """What the index's own check finds (empty when sound)."""
@@ -354,6 +523,12 @@ def _owner_key(owner):
                           signed=True)
 
 
+#: The columns as the server sends them: each as at most TEXT_CAP + 1 characters of text,
+#: whatever the table's column became (text, jsonb...), parsed and checked here.
+_SERVER_COLUMNS = ", ".join(f"left(({c})::text, {TEXT_CAP + 1}) AS {c}"
+                            for c in ("id", *COLUMNS))
+
+
 class _ServerSession(Session):
     """A write transaction on the index's one connection (closing it rolls back what was not
     committed; the connection, and the writer's session lock, stay)."""
@@ -369,12 +544,13 @@ class _ServerSession(Session):
 
     def paths(self):
         return {r[0] for r in self._run(
-            f"SELECT path FROM {SERVER_SCHEMA}.entries WHERE archive = %s", (self.identity,))}
+            f"SELECT left(path::text, {TEXT_CAP + 1}) FROM {SERVER_SCHEMA}.entries WHERE "
+            "archive = %s", (self.identity,))}
 
     def last_version(self, shot):
-        row = self._run(f"SELECT MAX(version) FROM {SERVER_SCHEMA}.entries WHERE archive = %s "
-                        "AND shot = %s", (self.identity, shot)).fetchone()
-        return int(row[0] or 0)
+        rows = self._run(f"SELECT {_SERVER_COLUMNS} FROM {SERVER_SCHEMA}.entries WHERE "
+                         "archive = %s AND shot = %s", (self.identity, shot)).dicts()
+        return max((r["version"] for r in checked_rows(rows, self.label)), default=0)
 
     def insert(self, row):
         try:  # in a savepoint: a clash leaves the rest standing
@@ -530,19 +706,21 @@ class ServerIndex:
             raise
         return session
 
-    def rows(self, shot=None, since=None, order="created, shot, version"):
+    def rows(self, shot=None, since=None, order="created, shot, version", bad=None):
+        """The entries' rows as dicts, checked (:func:`checked_row`), filtered by shot and
+        creation date; a bad row raises, or with ``bad`` is listed there."""
         conn = self._connection()
         try:
-            where, args = _filters(shot, since, "%s")
+            where, args = _filters(shot, "%s")
             found = conn.execute(
-                f"SELECT id, {', '.join(COLUMNS)} FROM {SERVER_SCHEMA}.entries WHERE "
-                f"archive = %s{where} ORDER BY {order}", [self.identity, *args]).dicts()
+                f"SELECT {_SERVER_COLUMNS} FROM {SERVER_SCHEMA}.entries WHERE "
+                f"archive = %s{where}", [self.identity, *args]).dicts()
             conn.rollback()  # no transaction left open between uses
             self._done()
-            return found
         except LinkError as exc:
             self.close()
             raise ArchiveError(f"{self.label}: cannot be read ({exc.message})") from None
+        return ordered(since_filter(checked_rows(found, self.label, bad), since), order)
 
     def problems(self):
         return []  # the server keeps its own pages whole

@@ -35,10 +35,37 @@ def all_versions(base):
             yield folder, version, path
 
 
+def link_below(root, path):
+    """The first part of ``path`` below ``root`` that is a link (a symbolic link, or a
+    Windows junction), and where it leads: ``(part, target)``; None when there is none.
+    ``root`` itself is the folder the user named, trusted as named."""
+    root, path = Path(root), Path(path)
+    try:
+        relative = path.relative_to(root)
+    except ValueError:
+        return path, "outside the archive"
+    part = root
+    for name in relative.parts:
+        part = part / name
+        junction = getattr(os.path, "isjunction", None)  # Python 3.12 and later
+        if part.is_symlink() or (junction is not None and junction(part)):
+            try:
+                target = os.readlink(part)
+            except OSError:
+                target = "somewhere unreadable"
+            return part, str(target)
+    return None
+
+
 def inside(root, path, what):
     """Refuse ``path`` unless it, resolved (every link followed), lies inside the archive at
-    ``root`` and no part of it below ``root`` is a link: a planted ``.verdicts`` or
-    ``.laws/NAME`` link must not carry a write (or a read) out of the archive.
+    ``root`` and no part of it below ``root`` is a link: a planted ``.verdicts``,
+    ``.laws/NAME``, shot or entry folder link must not carry a write (or a read) out of the
+    archive.
+
+    The check is a resolved-path one: a link swapped in between it and the use is the race a
+    writer closes with the directory descriptors of :mod:`airgun_xl.archive.store` where the
+    platform has them (``os.supports_dir_fd``).
 
     Raises
     ------
@@ -49,12 +76,12 @@ def inside(root, path, what):
         relative = path.relative_to(root)
     except ValueError:
         relative = None
-    part = root
-    for name in (relative.parts if relative is not None else ()):
-        part = part / name
-        if part.is_symlink():
-            raise ArchiveError(f"{display(part)}: is a link, expected {what} inside the "
-                               f"archive {display(root)} (a link could lead out of it)")
+    found = link_below(root, path) if relative is not None else None
+    if found is not None:
+        part, target = found
+        raise ArchiveError(f"{display(part)}: is a link to {display(target)}, expected "
+                           f"{what} inside the archive {display(root)} (a link could lead "
+                           "out of it; not followed)")
     real_root = root.resolve()
     real = path.resolve()
     if relative is None or not (real == real_root or real_root in real.parents):

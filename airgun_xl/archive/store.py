@@ -27,6 +27,7 @@ manifest, a missing or altered file, a row that points outside the archive.
 """
 import contextlib
 import datetime
+import errno
 import hashlib
 import json
 import os
@@ -41,7 +42,8 @@ from ..choices import ARCHIVE_ENV
 from ..errors import ArchiveError, OptionError
 from ..transaction import display, fsync, owner_token
 from ..transaction.owners import OWNER_PATTERN
-from .index import INDEX, ServerIndex, SqliteIndex, is_sqlite_index
+from .index import INDEX, INDEX_ENV, MAX_VERSION, ServerIndex, SqliteIndex, is_sqlite_index
+from .records import inside, link_below
 
 ENV = ARCHIVE_ENV
 MARKER = ".airgun-xl-archive"
@@ -86,10 +88,28 @@ class Entry:
     path: Path
     created: str
     row: dict
+    root: Path | None = None  # the archive's folder: nothing below it is read through a link
 
     @property
     def ref(self):
         return f"{self.shot}@{self.version}"
+
+    def contained(self):
+        """Refuse an entry whose shot folder, entry folder or files are reached through a
+        link (it could lead out of the archive): one line naming the link and its target.
+
+        Raises
+        ------
+        ArchiveError
+        """
+        if self.root is None:
+            return
+        found = link_below(self.root, self.path)
+        if found is not None:
+            part, target = found
+            raise ArchiveError(f"{self.ref}: {display(part)} is a link to {display(target)}, "
+                               "expected the entry's own folder inside the archive (not "
+                               "followed; see airgun-xl archive verify)")
 
     def manifest(self):
         return self.load(MANIFEST)
@@ -104,6 +124,7 @@ class Entry:
         """
         from ..untrusted_json import read_json
 
+        self.contained()
         path = self.path / name
         if not os.path.lexists(path):
             raise ArchiveError(f"{self.ref}: {name} is missing from {display(self.path)}, "
@@ -189,6 +210,12 @@ class Archive:
     index : str, optional
         For an archive whose index is on a server: its address (else ``$AIRGUN_XL_INDEX`` or
         libpq's defaults; never the marker's say).
+    check : bool
+        Refuse a marker that contradicts where the index is (:meth:`marker_problems`);
+        ``archive verify`` opens without, to report it.
+    initialising : bool
+        :meth:`init`'s own probe: with ``$AIRGUN_XL_INDEX`` set, any other command refuses
+        to make a new archive (its index would be local).
 
     Raises
     ------
@@ -197,11 +224,18 @@ class Archive:
         other files and is not an archive.
     """
 
-    def __init__(self, root, create=False, dry_run=False, index=None):
+    def __init__(self, root, create=False, dry_run=False, index=None, check=True,
+                 initialising=False):
         self.root = Path(root)
         self.index: SqliteIndex | ServerIndex = SqliteIndex(self.root)
         self.created_here = False  # this object made the folder (undone if nothing commits)
         shown = display(self.root)
+        if create and not initialising and os.environ.get(INDEX_ENV) and not (
+                (self.root / MARKER).is_file() or (self.root / INDEX).exists()):
+            raise ArchiveError(f"{shown}: a new archive, while ${INDEX_ENV} names a server for "
+                               "archives' indexes; expected airgun-xl archive init "
+                               f"{shown} first, which makes its index there (never a local "
+                               "index, which a share cannot serve)")
         if dry_run and not self.root.exists():  # what create would do, without doing it
             if not self.root.parent.is_dir():
                 raise ArchiveError(f"{shown}: its folder {display(self.root.parent)} does not "
@@ -253,6 +287,8 @@ class Archive:
         marker = read_marker(self.root)
         if marker["index"] == "server":
             self.index = ServerIndex(self.root, marker["identity"], index)
+        elif check and (found := self.marker_problems()):  # verify (check False) reports it
+            raise ArchiveError(f"{shown}: {found[0]} (see airgun-xl archive verify)")
 
     @classmethod
     def init(cls, root, index=None, server=None):
@@ -275,7 +311,7 @@ class Archive:
         server = None
         if on_server:  # the address checked, and the server reached, before the folder is made
             server = ServerIndex(root, uuid.uuid4().hex, index)
-        probe = cls(root, create=True, dry_run=True)
+        probe = cls(root, create=True, dry_run=True, initialising=True)
         del probe
         if root.exists() and next(iter(os.listdir(root)), None) is not None:
             raise ArchiveError(f"{shown}: is not empty, expected a new or empty folder")
@@ -459,9 +495,13 @@ class Archive:
             scratch.mkdir(exist_ok=True)
             work = scratch / f"{owner_token()}-{uuid.uuid4().hex}"
             work.mkdir()
+            inside(self.root, work, "the scratch folder")  # a planted link: nothing written
         except OSError as exc:
             self.index.close()  # no scratch folder to vouch for
             raise ArchiveError(f"{display(scratch)}: cannot be written ({exc.strerror})") from None
+        except ArchiveError:
+            self.index.close()
+            raise
         pending = PendingEntry(self, shot, work)
         try:
             for name, source in files.items():
@@ -491,12 +531,17 @@ class Archive:
     def _next_version(self, session, shot):
         folder = self.root / shot
         on_disk = [v for v in (_entry_version(p) for p in folder.iterdir()) if v is not None] \
-            if folder.is_dir() else []
-        return max([session.last_version(shot)] + on_disk) + 1
+            if folder.is_dir() and not folder.is_symlink() else []
+        last = max([session.last_version(shot)] + on_disk)
+        if last >= MAX_VERSION:  # this shot only: the others go on
+            raise ArchiveError(f"{display(self.root)}: shot {shot}: its last version is "
+                               f"{last:,}, expected fewer than {MAX_VERSION:,} (the most an "
+                               "archive numbers; see airgun-xl archive verify)")
+        return last + 1
 
     # -- reading --------------------------------------------------------------------------
-    def entries(self, shot=None, since=None):
-        rows = self.index.rows(safe_name(shot) if shot else None, since)
+    def entries(self, shot=None, since=None, bad=None):
+        rows = self.index.rows(safe_name(shot) if shot else None, since, bad=bad)
         return [e for e in (self._entry(r) for r in rows) if e is not None]
 
     def _entry(self, r):
@@ -506,7 +551,7 @@ class Archive:
         if len(parts) != 2 or parts[0] != safe_name(parts[0]) or not _ENTRY_NAME.match(parts[1]):
             return None
         return Entry(r["id"], r["shot"], r["version"], self.root / parts[0] / parts[1],
-                     r["created"], dict(r))
+                     r["created"], dict(r), self.root)
 
     def get(self, ref):
         """An entry by ``shot@version``, ``shot`` (its latest version), ``shot/v0003`` or
@@ -531,50 +576,124 @@ class Archive:
                                "SHOT@VERSION or #ID (see airgun-xl history)")
         return found[0]
 
+    def entry_problems(self, entry, hash_files=True):
+        """What is wrong with an indexed entry, in words (empty when it is whole): a link on
+        its way (and where it leads), its folder missing, its manifest missing, corrupt or
+        naming another shot or version than its row, a file missing, a link or altered (with
+        ``hash_files``)."""
+        found = link_below(self.root, entry.path)
+        if found is not None:
+            part, target = found
+            return [f"{entry.ref}: {part.relative_to(self.root).as_posix()} is a link to "
+                    f"{display(target)} (not followed)"]
+        if not entry.path.is_dir():
+            return [f"{entry.ref}: missing {entry.path.relative_to(self.root).as_posix()}"]
+        manifest = _read_manifest(entry.path)
+        if manifest is None:
+            return [f"{entry.ref}: {MANIFEST} is missing, corrupt or names another entry"]
+        named = (manifest["index"]["shot"], manifest["index"]["version"])
+        if named != (entry.shot, entry.version):
+            return [f"row #{entry.id}: it says {entry.ref}, but its folder "
+                    f"{entry.path.relative_to(self.root).as_posix()} holds "
+                    f"{named[0]}@{named[1]}"]
+        problems = []
+        for name, digest in manifest["files"].items():
+            f = entry.path / name
+            if f.is_symlink():
+                problems.append(f"{entry.ref}: {name} is a link to {display(os.readlink(f))} "
+                                "(not followed)")
+            elif not f.is_file():
+                problems.append(f"{entry.ref}: missing {name}")
+            elif hash_files and sha256(f) != digest:
+                problems.append(f"{entry.ref}: {name} altered (SHA-256 differs)")
+        return problems
+
+    def checked(self, entry):
+        """``entry``, refused in one line when ``verify`` would report it: a show or a
+        compare reads only whole entries of the archive's own.
+
+        Raises
+        ------
+        ArchiveError
+        """
+        problems = self.entry_problems(entry)
+        twins = [r for r in self.index.rows() if r["id"] != entry.id and (
+            r["path"] == entry.row.get("path") or (r["shot"], r["version"]) == (
+                entry.shot, entry.version))]
+        if twins:
+            problems.append(f"{entry.ref}: row #{twins[0]['id']} names the same entry "
+                            "(two rows on one folder, or one version twice)")
+        if problems:
+            raise ArchiveError(f"{problems[0]}; expected a whole entry of the archive's own "
+                               "(see airgun-xl archive verify)")
+        return entry
+
+    def marker_problems(self):
+        """Where the marker and the index disagree: a marker that says the index is
+        ``index.sqlite`` while there is none and entries are on disk, or a backup of an
+        index moved to a server beside it."""
+        if self.index.kind != "sqlite" or self.index.exists():
+            return []
+        moved = sorted(p.name for p in self.root.glob(f".{INDEX}.moved-*"))
+        folders = sum(1 for _ in self._entry_folders())
+        if moved:
+            return [f"{MARKER}: says the index is {INDEX}, which is missing, and {moved[0]} "
+                    "holds an index moved to a server (the marker was changed?); expected "
+                    "the marker archive migrate wrote"]
+        if folders:
+            return [f"{MARKER}: says the index is {INDEX}, which is missing, while {folders} "
+                    "entries are on disk; expected the archive's index"]
+        return []
+
     def verify(self):
-        """Re-hash every file of every entry; return the problems found (empty when clean).
+        """Re-hash every file of every entry; check the index against the folders both ways;
+        return the problems found (empty when clean).
 
         Recovery runs first, under the write lock, as any writer's would. Damage is reported,
-        never raised: a copied or stray entry folder, a corrupt manifest, a missing or altered
-        file, a row whose path is not an entry.
+        never raised: a bad row (a column of the wrong type, NULL, too long), a row whose
+        path is not an entry, whose folder is reached through a link or names another shot or
+        version, two rows on one folder or one version twice, a copied or stray entry folder,
+        a link (and where it leads), a corrupt manifest, a missing or altered file, a marker
+        that contradicts where the index is.
         """
-        problems = []
-        try:
-            session = self.index.write()
+        problems = list(self.marker_problems())
+        if not problems:
             try:
-                self._recover(session)
-                session.commit()
-            finally:
-                session.close()
-            problems += self.index.problems()
-        except ArchiveError as exc:
-            problems.append(str(exc))
+                session = self.index.write()
+                try:
+                    self._recover(session)
+                    session.commit()
+                finally:
+                    session.close()
+                problems += self.index.problems()
+            except ArchiveError as exc:
+                problems.append(str(exc))
+        bad: list[str] = []
         try:
-            rows = self.index.rows(order="shot, version")
+            rows = self.index.rows(order="shot, version", bad=bad)
         except ArchiveError as exc:
             problems.append(str(exc))
             rows = []
+        problems += bad
         indexed = set()
+        by_path: dict[Path, int] = {}
+        by_version: dict[tuple[str, int], int] = {}
         for r in rows:
             e = self._entry(r)
             if e is None:
                 problems.append(f"row #{r['id']}: its path {r['path']!r} is not an entry folder")
                 continue
+            if e.path in by_path:
+                problems.append(f"row #{r['id']}: names the folder of row #{by_path[e.path]} "
+                                f"({r['path']}): two rows on one folder")
+                continue
+            if (e.shot, e.version) in by_version:
+                problems.append(f"row #{r['id']}: {e.ref} is row #"
+                                f"{by_version[(e.shot, e.version)]}'s version too")
+            by_path[e.path] = r["id"]
+            by_version.setdefault((e.shot, e.version), r["id"])
             indexed.add(e.path)
-            if not e.path.is_dir():
-                problems.append(f"{e.ref}: missing {e.path.relative_to(self.root)}")
-                continue
-            manifest = _read_manifest(e.path)
-            if manifest is None:
-                problems.append(f"{e.ref}: {MANIFEST} is missing, corrupt or names another "
-                                "entry")
-                continue
-            for name, digest in manifest["files"].items():
-                f = e.path / name
-                if not f.is_file():
-                    problems.append(f"{e.ref}: missing {name}")
-                elif sha256(f) != digest:
-                    problems.append(f"{e.ref}: {name} altered (SHA-256 differs)")
+            problems += self.entry_problems(e)
         for folder, _ in self._entry_folders():
             if folder not in indexed:
                 why = ("its manifest is missing, corrupt or names another entry"
@@ -582,16 +701,75 @@ class Archive:
                 problems.append(f"{folder.relative_to(self.root).as_posix()}: not in the index "
                                 f"({why})")
         for shot in sorted(self.root.iterdir()):
-            if shot.name.startswith(".") or not shot.is_dir():
+            if shot.name.startswith(".") or not (shot.is_dir() or shot.is_symlink()):
                 continue
             if shot.is_symlink():
-                problems.append(f"{shot.name}: a symbolic link, not a shot folder (not followed)")
+                problems.append(f"{shot.name}: a symbolic link to {display(os.readlink(shot))}, "
+                                "not a shot folder (not followed)")
                 continue
             for folder in sorted(shot.iterdir()):
-                if _entry_version(folder) is None or folder.is_symlink():
+                if folder.is_symlink():
+                    problems.append(f"{folder.relative_to(self.root).as_posix()}: a symbolic "
+                                    f"link to {display(os.readlink(folder))}, not an entry "
+                                    "(not followed)")
+                elif _entry_version(folder) is None:
                     problems.append(f"{folder.relative_to(self.root).as_posix()}: not an entry "
                                     "(a copied or stray file?)")
         return problems
+
+
+#: Opening a folder without following a link where the platform can (POSIX); elsewhere the
+#: resolved-path check of :func:`~airgun_xl.archive.records.inside` stands alone.
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_DIRECTORY", 0)
+_BY_DESCRIPTOR = (os.rename in os.supports_dir_fd and os.mkdir in os.supports_dir_fd
+                  and os.open in os.supports_dir_fd and _NOFOLLOW != 0)
+
+
+def _rename_inside(root, work, final):
+    """Rename the scratch folder ``work`` to the entry folder ``final`` (``root/shot/vNNNN``,
+    its shot folder made if new) without following a link below ``root``: each folder is
+    opened by descriptor, relative to the one above it, refusing a link (``O_NOFOLLOW``), and
+    the rename is made between those descriptors (renameat), so a link swapped in after the
+    check cannot take the entry out of the archive. Where the platform has no such calls
+    (Windows), the folders are checked by resolved path just before the rename: a link
+    swapped in between the two is the race that remains there.
+
+    Raises
+    ------
+    ArchiveError
+        For a link below ``root``.
+    OSError
+    """
+    root, work, final = Path(root), Path(work), Path(final)
+    shot = final.parent.name
+    if not _BY_DESCRIPTOR:
+        inside(root, work, "the entry being written")
+        with contextlib.suppress(FileExistsError):
+            os.mkdir(final.parent)
+        inside(root, final, "the entry")
+        os.rename(work, final)
+        return
+    opened: list[int] = []
+
+    def descend(name):  # a folder of the archive's top, opened without following a link
+        try:
+            opened.append(os.open(name, os.O_RDONLY | _NOFOLLOW, dir_fd=opened[0]))
+        except OSError as exc:
+            if exc.errno in (errno.ELOOP, errno.ENOTDIR):
+                inside(root, root / name, "the entry's folder")  # names the link
+            raise
+        return opened[-1]
+
+    try:
+        opened.append(os.open(root, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0)))
+        with contextlib.suppress(FileExistsError):
+            os.mkdir(shot, dir_fd=opened[0])
+        shot_fd = descend(shot)
+        scratch_fd = descend(SCRATCH)
+        os.rename(work.name, final.name, src_dir_fd=scratch_fd, dst_dir_fd=shot_fd)
+    finally:
+        for fd in opened:
+            os.close(fd)
 
 
 class PendingEntry:
@@ -633,8 +811,7 @@ class PendingEntry:
     def commit(self):
         """Rename the entry into place and commit its row (under the lock from prepare)."""
         try:
-            self.final.parent.mkdir(exist_ok=True)
-            os.rename(self.work, self.final)  # the entry appears whole: the commit point
+            _rename_inside(self.archive.root, self.work, self.final)  # the commit point
         except OSError as exc:
             raise ArchiveError(f"{display(self.final)}: cannot be written "
                                f"({exc.strerror})") from None

@@ -249,7 +249,8 @@ def shown_figure(key, value):
 
 
 def run_show(args):
-    e = _archive(args.archive).get(args.entry)
+    archive = _archive(args.archive)
+    e = archive.checked(archive.get(args.entry))  # what verify would report is refused
     doc = {"entry": e.ref, "id": e.id, "path": str(e.path), "created": e.created,
            "params": e.load("params.json"), "summary": e.load("summary.json"),
            "provenance": e.load("provenance.json"), "files": e.manifest()["files"]}
@@ -300,7 +301,7 @@ def run_compare(args):
 
         check_output(args.report, args.force)
     archive = _archive(args.archive)
-    a, b = archive.get(args.entry1), archive.get(args.entry2)
+    a, b = (archive.checked(archive.get(ref)) for ref in (args.entry1, args.entry2))
     pa = {p["cell"]: p for p in a.load("params.json")}
     pb = {p["cell"]: p for p in b.load("params.json")}
     differing = [(c, pa[c]["label"], pa[c]["value"], pb[c]["value"]) for c in pa
@@ -396,11 +397,11 @@ def run_init(args):
 
 
 def run_verify(args):
-    archive = Archive(archive_dir(args.dir), index=args.index)
+    archive = Archive(archive_dir(args.dir), index=args.index, check=False)
     problems = archive.verify()
-    entries = archive.entries()
+    entries = archive.entries(bad=[])
     for p in problems:
-        print(f"problem: {p}")
+        print(printable(f"problem: {p}"))
     print(f"{_count(len(entries), 'entry', 'entries')}, "
           f"{_count(len(problems), 'problem', 'problems')} in {display(archive.root)}")
     return 0 if not problems else 1
