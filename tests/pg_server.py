@@ -5,8 +5,10 @@ server's own binaries (initdb, pg_ctl): no mock.
   (``postgres`` where Debian's package made one, else ``nobody``);
 - its socket folder is short (``/tmp/agx-pg-XXXX``): Unix socket paths stop near 107 bytes;
 - it listens on the loopback on a free port, with password (SCRAM) authentication over TCP;
-- the archive's role ``lab`` is not a superuser: it owns schema ``airgun_xl`` and may connect
-  to database ``lab``, nothing more (what README asks of a lab's database role).
+- two roles, as README's administrator block makes them (issue 43): ``lab_admin`` owns
+  schema ``airgun_xl`` (it makes and migrates the archives' tables: ``archive init --index
+  ... --writers lab``), and ``lab``, the engineers', may use the schema and, once an archive
+  is made, read its tables and add entries, nothing more; neither is a superuser.
 
 Without the binaries or psycopg, the tests skip with one line saying what to install.
 """
@@ -64,7 +66,13 @@ class Server:
 
     @property
     def address(self) -> str:
+        """The engineers' role: SELECT and INSERT."""
         return f"postgresql://lab@127.0.0.1:{self.port}/lab"
+
+    @property
+    def owner_address(self) -> str:
+        """The administrator's role, the schema's owner."""
+        return f"postgresql://lab_admin@127.0.0.1:{self.port}/lab"
 
     @property
     def admin(self) -> str:
@@ -121,15 +129,17 @@ def start_server():
         os.chown(server.data / "pg_hba.conf", record.pw_uid, record.pw_gid)
     server.start()
     server.sql(f"CREATE ROLE lab LOGIN PASSWORD '{PASSWORD}'",
+               f"CREATE ROLE lab_admin LOGIN PASSWORD '{PASSWORD}'",
                "CREATE DATABASE lab",
                "REVOKE ALL ON DATABASE lab FROM PUBLIC",
-               "GRANT CONNECT ON DATABASE lab TO lab")
+               "GRANT CONNECT ON DATABASE lab TO lab, lab_admin")
     import psycopg
 
     with psycopg.connect(server.admin.replace("dbname=postgres", "dbname=lab"),
                          autocommit=True) as conn:
         conn.execute("REVOKE ALL ON SCHEMA public FROM PUBLIC")
-        conn.execute("CREATE SCHEMA airgun_xl AUTHORIZATION lab")
+        conn.execute("CREATE SCHEMA airgun_xl AUTHORIZATION lab_admin")
+        conn.execute("GRANT USAGE ON SCHEMA airgun_xl TO lab")
     return server
 
 

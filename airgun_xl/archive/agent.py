@@ -36,7 +36,8 @@ class LinkError(Exception):
     ----------
     kind : str
         ``missing`` (psycopg is not installed), ``address`` (libpq cannot read the address),
-        ``connect`` (the server cannot be reached or refused the login), ``unique`` (a unique
+        ``connect`` (the server cannot be reached), ``login`` (it refused the login: a wrong
+        password, an unknown role), ``unique`` (a unique
         constraint), ``undefined`` (no such table or schema), ``lost`` (the agent stopped),
         ``other``.
     message : str
@@ -64,6 +65,23 @@ def _libpq_reads(name):
 
 # -- the agent's side ---------------------------------------------------------------------------
 
+#: The libpq keywords an address may hold: where the server is, who logs in, how the
+#: connection is secured and kept alive. Not ``password`` nor ``sslpassword`` (SECRETS: the
+#: command line is recorded with every entry and shown by ps), nor ``options`` (the tool's
+#: own session settings, its timeouts, would be overridden) nor ``replication``.
+ALLOWED_KEYWORDS = frozenset((
+    "host", "hostaddr", "port", "dbname", "user", "passfile", "require_auth",
+    "channel_binding", "connect_timeout", "client_encoding", "application_name",
+    "fallback_application_name", "keepalives", "keepalives_idle", "keepalives_interval",
+    "keepalives_count", "tcp_user_timeout", "gssencmode", "sslmode", "sslcompression",
+    "sslcert", "sslkey", "sslrootcert", "sslcrl", "sslcrldir", "sslsni", "sslcertmode",
+    "ssl_min_protocol_version", "ssl_max_protocol_version", "requirepeer", "krbsrvname",
+    "gsslib", "gssdelegation", "service", "target_session_attrs", "load_balance_hosts"))
+
+#: The keywords that carry a secret: refused, their values never repeated.
+SECRETS = ("password", "sslpassword")
+
+
 def _handle(psycopg, conns, request):
     op = request["op"]
     if op == "parse":  # libpq reads the address; only what messages show comes back
@@ -74,18 +92,23 @@ def _handle(psycopg, conns, request):
         except Exception:
             raise LinkError("address", "libpq cannot read the address") from None
         shown = {k: parts.get(k) for k in ("host", "hostaddr", "port", "dbname", "service")}
-        return dict(shown, password=parts.get("password") not in (None, ""))
+        secrets = [k for k in SECRETS if k in parts]
+        unknown = sorted(k for k in parts if k not in ALLOWED_KEYWORDS and k not in SECRETS)
+        return dict(shown, password=bool(secrets), secrets=secrets, unknown=unknown[:5])
     if op == "connect":
-        if _handle(psycopg, conns, {"op": "parse", "address": request["address"]})["password"]:
-            raise LinkError("address", "found a password in the address")  # never dialled
+        parsed = _handle(psycopg, conns, {"op": "parse", "address": request["address"]})
+        if parsed["secrets"] or parsed["unknown"]:  # refused by the allow-list, never dialled
+            raise LinkError("address", "found a keyword the address may not hold")
         for name in [n for n in os.environ if _libpq_reads(n)]:  # this process's, as now
             del os.environ[name]
         os.environ.update(request["env"])
         try:
             conn = psycopg.connect(request["address"], connect_timeout=10,
                                    application_name="airgun-xl", options=request["options"])
-        except psycopg.Error as exc:
-            raise LinkError("connect", _reason(exc), True) from None
+        except psycopg.Error as exc:  # SQLSTATE class 28: the server refused the login
+            login = str(getattr(exc, "sqlstate", "") or "").startswith("28") or \
+                "authentication failed" in str(exc)
+            raise LinkError("login" if login else "connect", _reason(exc), True) from None
         number = max(conns, default=0) + 1
         conns[number] = conn
         return number

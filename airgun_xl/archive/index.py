@@ -25,6 +25,7 @@ from typing import Any
 
 from ..errors import ArchiveError, OptionError
 from ..transaction import display
+from ..untrusted_json import printable
 from .agent import Link, LinkError, agent, prestart
 
 INDEX = "index.sqlite"
@@ -80,6 +81,17 @@ SERVER_TABLES = (
         PRIMARY KEY (archive, id),
         UNIQUE (archive, shot, version))""",
 )
+
+
+#: What the engineers' role needs, and all it gets (``archive init --writers ROLE``): the
+#: schema, the archives read, the entries read and added. No UPDATE, DELETE or DDL: a writer
+#: cannot rewrite history (the write lock is an advisory lock, which needs no right).
+WRITER_GRANTS = (f"GRANT USAGE ON SCHEMA {SERVER_SCHEMA} TO {{role}}",
+                 f"GRANT SELECT ON {SERVER_SCHEMA}.archives TO {{role}}",
+                 f"GRANT SELECT, INSERT ON {SERVER_SCHEMA}.entries TO {{role}}")
+
+#: A role name ``--writers`` takes: a plain PostgreSQL identifier.
+ROLE_NAME = r"[A-Za-z_][A-Za-z0-9_]{0,62}"
 
 
 class Session:
@@ -450,6 +462,20 @@ class SqliteIndex:
 
 # -- PostgreSQL --------------------------------------------------------------------------------
 
+#: What the archive says once a command, for the command to print as warnings (a role that
+#: may rewrite history), and the servers already checked by this command.
+NOTICES: list[str] = []
+_CHECKED: set[str] = set()
+
+
+def take_notices() -> list[str]:
+    """The notices said since the last call, and a fresh start for the next command."""
+    said = list(NOTICES)
+    NOTICES.clear()
+    _CHECKED.clear()
+    return said
+
+
 def session_options():
     """A connection's settings: how long a statement, a lock wait and an idle transaction
     may last."""
@@ -501,10 +527,20 @@ def server_address(given=None, where="--index"):
             raise _link_error(exc, "the archive's index") from None
         raise OptionError(f"{source}: found an address libpq cannot read; expected "
                           "postgresql://HOST[:PORT]/DATABASE") from None
-    if parts.pop("password"):
-        raise OptionError(f"{source}: found a password in the address (not repeated here); "
-                          "expected it in ~/.pgpass or $PGPASSWORD, since the command line is "
-                          "recorded with every entry and shown by ps")
+    secrets, unknown = parts.pop("secrets", []), parts.pop("unknown", [])
+    parts.pop("password", None)
+    if secrets:
+        what = ("a password" if secrets[0] == "password" else
+                f"the keyword {secrets[0]}, which carries a secret")
+        raise OptionError(f"{source}: found {what} in the address (not repeated here); "
+                          "expected none there, since the command line is recorded with every "
+                          "entry and shown by ps: a password in ~/.pgpass or $PGPASSWORD, a "
+                          "client key's pass phrase kept by the key's owner")
+    if unknown:
+        raise OptionError(f"{source}: found the keyword {printable(unknown[0])!r} in the "
+                          "address, expected only libpq keywords that say where the server is, "
+                          "who logs in and how the connection is secured (host, port, dbname, "
+                          "user, sslmode, sslrootcert, service...; docs/security.md lists them)")
     return text, _shown_address(parts)
 
 
@@ -631,6 +667,10 @@ class ServerIndex:
         except LinkError as exc:
             if exc.kind == "missing":
                 raise _link_error(exc, self.label) from None
+            if exc.kind == "login":
+                raise ArchiveError(f"{self.label}: refused the login ({exc.message}); "
+                                   "expected the role's password in ~/.pgpass or $PGPASSWORD, "
+                                   "and a role the server knows") from None
             raise ArchiveError(f"{self.label}: cannot be reached ({exc.message}); expected a "
                                f"PostgreSQL server at ${INDEX_ENV}, --index or libpq's "
                                "defaults") from None
@@ -654,15 +694,36 @@ class ServerIndex:
                                    "expected the server the archive was made on (check "
                                    f"${INDEX_ENV})")
             try:
+                self._check_role(conn)
                 conn.rollback()
             except LinkError as exc:
                 conn.close()
                 raise ArchiveError(f"{self.label}: cannot be used ({exc.message})") from None
         return conn
 
-    def create(self, rows=()):
+    def _check_role(self, conn):
+        """Whether this role could alter the schema or rewrite entries (it owns them, or
+        holds CREATE on the schema, UPDATE, DELETE or TRUNCATE on the entries): said once a
+        command (:data:`NOTICES`), since engineers should use a writer's role."""
+        if self.label in _CHECKED:
+            return
+        _CHECKED.add(self.label)
+        table = f"{SERVER_SCHEMA}.entries"
+        row = conn.execute(
+            "SELECT current_user, has_schema_privilege(%s, 'CREATE'), "
+            "has_table_privilege(%s, 'UPDATE'), has_table_privilege(%s, 'DELETE'), "
+            "has_table_privilege(%s, 'TRUNCATE')",
+            (SERVER_SCHEMA, table, table, table)).fetchone()
+        if row is not None and any(row[1:]):
+            NOTICES.append(f"{self.label}: role {printable(row[0])!r} may alter the schema or "
+                           "rewrite entries (it owns them, or holds CREATE, UPDATE, DELETE or "
+                           "TRUNCATE there); expected the engineers' role to read and add only "
+                           "(archive init --writers ROLE; README, 'A shared archive')")
+
+    def create(self, rows=(), writers=()):
         """Make the schema (if the role may), this archive's row and ``rows`` (an index
-        moved from SQLite, their ids kept apart), in one transaction."""
+        moved from SQLite, their ids kept apart), in one transaction; grant each of
+        ``writers`` (role names) what a writer needs and no more (:data:`WRITER_GRANTS`)."""
         import datetime
 
         conn = self._connect(check=False)
@@ -674,6 +735,9 @@ class ServerIndex:
                     if exists:
                         continue
                 conn.execute(sql)
+            for role in writers:
+                for grant in WRITER_GRANTS:
+                    conn.execute(grant.format(role=f'"{role}"'))  # a checked name, quoted
             created = datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")
             conn.execute(f"INSERT INTO {SERVER_SCHEMA}.archives (identity, created, format) "
                          "VALUES (%s, %s, 1)", (self.identity, created))
@@ -698,9 +762,10 @@ class ServerIndex:
 
     def write(self):
         session = _ServerSession(self._connection(), self.identity, self.label, self)
-        try:
-            session._run(f"SELECT identity FROM {SERVER_SCHEMA}.archives WHERE identity = %s "
-                         "FOR UPDATE", (self.identity,))  # the write lock: one writer at a time
+        try:  # the write lock, one writer at a time: an advisory lock the transaction holds
+            # (a row lock, SELECT ... FOR UPDATE, would need the writers' role to hold UPDATE)
+            session._run("SELECT pg_advisory_xact_lock(%s)", (_owner_key(
+                f"archive:{self.identity}"),))
         except BaseException:
             session.close()
             raise

@@ -291,11 +291,12 @@ class Archive:
             raise ArchiveError(f"{shown}: {found[0]} (see airgun-xl archive verify)")
 
     @classmethod
-    def init(cls, root, index=None, server=None):
+    def init(cls, root, index=None, server=None, writers=()):
         """Make a new archive at ``root`` (a new or empty folder): its index in the folder, or
         with ``server`` (default: when ``index`` is given) on a PostgreSQL server at ``index``
         (an address, :func:`~airgun_xl.archive.index.server_address`; None for
-        ``$AIRGUN_XL_INDEX`` or libpq's defaults), the marker naming its identity; return it.
+        ``$AIRGUN_XL_INDEX`` or libpq's defaults), the marker naming its identity, and the
+        ``writers`` roles granted what a writer needs; return it.
 
         Raises
         ------
@@ -316,7 +317,7 @@ class Archive:
         if root.exists() and next(iter(os.listdir(root)), None) is not None:
             raise ArchiveError(f"{shown}: is not empty, expected a new or empty folder")
         if server is not None:
-            server.create()
+            server.create(writers=writers)
         made = not root.exists()
         try:
             os.makedirs(root, exist_ok=True)
@@ -333,7 +334,7 @@ class Archive:
             raise ArchiveError(f"{shown}: cannot be written ({exc.strerror})") from None
         return cls(root, index=index)  # the server it was made on, as given
 
-    def migrate(self, index=None):
+    def migrate(self, index=None, writers=()):
         """Move this archive's SQLite index to a PostgreSQL server at ``index`` (else
         ``$AIRGUN_XL_INDEX`` or libpq's defaults); return the backup the SQLite index was
         renamed to.
@@ -367,7 +368,7 @@ class Archive:
                                    f"not match their entry's manifest (the first: "
                                    f"{r['shot']}@{r['version']}); expected a clean archive "
                                    "(see airgun-xl archive verify); nothing was moved")
-            server.create(rows)
+            server.create(rows, writers)
             marker = {"format": FORMAT, "tool": "airgun-xl", "index": "server",
                       "identity": server.identity}
             temp = self.root / f".{MARKER}.{owner_token()}.tmp"

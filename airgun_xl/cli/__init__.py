@@ -85,6 +85,9 @@ def _unraisable(hook):
 def main(argv=None):
     """Run the CLI; return the exit code (0 ok, 1 differences, 2 bad input, 128+N signal N)."""
     _WARNED.clear()
+    archive_index = sys.modules.get("airgun_xl.archive.index")
+    if archive_index is not None:  # an earlier in-process command's
+        archive_index.take_notices()
     if argv is None:  # the command itself, not a caller's in-process run
         sys.unraisablehook = _unraisable(sys.unraisablehook)
     for stream in (sys.stdout, sys.stderr):  # a file name may hold undecodable bytes
@@ -111,6 +114,9 @@ def main(argv=None):
             # after a success, said as the tool's own warnings; a refusal drops them (one line)
             warn(sorted({f"{w.category.__name__} from a library: {str(w.message)[:300]}"
                          for w in caught}))
+            archive_index = sys.modules.get("airgun_xl.archive.index")  # loaded if used
+            if archive_index is not None:
+                warn(archive_index.take_notices())  # a server role that may rewrite history
             if SIGNALS["pending"] is not None and SIGNALS["committed"]:
                 _say(f"airgun-xl: signal {SIGNALS['pending']} arrived after the outputs were "
                      "complete; nothing was lost")

@@ -69,7 +69,25 @@ def add_parser(sub):
                    help=f"the PostgreSQL server of the archive's index (default "
                         f"${INDEX_ENV}, else libpq's PGHOST, PGSERVICE and service file); "
                         "never a password: ~/.pgpass or $PGPASSWORD hold it")
+    a.add_argument("--writers", action="append", default=[], metavar="ROLE",
+                   type=_role,
+                   help="init and migrate on a server, run by the schema's owner: grant the "
+                        "engineers' role what a writer needs and no more (read, add entries; "
+                        "no update, delete or schema change); may be repeated")
     a.set_defaults(run=run_archive)
+
+
+def _role(text):
+    """``--writers``: a PostgreSQL role name (a plain identifier)."""
+    import argparse
+    import re
+
+    from ..archive.index import ROLE_NAME
+
+    if not re.fullmatch(ROLE_NAME, str(text)):
+        raise argparse.ArgumentTypeError(f"found {str(text)[:40]!r}, expected a role name: "
+                                         "letters, digits and _, at most 63")
+    return str(text)
 
 
 def _count(n, one, many):
@@ -377,7 +395,7 @@ def run_migrate(args):
     """Move an archive's SQLite index to a server, writers kept out, every row verified."""
     archive = Archive(archive_dir(args.dir))
     before = len(archive.entries())
-    backup = archive.migrate(args.index)
+    backup = archive.migrate(args.index, args.writers)
     print(f"moved the index of {display(archive.root)} ({_count(before, 'entry', 'entries')}) "
           f"to {archive.index.shown}; the SQLite index is kept as {backup.name}")
     return 0
@@ -389,7 +407,12 @@ def run_init(args):
 
     root = archive_dir(args.dir)
     server = args.index is not None or bool(os.environ.get(INDEX_ENV))
-    archive = Archive.init(root, args.index, server=server)
+    if args.writers and not server:
+        from ..errors import OptionError
+
+        raise OptionError("--writers: found roles for an archive whose index is in its folder, "
+                          f"expected --index or ${INDEX_ENV} (a server's roles)")
+    archive = Archive.init(root, args.index, server=server, writers=args.writers)
     where = (f"its index on {archive.index.shown}" if archive.index.kind == "server"
              else "its index in the folder")
     print(f"made the archive {display(archive.root)}, {where}")
