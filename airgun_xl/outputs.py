@@ -145,8 +145,13 @@ def block_cells(outputs=Outputs()):
 
 
 def _flag(cell, value):
+    """A switch of the block: TRUE or FALSE, or the number 1 or 0 a boolean is stored as in
+    an .xls that LibreOffice writes (a number in a boolean format, which the .xls reader does
+    not see), or as text."""
     if isinstance(value, bool):
         return value
+    if isinstance(value, (int, float)) and value in (0, 1):
+        return bool(value)
     text = str(value).strip().lower() if value is not None else ""
     if text in ("true", "yes", "1"):
         return True

@@ -65,6 +65,14 @@ CAPS = {
     "db": 60.0,  # |SRS tolerance| [dB]
 }
 
+#: The smallest value each quantity may take: below it a value is a typing slip, and a
+#: denormal (5e-324 kG) would overflow the judge's quotients into a numpy warning.
+FLOORS = {
+    "peak": 1e-6,  # [kG], 0.001 g
+    "duration": 1e-9,  # [s], 1 ns
+    "velocity_change": 1e-6,  # [m/s]
+}
+
 #: The duration definitions: each shape's own D (``base``: a half-sine's or a trapezoid's
 #: base, a sawtooth's rise), or the width at 10 % of the peak (JEDEC-style).
 DURATION_DEFS = ("base", "width@10%")
@@ -374,12 +382,15 @@ def _unit(unit: str, units: dict, text: str, where: str, expected: str) -> Any:
 
 
 def _quantity(text: str, where: str, what: str, units: dict, example: str, cap: float,
-              cap_text: str, zero: bool = False) -> float:
-    """A positive (or, with ``zero``, non-negative) quantity with its unit, at most ``cap``
-    in the inside unit; times scaled exactly in decimal, then rounded once."""
+              cap_text: str, zero: bool = False, floor: float = 0.0,
+              floor_text: str = "") -> float:
+    """A positive (or, with ``zero``, non-negative) quantity with its unit, at least
+    ``floor`` and at most ``cap`` in the inside unit; times scaled exactly in decimal, then
+    rounded once."""
+    low = "from 0" if zero else f"from {floor_text}" if floor else "above 0"
     expected = (f"{what} such as {example} (units "
                 f"{', '.join(u for u in units if u in _SHOWN_UNITS)}), "
-                f"{'from 0' if zero else 'above 0'} and at most {cap_text}")
+                f"{low} and at most {cap_text}")
     sign, magnitude, unit_text = _split(text, where, expected)
     factor = _unit(unit_text, units, text, where, expected)
     if sign:
@@ -389,7 +400,8 @@ def _quantity(text: str, where: str, what: str, units: dict, example: str, cap: 
         value = _scaled(magnitude, factor)
     else:
         value = float(magnitude) * factor
-    if not (math.isfinite(value) and (value >= 0 if zero else value > 0) and value <= cap):
+    if not (math.isfinite(value) and (value >= 0 if zero else value > 0 and value >= floor)
+            and value <= cap):
         raise _refuse(where, text, expected)
     return value
 
@@ -599,19 +611,22 @@ def show_window(window: tuple) -> str:
 
 def _peak(text: str, where: str) -> float:
     return _quantity(text, where, "a peak", PEAK_UNITS, "12kG, 11750g or 1.2e5m/s^2",
-                     CAPS["peak"], f"{CAPS['peak']:,g} kG")
+                     CAPS["peak"], f"{CAPS['peak']:,g} kG", floor=FLOORS["peak"],
+                     floor_text="1e-6 kG")
 
 
 def _time(name: str, zero: bool = False) -> Callable[[str, str], float]:
     def parse(text: str, where: str) -> float:
         return _quantity(text, where, f"a {name}", TIME_UNITS, "5ms or 500us", CAPS[name],
-                         f"{CAPS[name]:g} s", zero)
+                         f"{CAPS[name]:g} s", zero, floor=FLOORS["duration"],
+                         floor_text="1 ns")
     return parse
 
 
 def _velocity(text: str, where: str) -> float:
     return _quantity(text, where, "a velocity change", VELOCITY_UNITS, "35m/s",
-                     CAPS["velocity_change"], f"{CAPS['velocity_change']:,g} m/s")
+                     CAPS["velocity_change"], f"{CAPS['velocity_change']:,g} m/s",
+                     floor=FLOORS["velocity_change"], floor_text="1e-6 m/s")
 
 
 #: The grammar's keys, by name: the profile's keys, the sheet's rows and the options'.

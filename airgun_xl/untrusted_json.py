@@ -166,6 +166,17 @@ def _constant(name: str) -> None:
     raise _Refused(f"{name}, which is not JSON")
 
 
+def _object(pairs: list[tuple[str, Any]]) -> dict:
+    """An object, refusing a key given twice: the last would win unseen (a profile's
+    ``"peak_tolerance": 10, "peak_tolerance": 50`` judged with 50)."""
+    out: dict = {}
+    for key, value in pairs:
+        if key in out:
+            raise _Refused(f"the key {short(key)} twice (at its last: {short(value, 30)})")
+        out[key] = value
+    return out
+
+
 def short(value: Any, limit: int = 60) -> str:
     """A value as a message quotes it: its repr, cut to ``limit`` characters."""
     text = repr(value)
@@ -215,7 +226,7 @@ def read_json(path: Path | str, kind: str, shown: str,
                     f"a JSON {kind} record")
     try:
         data = json.loads(text, parse_int=_integer, parse_float=_float,
-                          parse_constant=_constant)
+                          parse_constant=_constant, object_pairs_hook=_object)
     except _Refused as exc:
         raise error(f"{shown}: found {exc}, expected a JSON {kind} record") from None
     except (ValueError, RecursionError) as exc:

@@ -14,7 +14,7 @@ import warnings
 
 from ..errors import AirgunXlError
 from ..transaction import SIGNALS, Interrupted, note_signal, on_signal, reset_signals
-from .messages import _WARNED, _say, note, warn
+from .messages import _LATER, _WARNED, _say, note, say_later, warn
 
 __all__ = ["main", "note", "warn"]
 
@@ -85,6 +85,7 @@ def _unraisable(hook):
 def main(argv=None):
     """Run the CLI; return the exit code (0 ok, 1 differences, 2 bad input, 128+N signal N)."""
     _WARNED.clear()
+    _LATER.clear()
     archive_index = sys.modules.get("airgun_xl.archive.index")
     if archive_index is not None:  # an earlier in-process command's
         archive_index.take_notices()
@@ -111,6 +112,7 @@ def main(argv=None):
                                    ImportWarning, ResourceWarning):  # not the user's business
                     warnings.simplefilter("ignore", developers)
                 code = args.run(args)
+            say_later()  # an old spelling's note: after a success, a refusal stays one line
             # after a success, said as the tool's own warnings; a refusal drops them (one line)
             warn(sorted({f"{w.category.__name__} from a library: {str(w.message)[:300]}"
                          for w in caught}))

@@ -6,6 +6,7 @@ from pathlib import Path
 from .recording_options import RECORDING_HELP, add_recording_options
 from .run_options import SHOT_HELP, add_force, add_output
 from .spec_options import RECORD_HELP, add_spec_options
+from .vocabulary import One
 
 #: The exit status of a shot that fails its specification (2 stays for bad input).
 FAIL_EXIT = 3
@@ -27,7 +28,7 @@ def add_parser(sub):
         RECORD_HELP + ", over the sheet's and the profile's (refused where the filter is "
         "unstable, below 4.155 x the class in samples a second; a warning below J211's 10 x)"))
     add_spec_options(p, cfc=False)
-    p.add_argument("--archive", metavar="DIR",
+    p.add_argument("--archive", metavar="DIR", action=One,
                    help="record the verdict in the archive (the verdict file of the shot's "
                         "next entry)")
     p.set_defaults(run=run)
@@ -105,21 +106,25 @@ def run(args):
 
 
 def print_verdict(verdict, what):
-    """The verdict, a line a criterion, with the tolerances used."""
+    """The verdict, a line a criterion, with the tolerances used; what files gave (a
+    profile's notes, names) reaches the terminal as text, never as control codes."""
+    from ..untrusted_json import printable
+
     n = len(verdict.warnings)
-    print(f"{verdict.word}: {what}"
-          + (f" (with {n} warning{'s' * (n != 1)}: read them before relying on it)" if n else ""))
+    print(printable(f"{verdict.word}: {what}" + (
+        f" (with {n} warning{'s' * (n != 1)}: read them before relying on it)" if n else "")))
     from ..studies.acceptance import limits_text
 
     for c in verdict.criteria:
         limits = limits_text(c)
         margin = f"{c.margin:+.2f} {c.margin_unit}"
-        print(f"  {'PASS' if c.passed else 'FAIL'}  {c.name}: {c.value:.5g} {c.unit} "
-              f"(limits {limits}; margin {margin})" + (f"; {c.detail}" if c.detail else ""))
+        print(printable(f"  {'PASS' if c.passed else 'FAIL'}  {c.name}: {c.value:.5g} "
+                        f"{c.unit} (limits {limits}; margin {margin})"
+                        + (f"; {c.detail}" if c.detail else "")))
     for line in verdict.definitions:
-        print(f"  {line}")
+        print(printable(f"  {line}"))
     for line in verdict.spec.notes:  # a profile's caveats, with every verdict judged by it
-        print(f"  note: {line}")
+        print(printable(f"  note: {line}"))
 
 
 def report_data(time, kg, spec, verdict):

@@ -7,6 +7,7 @@ from ..archive import ENV, INDEX_ENV, Archive, archive_dir
 from ..transaction import display
 from ..untrusted_json import printable
 from .run_options import ATOL_HELP, RTOL_HELP, add_force, tolerance
+from .vocabulary import One
 
 
 def add_parser(sub):
@@ -15,7 +16,7 @@ def add_parser(sub):
                        description=f"List archived runs with their key figures (peak, "
                                    f"filtered peak, pulse, crush, warnings, integrator, crush "
                                    f"law) and the archive's crush laws. {where}")
-    h.add_argument("--archive", metavar="DIR", help="the archive folder")
+    h.add_argument("--archive", metavar="DIR", action=One, help="the archive folder")
     h.add_argument("dir", nargs="?", metavar="DIR",
                    help="old spelling of --archive DIR, kept one release")
     h.add_argument("--shot", metavar="NAME", help="only this shot's runs")
@@ -25,7 +26,7 @@ def add_parser(sub):
                    help="only runs whose input cell holds VALUE (to 1e-9 of it) or lies in "
                         "LO:HI, e.g. E40=2.703e7 or E40=2.6e7:2.8e7 (a honeycomb lot); may "
                         "be repeated")
-    h.add_argument("-o", "--output", metavar="SHOTS.xlsx",
+    h.add_argument("-o", "--output", metavar="SHOTS.xlsx", action=One,
                    help="also write the table across the runs, with the peak against v0")
     add_force(h, "SHOTS.xlsx")
     h.add_argument("--json", action="store_true", help="print the list as JSON")
@@ -33,7 +34,7 @@ def add_parser(sub):
     s = sub.add_parser("show", help="print one archived run: inputs, figures, provenance",
                        description=f"Print one archived run. {where}")
     s.add_argument("entry", metavar="ENTRY", help="SHOT (its latest run), SHOT@VERSION or #ID")
-    s.add_argument("--archive", metavar="DIR", help="the archive folder")
+    s.add_argument("--archive", metavar="DIR", action=One, help="the archive folder")
     s.add_argument("--json", action="store_true", help="print the run as JSON")
     s.set_defaults(run=run_show)
     c = sub.add_parser("compare", help="diff two archived runs: inputs, then every series",
@@ -42,11 +43,11 @@ def add_parser(sub):
                                    f"they agree, 1 when they differ. {where}")
     c.add_argument("entry1", metavar="ENTRY1", help="SHOT, SHOT@VERSION or #ID")
     c.add_argument("entry2", metavar="ENTRY2", help="SHOT, SHOT@VERSION or #ID")
-    c.add_argument("--archive", metavar="DIR", help="the archive folder")
+    c.add_argument("--archive", metavar="DIR", action=One, help="the archive folder")
     c.add_argument("--rtol", default="1e-12", help=RTOL_HELP.replace("column", "series"))
     c.add_argument("--atol", default="0", help=ATOL_HELP)
     c.add_argument("--json", action="store_true", help="print the report as JSON, as diff does")
-    c.add_argument("--report", metavar="REPORT.xlsx",
+    c.add_argument("--report", metavar="REPORT.xlsx", action=One,
                    help="also write a workbook: the input cells that differ and the error table")
     add_force(c, "REPORT.xlsx")
     c.set_defaults(run=run_compare)
@@ -65,7 +66,7 @@ def add_parser(sub):
                    help="init: make a new archive; migrate: move an archive's SQLite index to "
                         "the --index server; verify: check one")
     a.add_argument("dir", nargs="?", metavar="DIR", help="the archive folder")
-    a.add_argument("--index", metavar="postgresql://HOST/DB",
+    a.add_argument("--index", metavar="postgresql://HOST/DB", action=One,
                    help=f"the PostgreSQL server of the archive's index (default "
                         f"${INDEX_ENV}, else libpq's PGHOST, PGSERVICE and service file); "
                         "never a password: ~/.pgpass or $PGPASSWORD hold it")
@@ -371,7 +372,7 @@ def _history_archive(args):
     """history's archive: --archive, or the old positional DIR (noted)."""
     if args.dir is None:
         return args.archive
-    from .messages import note
+    from .messages import later
     from .vocabulary import old_spelling_note
 
     if args.archive is not None and args.archive != args.dir:
@@ -379,7 +380,7 @@ def _history_archive(args):
 
         raise OptionError(f"--archive: found {args.archive!r} and the folder {args.dir!r}, "
                           "expected one archive")
-    note([old_spelling_note("history DIR", "history --archive DIR")])
+    later([old_spelling_note("history DIR", "history --archive DIR")])
     return args.dir
 
 

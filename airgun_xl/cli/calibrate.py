@@ -6,6 +6,7 @@ from pathlib import Path
 from ..errors import OptionError
 from .recording_options import add_recording_options
 from .run_options import add_force, add_integrator, add_output
+from .vocabulary import One
 
 
 def add_parser(sub):
@@ -36,7 +37,7 @@ def add_parser(sub):
     add_recording_options(p, "TDMS only: the channel of every measured file (default: the "
                              "first waveform channel)")
     add_integrator(p)
-    p.add_argument("--archive", metavar="DIR",
+    p.add_argument("--archive", metavar="DIR", action=One,
                    help="with --name: keep the fitted law in this archive's library of crush "
                         "laws (default: $AIRGUN_XL_ARCHIVE when set), for fill --crush-law NAME")
     p.add_argument("--name", metavar="NAME",

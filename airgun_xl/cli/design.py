@@ -150,16 +150,11 @@ def run_srs(args):
 
 
 def _srs_q(text):
-    """--srs-q with --target-srs: the SRS's quality factor (default 10) [-]."""
-    if text is None:
-        return 10.0
-    try:
-        q = float(text)
-    except ValueError:
-        q = float("nan")
-    if not 0.5 < q < 1e6:
-        raise OptionError(f"--srs-q: found {text!r}, expected a quality factor above 0.5")
-    return q
+    """--srs-q with --target-srs: the SRS's quality factor (default 10) [-], read by the
+    one grammar every command reads it with."""
+    from ..specification import parse_q
+
+    return 10.0 if text is None else parse_q(text, "--srs-q")
 
 
 def run_spec(args):

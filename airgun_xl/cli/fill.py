@@ -9,6 +9,7 @@ from ..outputs import GROUPS
 from ..transaction import display
 from .run_options import add_force, add_integrator, add_model
 from .spec_options import add_spec_options
+from .vocabulary import One
 
 
 def add_parser(sub):
@@ -21,7 +22,7 @@ def add_parser(sub):
     p.add_argument("shots", nargs="+", metavar="SHOT.xlsx",
                    help="workbook in the report's layout; several, or a folder (its .xlsx "
                         "shots), fill a campaign")
-    p.add_argument("-o", "--output", metavar="OUT.xlsx",
+    p.add_argument("-o", "--output", metavar="OUT.xlsx", action=One,
                    help="output workbook (default: SHOT.out.xlsx beside SHOT; one shot only)")
     add_force(p)
     p.add_argument("--jobs", metavar="N",
@@ -60,7 +61,7 @@ def add_parser(sub):
     p.add_argument("--compare-models", action="store_true",
                    help="also run the other model; both curves in the acceleration chart and "
                         "both peaks in the Summary")
-    p.add_argument("--archive", metavar="DIR",
+    p.add_argument("--archive", metavar="DIR", action=One,
                    help=f"also store the run as a new entry of this archive (default: "
                         f"${ENV} when set)")
     p.add_argument("--name", help="shot name in the archive (default: the cell beside a 'Shot' "
@@ -119,7 +120,9 @@ def print_summary(output, filled):
                                  for c in v.criteria))
         lines += [f"    {line}" for line in v.sources()]
         lines += [f"    note: {line}" for line in v.spec.notes]  # a profile's caveats
-    print("\n".join(lines))
+    from ..untrusted_json import printable
+
+    print("\n".join(printable(line) for line in lines))  # a file's text, never control codes
 
 
 def settings_of(args):

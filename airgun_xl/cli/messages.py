@@ -4,16 +4,36 @@ import sys
 
 
 def _say(text):
-    """One line to stderr, whatever the file names in it hold."""
+    """One line to stderr, whatever the file names and records in it hold: a control
+    character (an escape sequence in a profile's notes) shown as an escape, never sent to
+    the terminal."""
+    from ..untrusted_json import printable
     from .progress import clear_line
 
     stream = sys.stderr
     clear_line(stream)  # a progress bar's line
     encoding = getattr(stream, "encoding", None) or "utf-8"
-    print(text.encode(encoding, "backslashreplace").decode(encoding, "replace"), file=stream)
+    print(printable(text).encode(encoding, "backslashreplace").decode(encoding, "replace"),
+          file=stream)
 
 
 _WARNED: set = set()
+
+
+_LATER: list = []
+
+
+def later(messages):
+    """Notices to print once the command has succeeded (an old spelling's): a refusal stays
+    one line."""
+    _LATER.extend(m for m in messages if m not in _LATER)
+
+
+def say_later():
+    """Print the notices held by :func:`later`, and forget them."""
+    held = list(_LATER)
+    _LATER.clear()
+    note(held)
 
 
 def note(messages):

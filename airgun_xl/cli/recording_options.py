@@ -36,17 +36,21 @@ def record_value(text):
 
 
 def _given(namespace, option_string, value):
-    """Store the class, and which option gave it; the filter given by both its spellings,
-    differently, is refused (the last would otherwise win unseen)."""
+    """Store the class, and which option gave it; the filter given twice, by any of its
+    spellings, differently, is refused (the last would otherwise win unseen)."""
     from ..errors import OptionError
 
-    first = getattr(namespace, "cfc_given", None)
-    if first and first != option_string and getattr(namespace, "cfc", None) != value:
+    seen = getattr(namespace, "_given", None) or {}
+    if "cfc" in seen and seen["cfc"][1] != value:
         def shown(cfc):
             return "none" if cfc is None else str(cfc)
 
-        raise OptionError(f"{option_string}: found {shown(value)}, where {first} gave "
-                          f"{shown(namespace.cfc)}; expected the filter once (--cfc)")
+        first = seen["cfc"][0]
+        again = "again" if first == option_string else f"where {first} gave it"
+        raise OptionError(f"{option_string}: found {shown(value)}, {again} "
+                          f"({shown(seen['cfc'][1])}); expected the filter once (--cfc)")
+    seen["cfc"] = (option_string, value)
+    namespace._given = seen
     namespace.cfc = value
     namespace.cfc_given = option_string
 
@@ -66,8 +70,11 @@ class RecordAlias(Alias):
         super().__init__(option_strings, dest, idea="recording's filter", **kwargs)
 
     def __call__(self, parser, namespace, values, option_string=None):
-        super().__call__(parser, argparse.Namespace(), values, option_string)  # the note
+        from .messages import later
+        from .vocabulary import old_spelling_note, spelling
+
         _given(namespace, option_string or "--record", values)
+        later([old_spelling_note(option_string or "--record", spelling(self.idea))])
 
 
 def sign_value(text):

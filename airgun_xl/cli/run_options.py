@@ -48,7 +48,7 @@ class Integrators(argparse.Action):
     replaced by the first one given). ``legacy,newmark`` is the old spelling of two, noted."""
 
     def __call__(self, parser, namespace, values, option_string=None):
-        from .messages import note
+        from .messages import later
         from .vocabulary import old_spelling_note
 
         names = [n.strip() for n in str(values).split(",")]
@@ -56,7 +56,7 @@ class Integrators(argparse.Action):
             raise argparse.ArgumentError(self, f"found {values!r}, expected one of "
                                                f"{', '.join(sorted(INTEGRATORS))}")
         if len(names) > 1:
-            note([old_spelling_note(f"{option_string} {values}", " ".join(
+            later([old_spelling_note(f"{option_string} {values}", " ".join(
                 f"{option_string} {n}" for n in names))])
         given = getattr(namespace, "integrators_given", False)
         chosen = (getattr(namespace, self.dest) if given else []) + names
@@ -70,7 +70,10 @@ def add_model(p):
 
 def add_output(p, what, default, metavar="OUT.xlsx"):
     """``-o``/``--output``: ``what`` the file holds, and its ``default`` name."""
-    p.add_argument("-o", "--output", metavar=metavar, help=f"{what} (default: {default})")
+    from .vocabulary import One
+
+    p.add_argument("-o", "--output", metavar=metavar, action=One,
+                   help=f"{what} (default: {default})")
 
 
 def add_force(p, metavar="OUT.xlsx"):

@@ -26,53 +26,54 @@ def add_spec_options(p, cfc=True):
     """The specification's options; ``cfc`` False where the command's recording options
     already give ``--cfc`` (accept), the record judged all the same."""
     from .recording_options import CfcOption, RecordAlias, cfc_value, record_value
+    from .vocabulary import Once
 
     g = p.add_argument_group("specification (override the shot's Specification sheet and the"
                              " profile, field by field)")
-    g.add_argument("--profile", metavar="NAME|FILE.json",
+    g.add_argument("--profile", action=Once, metavar="NAME|FILE.json",
                    help="a tolerance profile: a JSON file of specification fields, or the name"
                         " of one shipped (mil-std-810h-half-sine, quoted, not checked)")
-    g.add_argument("--shape", metavar="|".join(SHAPES), help="the nominal pulse shape")
-    g.add_argument("--peak", metavar="PEAK[:TOL]",
+    g.add_argument("--shape", action=Once, metavar="|".join(SHAPES), help="the nominal pulse shape")
+    g.add_argument("--peak", action=Once, metavar="PEAK[:TOL]",
                    help="nominal peak and tolerance: 12kG:10%% or 11750g:-10%%,+20%% (units "
                         "kG, g, m/s^2)")
-    g.add_argument("--duration", metavar="DURATION[:TOL]",
+    g.add_argument("--duration", action=Once, metavar="DURATION[:TOL]",
                    help="nominal duration (the shape's base) and tolerance: 0.3ms:10%% "
                         "(units s, ms, us, ns)")
-    g.add_argument("--velocity-change", metavar="DV[:TOL]",
+    g.add_argument("--velocity-change", action=Once, metavar="DV[:TOL]",
                    help="nominal velocity change and tolerance: 35m/s:10%%")
-    g.add_argument("--corridor", metavar="PCT",
+    g.add_argument("--corridor", action=Once, metavar="PCT",
                    help="corridor half-width round the ideal pulse, %% of the nominal peak: "
                         "20%%")
-    g.add_argument("--time-slack", metavar="PCT",
+    g.add_argument("--time-slack", action=Once, metavar="PCT",
                    help="time slack of the corridor, %% of the duration: 10%% (default 0%%)")
-    g.add_argument("--dv-window", metavar="BEFORE,AFTER",
+    g.add_argument("--dv-window", action=Once, metavar="BEFORE,AFTER",
                    help="the velocity change's window before and after the pulse, in time or"
                         " in nominal durations: 0.4D,0.1D or 1ms,0.5ms (default 0.5D,0.5D)")
-    g.add_argument("--monitor", metavar="BEFORE,AFTER",
+    g.add_argument("--monitor", action=Once, metavar="BEFORE,AFTER",
                    help="the corridor's monitoring window before and after the pulse: "
                         "0.5D,2D (default 1D,1D)")
-    g.add_argument("--window", metavar="DURATION",
+    g.add_argument("--window", action=Once, metavar="DURATION",
                    help="(alias for one release) both windows, the same each side: 0.5ms")
-    g.add_argument("--duration-def", metavar="|".join(DURATION_DEFS),
+    g.add_argument("--duration-def", action=Once, metavar="|".join(DURATION_DEFS),
                    help="the duration judged: each shape's base (a sawtooth's rise; the "
                         "default) or the width at 10%% of the peak")
-    g.add_argument("--decay", metavar="PCT",
+    g.add_argument("--decay", action=Once, metavar="PCT",
                    help="the terminal-peak sawtooth's decay allowance, %% of the duration: "
                         "10%% (the default)")
-    g.add_argument("--placement", metavar="|".join(PLACEMENTS),
+    g.add_argument("--placement", action=Once, metavar="|".join(PLACEMENTS),
                    help="where the ideal pulse sits: least squares (default) or on the peak")
     if cfc:
         g.add_argument("--cfc", type=cfc_value, default=None, metavar="N|none",
                        action=CfcOption, help=RECORD_HELP)
     g.add_argument("--record", type=record_value, metavar="unfiltered|cfcN", dest="cfc",
                    action=RecordAlias)
-    g.add_argument("--srs", metavar="REQ.csv",
+    g.add_argument("--srs", action=Once, metavar="REQ.csv",
                    help="an SRS requirement (CSV: 'frequency [Hz],srs [g]')")
-    g.add_argument("--srs-tol", metavar="LO,HI", help="its tolerance in dB: -3dB,+6dB "
+    g.add_argument("--srs-tol", action=Once, metavar="LO,HI", help="its tolerance in dB: -3dB,+6dB "
                                                       "(default)")
-    g.add_argument("--srs-q", metavar="Q", help="its quality factor (default 10)")
-    g.add_argument("--srs-outside", metavar="PCT",
+    g.add_argument("--srs-q", action=Once, metavar="Q", help="its quality factor (default 10)")
+    g.add_argument("--srs-outside", action=Once, metavar="PCT",
                    help="%% of its frequencies allowed outside the tolerance: 5%% (default "
                         "0%%)")
 

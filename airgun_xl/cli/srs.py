@@ -4,7 +4,15 @@ from pathlib import Path
 from ..errors import OptionError
 from .recording_options import CfcOption, cfc_value
 from .run_options import SHOT_HELP, add_force, add_output, add_run_options
-from .vocabulary import Alias
+from .vocabulary import Alias, One
+
+
+def _q(text):
+    """--srs-q: the one grammar of the SRS's quality factor (finite, above 0.5, at most
+    1,000), as every command reads it."""
+    from ..specification import parse_q
+
+    return parse_q(text, "--srs-q")
 
 
 def add_parser(sub):
@@ -15,9 +23,9 @@ def add_parser(sub):
     p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
     add_output(p, "the SRS workbook", "SHOT.srs.xlsx")
     add_force(p)
-    p.add_argument("--srs-q", type=float, default=10.0, metavar="Q",
+    p.add_argument("--srs-q", type=_q, default=10.0, metavar="Q", action=One,
                    help="quality factor (default 10: 5 %% damping)")
-    p.add_argument("--q", type=float, dest="srs_q", metavar="Q", action=Alias,
+    p.add_argument("--q", type=_q, dest="srs_q", metavar="Q", action=Alias,
                    idea="SRS quality factor")
     p.add_argument("--cfc", type=cfc_value, action=CfcOption, metavar="N|none",
                    help="filter the pulse first: SAE J211 class 60, 180, 600 or 1000, or "

@@ -62,9 +62,68 @@ def old_spelling_note(old: str, new: str) -> str:
     return f"{old} is the old spelling of {new}, kept until the next release: write {new}"
 
 
+def given(namespace, dest, option, value, once=False):
+    """Store ``value`` at ``dest`` for ``option``, refusing a second value for the same idea
+    (by any of its spellings, or by the same one: the last would win unseen); with ``once``
+    (a specification's field), a second time at all.
+
+    Raises
+    ------
+    airgun_xl.errors.OptionError
+    """
+    from ..errors import OptionError
+
+    seen = getattr(namespace, "_given", None)
+    if seen is None:
+        seen = {}
+        setattr(namespace, "_given", seen)
+    if dest in seen:
+        first, earlier = seen[dest]
+        if once or earlier != value:
+            again = "again" if first == option else f"where {first} gave it"
+            raise OptionError(f"{option}: found {_shown(value)}, {again} ({_shown(earlier)}); "
+                              "expected it once")
+    seen[dest] = (option, value)
+    setattr(namespace, dest, value)
+
+
+def _shown(value):
+    text = repr(value) if not isinstance(value, str) else repr(value)
+    return text if len(text) <= 40 else f"{text[:30]}..."
+
+
+class Once(argparse.Action):
+    """A specification's field: given once (a second ``--peak`` is refused, as a second
+    ``--sd`` is), an empty value refused."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        option = option_string or self.dest
+        _not_empty(option, values)
+        given(namespace, self.dest, option, values, once=True)
+
+
+class One(argparse.Action):
+    """An idea's one spelling: a second, different value for it, by this spelling or an
+    old one, is refused."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        option = option_string or self.dest
+        _not_empty(option, values)
+        given(namespace, self.dest, option, values)
+
+
+def _not_empty(option, values):
+    """An option given an empty value (``--archive=``) is refused: it would stand for none."""
+    if isinstance(values, str) and not values.strip():
+        from ..errors import OptionError
+
+        raise OptionError(f"{option}: found an empty value, expected one")
+
+
 class Alias(argparse.Action):
-    """An old spelling: stores its value where the idea's one spelling does, and notes on
-    stderr which spelling replaces it."""
+    """An old spelling: stores its value where the idea's one spelling does (a different
+    value from its one spelling's refused), and notes on stderr, once the command has
+    succeeded, which spelling replaces it."""
 
     def __init__(self, option_strings, dest, idea: str = "", **kwargs):
         self.idea = idea
@@ -72,7 +131,9 @@ class Alias(argparse.Action):
         super().__init__(option_strings, dest, **kwargs)
 
     def __call__(self, parser, namespace, values, option_string=None):
-        from .messages import note
+        from .messages import later
 
-        note([old_spelling_note(option_string or self.dest, spelling(self.idea))])
-        setattr(namespace, self.dest, values)
+        option = option_string or self.dest
+        _not_empty(option, values)
+        given(namespace, self.dest, option, values)
+        later([old_spelling_note(option, spelling(self.idea))])

@@ -6,6 +6,7 @@ import os
 import shutil
 import sqlite3
 
+import numpy as np
 import pytest
 from conftest import TEMPLATE
 from support import refused, run_child, snapshot
@@ -245,3 +246,113 @@ def test_43_14_with_a_server_named_a_new_archive_is_never_a_local_index(tmp_path
     refused(capsys, ["fill", TEMPLATE, "-o", tmp_path / "o.xlsx", "--archive", empty],
             tmp_path, naming=["a new archive"])
     assert not new.exists() and list(empty.iterdir()) == []
+
+
+# -- 43.10 to 43.13: each thing said once, in one grammar -----------------------------------
+
+def _profile(tmp_path, text):
+    path = tmp_path / "lab.json"
+    path.write_text(text)
+    return path
+
+
+def _accept(tmp_path, *flags):
+    recording = TEMPLATE.parent / "shot_a_recording.csv"
+    return ["accept", TEMPLATE, recording, "--sign", "-1", "-o", tmp_path / "v.xlsx", *flags]
+
+
+def test_43_10_a_key_given_twice_in_a_profile_is_refused(tmp_path, capsys):
+    """"peak_tolerance": 10, "peak_tolerance": 50: the last won (a FAIL judged as a PASS);
+    now one line naming the key."""
+    lab = _profile(tmp_path, '{"peak_tolerance": 10, "peak_tolerance": 50}')
+    refused(capsys, _accept(tmp_path, "--profile", lab, "--peak", "9.5kG"), tmp_path,
+            naming=["lab.json", "the key 'peak_tolerance' twice"])
+
+
+def test_43_11_a_specification_option_given_twice_is_refused(tmp_path, capsys):
+    """--peak 12kG:10% --peak 14kG:50%: the last won unseen (a repeated --sd was refused)."""
+    refused(capsys, _accept(tmp_path, "--peak", "12kG:10%", "--peak", "14kG:50%"), tmp_path,
+            naming=["--peak: found '14kG:50%', again ('12kG:10%'); expected it once"])
+    refused(capsys, _accept(tmp_path, "--peak", "9.5kG:10%", "--duration", "5ms:10%",
+                            "--duration", "5ms:10%"), tmp_path, naming=["--duration:"])
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["design", TEMPLATE, "--srs-q", "10", "--q", "2"],
+     "--q: found '2', where --srs-q gave it ('10')"),
+    (["srs", TEMPLATE, "--srs-q", "10", "--q", "2"],
+     "--q: found 2.0, where --srs-q gave it (10.0)"),
+    (["accept", TEMPLATE, TEMPLATE.parent / "shot_a_recording.csv", "--peak", "9.5kG:10%",
+      "--record", "cfc60", "--cfc", "60", "--cfc", "1000"],
+     "--cfc: found 1000, again (60); expected the filter once"),
+])
+def test_43_12_an_idea_by_its_old_and_new_spellings_differently_is_refused(tmp_path, capsys,
+                                                                            argv, said):
+    """Given by a mix of spellings, repeated, with different values: refused in one line,
+    without the old spelling's note before it (a refusal is one line)."""
+    refused(capsys, [*argv, "-o", tmp_path / "x.xlsx"], tmp_path, naming=[said])
+
+
+def test_43_13_srs_q_has_one_grammar_everywhere(tmp_path, capsys):
+    """srs --srs-q inf was accepted where accept refused it, and --srs-q 0 showed numpy's
+    array repr: the one grammar now, in one line each."""
+    for value in ("inf", "0", "1e308", "-3"):
+        line = refused(capsys, ["srs", TEMPLATE, "--srs-q", value, "-o", tmp_path / "s.xlsx"],
+                       tmp_path, naming=[f"--srs-q: found '{value}'"])
+        assert "array" not in line
+    refused(capsys, ["srs", TEMPLATE, "--q", "inf", "-o", tmp_path / "s.xlsx"], tmp_path,
+            naming=["--srs-q: found 'inf'"])
+
+
+@pytest.mark.parametrize("argv", [
+    ["fill", TEMPLATE, "--archive="],
+    ["history", "--archive="],
+    ["fill", TEMPLATE, "-o", ""],
+])
+def test_43_13_an_empty_option_value_is_refused(tmp_path, capsys, argv):
+    """fill --archive= archived nothing, silently: an empty value is one line."""
+    refused(capsys, argv, tmp_path, naming=["found an empty value"])
+
+
+# -- 43.15: booleans of an .xls ------------------------------------------------------------------
+
+@pytest.mark.skipif(shutil.which("soffice") is None, reason="LibreOffice is not installed")
+def test_43_15_a_template_saved_as_xls_by_libreoffice_fills(tmp_path, capsys):
+    """LibreOffice stores the Outputs sheet's TRUE as 1 with a boolean format in an .xls:
+    fill refused it ("Outputs!B2: found 1.0, expected TRUE or FALSE"); now it reads TRUE and
+    FALSE and fills, with the groups the template switches on."""
+    import subprocess
+
+    import openpyxl
+
+    done = subprocess.run(["soffice", f"-env:UserInstallation=file://{tmp_path}/lo",
+                           "--headless", "--convert-to", "xls", "--outdir", str(tmp_path),
+                           str(TEMPLATE)], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    xls = tmp_path / "shot_a.xls"
+    out = tmp_path / "o.xlsx"
+    assert main(["fill", str(xls), "-o", str(out)]) == 0, capsys.readouterr().err
+    names = openpyxl.load_workbook(out, read_only=True).sheetnames
+    assert "Summary" in names
+
+
+# -- 43.16: what reaches the terminal ------------------------------------------------------------
+
+def test_43_16_a_denormal_peak_in_a_profile_is_one_line_not_a_numpy_warning(tmp_path,
+                                                                           capsys):
+    lab = _profile(tmp_path, '{"peak": 5e-324, "peak_tolerance": 10}')
+    with np.errstate(all="raise"):
+        refused(capsys, _accept(tmp_path, "--profile", lab), tmp_path,
+                naming=["lab.json", "peak", "from 1e-6 kG"])
+
+
+def test_43_16_escape_sequences_in_a_profiles_notes_are_escaped(tmp_path, capsys):
+    """A profile's notes holding an escape sequence (clearing the screen, recolouring): on
+    the terminal they are shown as escapes, never sent (history and show escaped theirs)."""
+    lab = _profile(tmp_path, json.dumps({"notes": ["rev C \x1b[2J\x1b[31mPASS\x07"],
+                                         "peak_tolerance": 10}))
+    assert main([str(a) for a in _accept(tmp_path, "--profile", lab, "--peak", "9.5kG",
+                                         "--force")]) in (0, 3)
+    out, err = capsys.readouterr()
+    assert "\x1b" not in out + err and "\x07" not in out + err
+    assert "note: rev C \\x1b[2J\\x1b[31mPASS\\x07" in out
