@@ -15,7 +15,7 @@ from .models import apply_model
 from .reports.fill import render_workbook
 from .reports.sidecar import SIDECAR_SUFFIXES, render_history, sidecar_path
 from .studies.check import after_run, before_run, quirk_fired, unloading_diverged
-from .transaction import Publication, check_output, display
+from .transaction import Publication, check_output, display, signals_held
 from .version import __version__
 
 
@@ -266,7 +266,8 @@ def _publish(shot, filled, output, outputs, info, options, record, progress, sta
         try:
             if options.archive is not None:
                 progress("archiving")
-                archive = Archive(options.archive.root, create=True)  # once the run is done
+                with signals_held():  # its folder and marker made together, or neither
+                    archive = Archive(options.archive.root, create=True)  # after the run
                 pending = prepare_entry(archive, options.archive, shot, workbook, filled,
                                         options, time.perf_counter() - started)
                 pub.join(pending)

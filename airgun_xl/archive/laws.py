@@ -13,9 +13,9 @@ from pathlib import Path
 
 from ..crush_law import DEGREE, CrushLaw
 from ..errors import ArchiveError, OptionError
-from ..transaction import display
+from ..transaction import display, signals_held
 from ..untrusted_json import short
-from .records import all_versions, read_record, store_record, versions
+from .records import all_versions, read_record, versions
 from .store import Archive, safe_name
 
 LAWS = ".laws"
@@ -41,12 +41,13 @@ def store_law(root, name, law, shots, scores, command=()):
     if not name or safe_name(name) != name:
         raise OptionError(f"--name: found {name!r}, expected a law name of letters, digits, "
                           "'-', '_' and '.' (such as LOT-2026-07)")
-    Archive(root, create=True)
     record = {"name": name, "coefficients": list(law.coefficients),
               "v_range": list(law.v_range), "shots": shots, "scores": scores,
               "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
               "command": list(command)}
-    version = store_record(_folder(root, name), record, "the law", root)
+    with signals_held():  # the archive made and the law stored, or neither
+        archive = Archive(root, create=True)
+        version = archive.keep(_folder(root, name), record, "the law")
     return f"{name}@{version}"
 
 

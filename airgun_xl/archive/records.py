@@ -10,6 +10,7 @@ from pathlib import Path
 
 from ..errors import ArchiveError
 from ..transaction import display
+from ..transaction.stages import stage
 
 _VERSION = re.compile(r"^v(\d{4,})\.json$")
 
@@ -132,6 +133,7 @@ def store_record(folder, record, what, root=None):
                 continue
         else:
             raise ArchiveError(f"{display(folder)}: no free version, expected fewer writers")
+        stage("record-stored")
     except OSError as exc:
         raise ArchiveError(f"{display(folder)}: {what} cannot be written "
                            f"({exc.strerror or exc})") from None

@@ -42,8 +42,9 @@ from ..choices import ARCHIVE_ENV
 from ..errors import ArchiveError, OptionError
 from ..transaction import display, fsync, owner_token
 from ..transaction.owners import OWNER_PATTERN
+from ..transaction.stages import stage
 from .index import INDEX, INDEX_ENV, MAX_VERSION, ServerIndex, SqliteIndex, is_sqlite_index
-from .records import inside, link_below
+from .records import inside, link_below, store_record
 
 ENV = ARCHIVE_ENV
 MARKER = ".airgun-xl-archive"
@@ -278,7 +279,12 @@ class Archive:
             except FileExistsError:
                 pass
             except OSError as exc:
+                if self.created_here:  # the folder this made, left as it was: none
+                    with contextlib.suppress(OSError):
+                        os.rmdir(self.root)
                 raise ArchiveError(f"{shown}: cannot be written ({exc.strerror})") from None
+            else:
+                stage("archive-made")
         if not (self.root / MARKER).is_file():
             return
         if dry_run:  # a server archive's agent starts while the run goes on
@@ -407,6 +413,22 @@ class Archive:
                 and manifest["index"]["version"] == row["version"]
                 and self._complete(entry.path, manifest))
 
+    def keep(self, folder, record, what):
+        """Store ``record`` as the next version in ``folder`` (one of the archive's record
+        folders: a law's, a verdict's; :func:`~airgun_xl.archive.records.store_record});
+        return the version. A failure takes back the folders this made and the archive
+        itself if this object created it and nothing else is in it."""
+        folder = Path(folder)
+        made = [f for f in (folder.parent, folder) if not f.exists()]
+        try:
+            return store_record(folder, record, what, self.root)
+        except BaseException:
+            for f in reversed(made):
+                with contextlib.suppress(OSError):
+                    f.rmdir()  # only if empty
+            self.remove_if_unused()
+            raise
+
     def remove_if_unused(self):
         """Undo the creation of a new archive whose first entry was never committed (a failed
         or interrupted fill): remove its empty index, marker and empty scratch folder, then
@@ -515,6 +537,7 @@ class Archive:
             for p in work.iterdir():
                 with open(p, "rb") as fh:
                     os.fsync(fh.fileno())
+            stage("entry-staged")
         except BaseException as exc:
             pending.release()
             if isinstance(exc, OSError):
@@ -817,6 +840,7 @@ class PendingEntry:
             raise ArchiveError(f"{display(self.final)}: cannot be written "
                                f"({exc.strerror})") from None
         try:
+            stage("entry-renamed")
             fsync(self.final.parent, directory=True)
             if not self.conn.insert(self.archive._row(self.manifest, self.final,
                                                       self.archive.root)):

@@ -10,7 +10,7 @@ from pathlib import Path
 from ..errors import ArchiveError
 from ..transaction import display
 from .entry import shot_name
-from .records import all_versions, read_record, store_record
+from .records import all_versions, read_record
 from .store import Archive, safe_name
 
 VERDICTS = ".verdicts"
@@ -46,12 +46,15 @@ def verdict_record(verdict, shot, recording, report, command=()):
 
 
 def store_verdict(root, shot, verdict, recording, report, command=()):
-    """Keep the verdict in the archive at ``root``; return a :class:`StoredVerdict`, which
-    :meth:`StoredVerdict.take_back` undoes."""
+    """Keep the verdict in the archive at ``root`` (made if new); return a
+    :class:`StoredVerdict`, which :meth:`StoredVerdict.take_back` undoes. Call it with signals
+    held (:func:`~airgun_xl.transaction.signals_held`) and assign its result inside that
+    section: a signal then arrives once the record and the archive are whole, and the
+    caller takes them back."""
+    record = verdict_record(verdict, shot, recording, report, command)
     archive = Archive(root, create=True)
     folder = Path(root) / VERDICTS / safe_name(shot_name(shot))
-    record = verdict_record(verdict, shot, recording, report, command)
-    version = store_record(folder, record, "the verdict", root)
+    version = archive.keep(folder, record, "the verdict")  # a failure takes the archive back
     return StoredVerdict(folder / f"v{version:04d}.json", archive)
 
 

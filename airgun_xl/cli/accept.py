@@ -85,9 +85,14 @@ def run(args):
     from ..reports.acceptance import write_acceptance
 
     # the verdict's record first, taken back if the workbook is not published: a failure or
-    # a signal leaves neither
-    stored = record_verdict(args, shot, verdict, output) if args.archive else None
+    # a signal leaves neither (the archive, if this made it, included)
+    from ..transaction import signals_held
+
+    stored = None
     try:
+        if args.archive:
+            with signals_held():  # a signal comes once the record is whole, and assigned
+                stored = record_verdict(args, shot, verdict, output)
         write_acceptance(output, verdict, about, pulse, spectra, args.force,
                          shot=Path(args.shot).name)
     except BaseException:

@@ -36,6 +36,7 @@ from .checks import display
 from .locks import folder_lock, fsync
 from .owners import OWNER_PATTERN, owner_alive, owner_token
 from .signals import SIGNALS, Interrupted, signals_held
+from .stages import stage
 
 SUFFIX = "airgun-xl"
 _OWNED = re.compile(r"^\.(?P<name>.+)\.(?P<owner>" + OWNER_PATTERN + r")-(?P<hex>[0-9a-f]{16})"
@@ -129,6 +130,7 @@ class Publication:
         folder = self.files[0][1].parent
         for temp, _ in self.files:
             fsync(temp)
+        stage("publishing")
         with folder_lock(folder), signals_held():
             if SIGNALS["pending"] is not None:  # swallowed earlier: stop before publishing
                 signum, SIGNALS["pending"] = SIGNALS["pending"], None
@@ -162,6 +164,7 @@ class Publication:
             os.unlink(journal)  # the commit point
             fsync(folder, directory=True)
             self.committed = True
+            stage("published")
             _clean(folder, record)
             SIGNALS["held"] += 1  # done: a signal from now on no longer stops the command
             SIGNALS["committed"] = True

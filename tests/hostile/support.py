@@ -98,3 +98,33 @@ def formulas_in(path):
 def strings_in(path):
     """Every text of a workbook's shared strings and inline strings."""
     return _xml_texts(path, r"<t(?:\s[^>]*)?>(.*?)</t>", ("sharedStrings", "worksheets/"))
+
+
+def at_stage(tmp_path, argv, stage, signum, env=None, timeout=300):
+    """Run ``airgun-xl argv`` in a child held at ``stage`` (airgun_xl.transaction.stages):
+    wait until it reaches the stage (polling the file it writes there: a stage, never a
+    guessed time), send it ``signum``, let it go on. Returns (exit code, stderr, whether the
+    stage was reached)."""
+    import signal as signals
+    import time
+
+    folder = tmp_path / "stages"
+    folder.mkdir(exist_ok=True)
+    for old in folder.iterdir():
+        old.unlink()
+    hold, reached = folder / f"{stage}.hold", folder / f"{stage}.reached"
+    hold.touch()
+    proc = subprocess.Popen([sys.executable, "-m", "airgun_xl", *map(str, argv)],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            env={**os.environ, **(env or {}), "AIRGUN_XL_STAGES": str(folder)})
+    deadline = time.monotonic() + timeout
+    try:
+        while not reached.exists() and proc.poll() is None:
+            assert time.monotonic() < deadline, f"{stage} not reached in {timeout} s"
+            time.sleep(0.002)  # a poll for the stage's file
+        if reached.exists():
+            os.kill(proc.pid, signum) if signum != signals.SIGKILL else proc.kill()
+    finally:
+        hold.unlink(missing_ok=True)
+    code = proc.wait(timeout=timeout)
+    return code, proc.stderr.read(), reached.exists()
