@@ -31,7 +31,9 @@ def _archives(tmp, server):
     env_local = dict(os.environ)
     env_server = dict(os.environ, AIRGUN_XL_INDEX=server.address, PGPASSWORD=pg_server.PASSWORD)
     remote = tmp / "server"
-    subprocess.run([sys.executable, "-m", "airgun_xl", "archive", "init", str(remote)],
+    # made by the schema's owner for the engineers' role, as README's administrator does
+    subprocess.run([sys.executable, "-m", "airgun_xl", "archive", "init", str(remote),
+                    "--index", server.owner_address, "--writers", "lab"],
                    check=True, capture_output=True, env=env_server)
     return [("SQLite in the folder", local, env_local),
             ("PostgreSQL on the loopback (TCP)", remote, env_server)]

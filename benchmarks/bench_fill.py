@@ -53,6 +53,22 @@ PEAK_RSS = (
 )
 
 
+def measured_process(cmd, times):
+    """Run ``cmd`` once to warm up, then ``times`` times: medians' inputs.
+
+    Returns the wall times [s] and each run's peak RSS [MB].
+    """
+    cmd = [sys.executable, "-c", PEAK_RSS, *cmd]
+    subprocess.run(cmd, check=True, capture_output=True)  # warm-up
+    walls, rss = [], []
+    for _ in range(times):
+        started = time.perf_counter()
+        done = subprocess.run(cmd, check=True, capture_output=True, text=True)
+        walls.append(time.perf_counter() - started)
+        rss.append(int(done.stdout.split()[-1]) / 1024)
+    return walls, rss
+
+
 def machine():
     cpu = "unknown cpu"
     try:
@@ -182,14 +198,8 @@ def bench_long(repeat, tmp):
     delta = 5e-8 if quick() else 5e-9  # quick: 120,000 steps
     wb["Sheet1"]["E2"] = delta
     wb.save(shot)
-    cmd = [sys.executable, "-c", PEAK_RSS, *fill_cmd(shot, tmp / "o5.xlsx")]
-    walls, rss = [], []
-    subprocess.run(cmd, check=True, capture_output=True)
-    for _ in range(1 if quick() else max(3, repeat // 2)):
-        started = time.perf_counter()
-        done = subprocess.run(cmd, check=True, capture_output=True, text=True)
-        walls.append(time.perf_counter() - started)
-        rss.append(int(done.stdout.split()[-1]) / 1024)
+    walls, rss = measured_process(fill_cmd(shot, tmp / "o5.xlsx"),
+                                  1 if quick() else max(3, repeat // 2))
     wall, peak = statistics.median(walls), max(rss)
     met = judged(wall <= TARGET_SECONDS and peak <= TARGET_MB)
     rows = round(6e-3 / delta) + 2

@@ -9,15 +9,13 @@ Reports the median wall time over N runs after one warm-up run, the peak RSS, an
 machine. --quick: the same record at 100 MHz.
 """
 import statistics
-import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_fill import PEAK_RSS, TEMPLATE, judged, quick, run_table  # noqa: E402
+from bench_fill import TEMPLATE, judged, measured_process, quick, run_table  # noqa: E402
 
 #: Issue 42's target for accept on the 1 GHz, 4,001-sample record [s], [MB].
 TARGET_SECONDS, TARGET_MB = 10.0, 300
@@ -37,16 +35,10 @@ def recording(path, rate):
 def bench_fast_record(repeat, tmp):
     rate = 1e8 if quick() else 1e9
     path, d = recording(tmp / "ghz.csv", rate)
-    cmd = [sys.executable, "-c", PEAK_RSS, sys.executable, "-m", "airgun_xl", "accept",
+    cmd = [sys.executable, "-m", "airgun_xl", "accept",
            str(TEMPLATE), str(path), "--peak", "12kG:10%", "--duration", f"{d * 1e6:g}us:10%",
            "-o", str(tmp / "v.xlsx"), "--force"]
-    subprocess.run(cmd, check=True, capture_output=True)  # warm-up
-    walls, rss = [], []
-    for _ in range(repeat):
-        started = time.perf_counter()
-        done = subprocess.run(cmd, check=True, capture_output=True, text=True)
-        walls.append(time.perf_counter() - started)
-        rss.append(int(done.stdout.split()[-1]) / 1024)
+    walls, rss = measured_process(cmd, repeat)
     wall, peak = statistics.median(walls), max(rss)
     met = judged(wall <= TARGET_SECONDS and peak <= TARGET_MB)
     return [(f"accept, 4,001 samples at {rate / 1e6:,.0f} MHz (process)", "verdict workbook",

@@ -229,7 +229,8 @@ def test_two_processes_filling_at_once_lose_nothing(tmp_path):
                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
              for k in range(2)]
     for p in procs:
-        assert p.wait(timeout=600) == 0, p.stderr.read()
+        _, err = p.communicate(timeout=600)  # stderr read to its end and closed
+        assert p.returncode == 0, err
     a = Archive(archive)
     assert sorted(e.version for e in a.entries(shot="shot")) == list(range(1, 41))
     assert a.verify() == []

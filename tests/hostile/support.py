@@ -126,5 +126,5 @@ def at_stage(tmp_path, argv, stage, signum, env=None, timeout=300):
             os.kill(proc.pid, signum) if signum != signals.SIGKILL else proc.kill()
     finally:
         hold.unlink(missing_ok=True)
-    code = proc.wait(timeout=timeout)
-    return code, proc.stderr.read(), reached.exists()
+    _, err = proc.communicate(timeout=timeout)  # reads stderr to its end and closes it
+    return proc.returncode, err, reached.exists()

@@ -208,6 +208,7 @@ def test_libreoffice_shows_the_text_and_does_not_run_it(tmp_path):
     assert done.returncode == 0, done.stderr
     import csv
 
-    rows = list(csv.reader((tmp_path / "shot.out.csv").open()))
+    with (tmp_path / "shot.out.csv").open() as text:
+        rows = list(csv.reader(text))
     assert rows[0][0] == "=1+1" and rows[0][6] == "=cmd|' /C calc'!A0"
     assert rows[0][7] == "Time" and float(rows[1][4]) == 5e-07  # E2 as written

@@ -79,7 +79,8 @@ def test_two_fills_to_one_output_without_force_exactly_one_wins(tmp_path):
     for round_ in range(3):
         out = tmp_path / f"race{round_}.xlsx"
         procs = [_fill(out, "--only", "summary", zeta=z) for z in ("0.02", "0.05")]
-        results = [(p.wait(timeout=300), p.stderr.read()) for p in procs]
+        errs = [p.communicate(timeout=300)[1] for p in procs]  # read to the end, closed
+        results = [(p.returncode, err) for p, err in zip(procs, errs)]
         codes = sorted(code for code, _ in results)
         assert codes == [0, 2], results
         loser = next(err for code, err in results if code == 2).strip().splitlines()
@@ -96,11 +97,15 @@ def test_forced_fills_racing_keep_each_workbook_with_its_own_sidecar(tmp_path):
     for _ in range(4):
         procs = [_fill(out, "--force", "--sidecar", "always", "--only", "positions",
                        zeta=z) for z in ("0.02", "0.3")]
-        assert [p.wait(timeout=300) for p in procs] == [0, 0]
-        sheet = openpyxl.load_workbook(out, read_only=True).worksheets[0]
+        for p in procs:
+            p.communicate(timeout=300)  # pipes read to the end and closed
+        assert [p.returncode for p in procs] == [0, 0]
+        book = openpyxl.load_workbook(out, read_only=True)
+        sheet = book.worksheets[0]
         zeta = sheet["E43"].value
         y33 = np.array([r[0] for r in sheet.iter_rows(min_row=2, max_row=12003, min_col=12,
                                                        max_col=12, values_only=True)])
+        book.close()  # read-only workbooks hold their file open until closed
         history = pd.read_parquet(sidecar)
         assert zeta in (0.02, 0.3)
         np.testing.assert_array_equal(history["y33"].to_numpy(), y33)  # exact: same run
