@@ -521,7 +521,8 @@ def error_budget(fit, blocks, residuals=None, scale=None):
 
     Measured on the recorder model over 200 seeds (tests/test_calibration_intervals.py),
     white noise and AR(1) noise of 0.6 (half its variance) and 0.8: every node's 95 %
-    interval holds the truth inside the binomial band.
+    interval holds the truth inside the exact binomial band taken family-wise over the 37
+    intervals checked (pooled, AR(1) 0.8's cover 92.7 %: slightly narrow).
 
     A singular J^T J (a parameter the residuals do not see) gives infinite errors.
 
