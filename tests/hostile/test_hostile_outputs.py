@@ -80,7 +80,7 @@ def test_two_fills_to_one_output_without_force_exactly_one_wins(tmp_path):
         out = tmp_path / f"race{round_}.xlsx"
         procs = [_fill(out, "--only", "summary", zeta=z) for z in ("0.02", "0.05")]
         errs = [p.communicate(timeout=300)[1] for p in procs]  # read to the end, closed
-        results = [(p.returncode, err) for p, err in zip(procs, errs)]
+        results = [(p.returncode, err) for p, err in zip(procs, errs, strict=True)]
         codes = sorted(code for code, _ in results)
         assert codes == [0, 2], results
         loser = next(err for code, err in results if code == 2).strip().splitlines()
