@@ -128,6 +128,7 @@ SLOW_TESTS = {
     "test_parameters_round_trip_exactly", "test_reduced_models_run",
     "test_libreoffice_reads_the_output", "test_summary_matches_the_report_figures",
     "test_two_processes_filling_at_once_lose_nothing", "test_libreoffice_renders_every_chart",
+    "test_two_fills_making_one_archive_at_once_both_find_it_whole",
     "test_the_estimate_is_above_the_measured_peak",
     "test_23_11_durations_with_an_exponent_and_a_unit_run",
     "test_23_16_a_file_size_limit_is_one_line_with_no_zipfile_traceback",

@@ -52,6 +52,43 @@ SCRATCH = ".airgun-xl-scratch"
 MANIFEST = "manifest.json"
 FORMAT = 1
 _SCRATCH_NAME = re.compile(r"^(?P<owner>" + OWNER_PATTERN + r")-[0-9a-f]{32}$")
+
+#: A marker being written (:func:`_write_marker`): a new archive's folder holding only
+#: these is still empty to a fill that comes to it at the same moment.
+_MARKER_TEMP = re.compile(r"^\." + re.escape(MARKER) + r"\." + OWNER_PATTERN + r"\.tmp$")
+
+
+def _write_marker(root, marker):
+    """Write ``marker`` as ``root``'s marker, whole or not at all: written and synced under
+    a name of its own, then linked to the marker's name, which fails if it exists (two
+    fills making one archive at once: one marker, and no fill ever reads half of one).
+    Returns whether this call made it. Where the file system has no hard links, the
+    rename that takes its place is exclusive on Windows; on POSIX it may replace a marker
+    made the same moment, which says the same (a new archive's index is the folder's)."""
+    root = Path(root)
+    temp = root / f".{MARKER}.{owner_token()}.tmp"
+    try:
+        with open(temp, "x") as fh:
+            json.dump(marker, fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+        try:
+            os.link(temp, root / MARKER)
+        except FileExistsError:
+            return False
+        except OSError as exc:
+            if exc.errno not in (errno.EPERM, errno.EOPNOTSUPP, errno.ENOTSUP, errno.EMLINK):
+                raise
+            if (root / MARKER).exists():
+                return False
+            try:
+                os.rename(temp, root / MARKER)  # exclusive on Windows
+            except FileExistsError:
+                return False
+        fsync(root, directory=True)
+        return True
+    finally:
+        temp.unlink(missing_ok=True)
 _ENTRY_NAME = re.compile(r"^v(\d{4,})$")
 def archive_dir(given=None, required=True):
     """The archive folder: the given one, else $AIRGUN_XL_ARCHIVE."""
@@ -261,8 +298,8 @@ class Archive:
         marked = (self.root / MARKER).is_file() or is_sqlite_index(self.root / INDEX)
         if not marked:
             try:
-                with os.scandir(self.root) as found:
-                    empty = not any(found)
+                with os.scandir(self.root) as found:  # a marker being written: still empty
+                    empty = not any(not _MARKER_TEMP.match(f.name) for f in found)
             except OSError as exc:
                 raise ArchiveError(f"{shown}: cannot be read ({exc.strerror})") from None
             # a fill that created the folder a moment ago may have marked it since we looked
@@ -274,16 +311,13 @@ class Archive:
                        else "a folder written by airgun-xl fill --archive"))
         if create and not dry_run and not (self.root / MARKER).is_file():
             try:
-                with open(self.root / MARKER, "x") as fh:
-                    json.dump({"format": FORMAT, "tool": "airgun-xl"}, fh)
-            except FileExistsError:
-                pass
+                made = _write_marker(self.root, {"format": FORMAT, "tool": "airgun-xl"})
             except OSError as exc:
                 if self.created_here:  # the folder this made, left as it was: none
                     with contextlib.suppress(OSError):
                         os.rmdir(self.root)
                 raise ArchiveError(f"{shown}: cannot be written ({exc.strerror})") from None
-            else:
+            if made:
                 stage("archive-made")
         if not (self.root / MARKER).is_file():
             return
@@ -330,10 +364,8 @@ class Archive:
             marker = {"format": FORMAT, "tool": "airgun-xl"}
             if server is not None:
                 marker.update(index="server", identity=server.identity)
-            with open(root / MARKER, "x") as fh:
-                json.dump(marker, fh)
-                fh.flush()
-                os.fsync(fh.fileno())
+            if not _write_marker(root, marker):
+                raise FileExistsError(errno.EEXIST, "made by another command meanwhile")
         except OSError as exc:
             if made:
                 shutil.rmtree(root, ignore_errors=True)
@@ -378,11 +410,14 @@ class Archive:
             marker = {"format": FORMAT, "tool": "airgun-xl", "index": "server",
                       "identity": server.identity}
             temp = self.root / f".{MARKER}.{owner_token()}.tmp"
-            with open(temp, "w") as fh:
-                json.dump(marker, fh)
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.replace(temp, self.root / MARKER)  # from here on, writers use the server
+            try:
+                with open(temp, "w") as fh:
+                    json.dump(marker, fh)
+                    fh.flush()
+                    os.fsync(fh.fileno())
+                os.replace(temp, self.root / MARKER)  # from here on, writers use the server
+            finally:
+                temp.unlink(missing_ok=True)
             fsync(self.root, directory=True)
         finally:
             session.close()
