@@ -116,7 +116,7 @@ SLOW_MODULES = {
     "test_hostile_outputs", "test_hostile_properties", "test_hostile_measured_properties",
     "test_hostile_spec_properties",
     "test_hostile_archive", "test_pure_python", "test_typing", "test_sensitivity",
-    "test_calibration_intervals", "test_benchmarks",
+    "test_calibration_intervals", "test_benchmarks", "test_golden_commands",
 }
 
 
