@@ -12,11 +12,11 @@ written as a name instead (found by running the walk twice, tests/test_golden_co
 
 - the terminal text: the copy's folder is ``<clone>``; times of day (an entry's creation, a
   run's start) ``<date>``; measured run times (``in 5.2 s``, ``(135 runs, 0.75 s)``,
-  ``(0.35 s a shot)``, convergence's kernel and total seconds, show's ``run_seconds``)
-  ``<time>``; a sweep's shot-steps per second ``<rate>``; checksums ``<sha256>`` (an
-  archived workbook's holds its run times); an entry's ``"id"`` ``<id>`` (shots filled with
-  ``--jobs`` are numbered in the order their workers end, which also orders their lines:
-  a ``--jobs`` line's text is compared sorted);
+  ``(0.35 s a shot)``, show's ``started <date>, 0.05 s`` and ``run_seconds``, convergence's
+  kernel and total seconds) ``<time>``; a sweep's shot-steps per second ``<rate>``;
+  checksums ``<sha256>`` (an archived workbook's holds its run times); an entry's ``"id"``
+  ``<id>`` (shots filled with ``--jobs`` are numbered in the order their workers end, which
+  also orders their lines: a ``--jobs`` line's text is compared sorted);
 - each workbook (.xlsx) written, as the SHA-256 of its parts uncompressed, in order: every
   sheet, chart and style as XlsxWriter or openpyxl wrote them (the zip's compression is
   zlib's, not ours), with its texts normalised as above, a fill's run times (its Summary's
@@ -90,10 +90,12 @@ _ID = re.compile(r'("id": )\d+')
 _SECONDS = re.compile(r'("(?:run|kernel)_seconds": )[0-9.eE+-]+')
 
 #: Measured run times in the terminal text: calibrate's "(135 runs, 0.75 s)", a
-#: campaign's "(0.35 s a shot)", convergence's table's kernel and total seconds.
+#: campaign's "(0.35 s a shot)", show's provenance ("started <date>, 0.05 s"), convergence's
+#: table's kernel and total seconds.
 _RUN_TIMES = (
     (re.compile(r"(\d runs, )\d+(?:\.\d+)? s\)"), r"\1<time>)"),
     (re.compile(r"\(\d+(?:\.\d+)? s a shot\)"), "(<time> a shot)"),
+    (re.compile(r"(started <date>, )\d+(?:\.\d+)? s\b"), r"\1<time>"),
     (re.compile(r"(?m)^(\s+\S+\s+[\d,]+\s+)\d+\.\d+(\s+)\d+\.\d+(?=\s+\d)"),
      r"\1<time>\2<time>"),
 )
