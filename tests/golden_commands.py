@@ -16,13 +16,15 @@ written as a name instead (found by running the walk twice, tests/test_golden_co
   kernel and total seconds) ``<time>``; a sweep's shot-steps per second ``<rate>``;
   checksums ``<sha256>`` (an archived workbook's holds its run times); an entry's ``"id"``
   ``<id>`` (shots filled with ``--jobs`` are numbered in the order their workers end, which
-  also orders their lines: a ``--jobs`` line's text is compared sorted);
+  also orders their lines: a ``--jobs`` line's text is compared sorted, and so is
+  history's, which lists the entries in the order they were archived);
 - each workbook (.xlsx) written, as the SHA-256 of its parts uncompressed, in order: every
   sheet, chart and style as XlsxWriter or openpyxl wrote them (the zip's compression is
   zlib's, not ours), with its texts normalised as above, a fill's run times (its Summary's
   two rows of them; ``--reproducible`` leaves them out, the documents' fills do not give
   it) and convergence's time columns written 0, and the charts' caches of the sheets'
   numbers left out (the numbers are compared on the sheets);
+- a workbook history writes by its rows' values, sorted (tests/golden_commands.row_digest);
 - other files written (.csv, .json) by their bytes, a PNG by its being written (its bytes
   are matplotlib's version's); an archive's folders are not compared (their records hold
   the time they were made; show and history print them).
@@ -188,6 +190,28 @@ def digest(path):
     return h.hexdigest()
 
 
+def row_digest(path):
+    """SHA-256 of a workbook's sheets' rows, each row's values normalised, the rows sorted:
+    for what history writes, whose rows come in the order the shots were archived (by
+    ``fill --jobs``, the order its workers end)."""
+    import datetime
+
+    import openpyxl
+
+    h = hashlib.sha256()
+    book = openpyxl.load_workbook(path, read_only=True)
+    try:
+        for sheet in book.worksheets:
+            rows = sorted(repr(tuple(
+                "<date>" if isinstance(v, datetime.datetime) else
+                normalise(v, Path("/nonexistent")) if isinstance(v, str) else v for v in row))
+                for row in sheet.iter_rows(values_only=True))
+            h.update(sheet.title.encode() + b"\0" + "\n".join(rows).encode())
+    finally:
+        book.close()
+    return "rows " + h.hexdigest()
+
+
 def _files(work):
     """{relative path: digest} of what the commands write (lab/, outside archives)."""
     out = {}
@@ -211,12 +235,16 @@ def walk(work, env):
                               text=True, timeout=600)
         after = _files(work)
         out, err = normalise(done.stdout, work), normalise(done.stderr, work)
-        if "--jobs" in line:  # the shots' lines come in the order their workers end
+        files = {k: v for k, v in after.items() if before.get(k) != v}
+        # the shots' lines come in the order fill --jobs's workers end, and history lists
+        # the entries in the order they were archived
+        if "--jobs" in line or line.startswith("airgun-xl history"):
             out, err = ("".join(sorted(t.splitlines(keepends=True))) for t in (out, err))
-        records.append({
-            "document": name, "line": line, "code": done.returncode, "stdout": out,
-            "stderr": err,
-            "files": {k: v for k, v in after.items() if before.get(k) != v}})
+        if line.startswith("airgun-xl history"):
+            files = {k: row_digest(work / k) if k.endswith(".xlsx") else v
+                     for k, v in files.items()}
+        records.append({"document": name, "line": line, "code": done.returncode,
+                        "stdout": out, "stderr": err, "files": files})
         before = after
     return records
 
