@@ -28,6 +28,7 @@ from .errors import (
 from .version import __version__
 
 if TYPE_CHECKING:
+    from .app.accept import AcceptOutcome
     from .params import ShotParams
     from .result import Result
     from .shot import Shot
@@ -54,6 +55,79 @@ def load(path: str | os.PathLike[str]) -> Shot:
     return Shot.from_workbook(path)
 
 
+def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
+           peak: str | None = None, duration: str | None = None,
+           velocity_change: str | None = None, shape: str | None = None,
+           corridor: str | None = None, time_slack: str | None = None,
+           dv_window: str | None = None, monitor: str | None = None,
+           duration_def: str | None = None, decay: str | None = None,
+           placement: str | None = None, srs: str | os.PathLike[str] | None = None,
+           srs_tol: str | None = None, srs_q: str | None = None,
+           srs_outside: str | None = None, profile: str | os.PathLike[str] | None = None,
+           cfc: int | str | None = None, output: str | os.PathLike[str] | None = None,
+           force: bool = False, archive: str | os.PathLike[str] | None = None,
+           channel: str | None = None, sign: float = 1.0, time_unit: str | None = None,
+           accel_unit: str | None = None) -> AcceptOutcome:
+    """Judge a recording against the shot's specification, as ``airgun-xl accept`` does.
+
+    The specification is the ``profile``'s, then the shot's Specification sheet's, then
+    the fields given here, each overriding the one before field by field; every field is
+    text in the command's grammar (``peak="12kG:10%"``, ``duration="5ms:10%"``), and a
+    refusal names the option the keyword stands for (``--peak``). ``cfc`` is the record
+    judged: a SAE J211 class (60, 180, 600, 1000) or ``"none"``.
+
+    Parameters
+    ----------
+    shot : path
+        The shot's workbook, in the report's layout.
+    recording : path
+        The recorded pulse: a CSV (time, acceleration, units in the header), a workbook's
+        columns (``trace.xlsx:Sheet1!A:B``) or a LabVIEW TDMS file.
+    output : path, optional
+        The verdict workbook to write (none is written if not given).
+    archive : path, optional
+        Keep the verdict in this archive (needs ``output``, which the record names).
+    sign : float
+        1, or -1 when the recorder's axis is opposite to the macro's [-].
+
+    Returns
+    -------
+    airgun_xl.app.accept.AcceptOutcome
+        ``passed``, ``criteria``, ``warnings``, the files written.
+
+    Raises
+    ------
+    AirgunXlError
+        Bad input, named; nothing is written.
+    """
+    from pathlib import Path
+
+    from .app.accept import AcceptRequest, run
+    from .app.specifying import SpecFields, cfc_class
+
+    def text(value: object) -> str | None:
+        return None if value is None else os.fspath(value) if isinstance(
+            value, os.PathLike) else str(value)
+
+    record = None
+    if cfc is not None:
+        try:
+            record = cfc_class(str(cfc))
+        except ValueError as exc:
+            raise OptionError(f"--cfc: {exc}") from None
+    fields = SpecFields(
+        profile=text(profile), shape=text(shape), peak=text(peak), duration=text(duration),
+        velocity_change=text(velocity_change), corridor=text(corridor),
+        time_slack=text(time_slack), dv_window=text(dv_window), monitor=text(monitor),
+        duration_def=text(duration_def), decay=text(decay), placement=text(placement),
+        srs=text(srs), srs_tol=text(srs_tol), srs_q=text(srs_q), srs_outside=text(srs_outside),
+        cfc=record, cfc_given="--cfc" if cfc is not None else None, accel_unit=accel_unit)
+    return run(AcceptRequest(
+        Path(shot), os.fspath(recording), fields, Path(output) if output is not None else None,
+        force, Path(archive) if archive is not None else None, channel, float(sign), time_unit,
+        accel_unit, ("accept",)))
+
+
 __all__ = [
     "AirgunXlError",
     "ArchiveError",
@@ -70,5 +144,6 @@ __all__ = [
     "ShotParams",
     "WorkbookError",
     "__version__",
+    "accept",
     "load",
 ]

@@ -17,7 +17,7 @@ ROOT = Path(__file__).resolve().parents[1]
 DOCUMENTS = ("README.md", "docs/cell-map.md", "docs/output.md", "docs/trust.md",
              "docs/studies.md", "docs/acceptance.md", "docs/legacy.md", "docs/security.md",
              "docs/speed.md",
-             "docs/layout.md", "docs/dependencies.md")
+             "docs/layout.md", "docs/dependencies.md", "docs/api.md")
 
 #: The blocks not run: (document, first line).
 NOT_RUN = [

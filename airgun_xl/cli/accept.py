@@ -34,80 +34,35 @@ def add_parser(sub):
     p.set_defaults(run=run)
 
 
-def run(args):
-
-    from ..errors import OptionError
-    from ..readers.recording import input_file, read_trace
-    from ..shot import Shot
-    from ..studies.acceptance import expectations, judge_record
-    from ..studies.measured import prepare
-    from ..transaction import check_output
-    from .messages import warn
-    from .spec_options import resolve_spec
+def request_of(args):
+    """The :class:`~airgun_xl.app.accept.AcceptRequest` the command line asks for (its
+    default output beside the shot)."""
+    from ..app.accept import AcceptRequest
+    from ..app.specifying import SpecFields
 
     shot_path = Path(args.shot)
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".accept.xlsx")
-    check_output(output, args.force, inputs=[args.shot, input_file(args.recording)])
-    if args.archive:  # a folder that is not an archive: refused before any work
-        from ..archive import Archive
+    return AcceptRequest(shot_path, args.recording, SpecFields.of(args), output, args.force,
+                         Path(args.archive) if args.archive else None, args.channel, args.sign,
+                         args.time_unit, args.accel_unit, tuple(args.argv))
 
-        Archive(args.archive, create=True, dry_run=True)
-    shot = Shot.from_workbook(args.shot)
-    spec = resolve_spec(shot, args)
-    if spec is None:
-        raise OptionError(f"{args.shot}: its Specification sheet is empty and no option gives"
-                          " a criterion; expected --peak, --duration, --velocity-change, --srs"
-                          " or --profile")
-    cfc = spec.judged.cfc  # --cfc is the specification's record field, over the sheet's
-    trace = read_trace(args.recording, args.time_unit, args.accel_unit, args.sign,
-                       args.channel)
-    from ..studies.shock import check_cfc
 
-    filtering = check_cfc(cfc, trace.dt) if cfc else []
-    expected, notes = expectations(shot, spec)
-    # zeroed and its quality read; the record judged is made below
-    rec = prepare(trace, None, anti_alias="none", flat_top=spec.shape == "trapezoid",
-                  expected=expected,
-                  nominal_duration=spec.duration.nominal if spec.duration else None)
-    verdict = judge_record(rec.trace.time, rec.corrected, spec, trace.name,
-                           noise=rec.base.noise,
-                           warnings=shot.warnings + filtering + rec.warnings,
-                           quality=rec.quality)
-    verdict.definitions += notes
-    assert verdict.record is not None
-    time, kg = verdict.record
-    pulse, spectra = report_data(time, kg, spec, verdict)
-    about = [("Shot", str(args.shot)), ("Recording", trace.name),
-             ("Units read", f"time {trace.units[0]}, acceleration {trace.units[1]}"),
-             ("Record judged", verdict.definitions[0].removeprefix("record judged: ")),
-             ("Baseline", rec.base.words()), ("Verdict", verdict.word)]
-    from ..reports.acceptance import write_acceptance
+def run(args):
+    from ..app.accept import run as accept
+    from .messages import warn
 
-    # the verdict's record first, taken back if the workbook is not published: a failure or
-    # a signal leaves neither (the archive, if this made it, included)
-    from ..transaction import signals_held
-
-    stored = None
-    try:
-        if args.archive:
-            with signals_held():  # a signal comes once the record is whole, and assigned
-                stored = record_verdict(args, shot, verdict, output)
-        write_acceptance(output, verdict, about, pulse, spectra, args.force,
-                         shot=Path(args.shot).name)
-    except BaseException:
-        if stored is not None:
-            stored.take_back()
-        raise
-    if stored is not None:
-        print(f"  archived the verdict as {stored.path}")
-    print_verdict(verdict, f"{trace.name} against {args.shot}")
-    print(f"  wrote {output}")
-    eq = spectra["equivalent"]
-    print(f"  equivalent half-sine (its SRS envelops the record's): {eq[0]:.4f} kG, "
-          f"{eq[1] * 1e3:.4f} ms; pseudo-velocity up to {max(spectra['pv']):.3f} m/s")
-    warn(verdict.warnings)
-    return 0 if verdict.passed else FAIL_EXIT
+    outcome = accept(request_of(args))
+    if outcome.archived is not None:
+        print(f"  archived the verdict as {outcome.archived}")
+    print_verdict(outcome.verdict, f"{outcome.recording} against {args.shot}")
+    print(f"  wrote {outcome.output}")
+    peak, duration = outcome.equivalent_half_sine
+    print(f"  equivalent half-sine (its SRS envelops the record's): {peak:.4f} kG, "
+          f"{duration * 1e3:.4f} ms; pseudo-velocity up to {outcome.peak_pseudo_velocity:.3f}"
+          " m/s")
+    warn(list(outcome.warnings))
+    return 0 if outcome.passed else FAIL_EXIT
 
 
 def print_verdict(verdict, what):
@@ -130,56 +85,3 @@ def print_verdict(verdict, what):
         print(printable(f"  {line}"))
     for line in verdict.spec.notes:  # a profile's caveats, with every verdict judged by it
         print(printable(f"  note: {line}"))
-
-
-def report_data(time, kg, spec, verdict):
-    """The pulse with its corridor, and the spectra, for the verdict workbook."""
-    import numpy as np
-
-    from ..studies.acceptance import corridor_limits, equivalent_half_sine, ideal, pseudo_velocity
-    from ..studies.shock import decimated_for, default_frequencies, srs
-
-    pulse = {"time": time, "kg": kg}
-    if spec.corridor is not None and verdict.onset is not None:
-        tau = time - verdict.onset
-        upper, lower = corridor_limits(spec, tau)
-        lo, hi = verdict.window
-        inside = (time >= lo) & (time <= hi)
-        pulse["ideal"] = ideal(spec.shape, tau, spec.peak.nominal, spec.duration.nominal)
-        pulse["upper"] = np.where(inside, upper, np.nan)
-        pulse["lower"] = np.where(inside, lower, np.nan)
-    dt = time[1] - time[0]
-    q = spec.srs_q if spec.srs is not None and spec.srs_q is not None else 10.0
-    top = 0.1 / dt  # the SRS's highest frequency at this rate
-    if spec.srs is not None:  # the requirement's band on a 1/12-octave grid, and its rows
-        required_f = np.array(spec.srs.frequencies)
-        lo, hi = required_f.min(), min(required_f.max(), top)
-        grid = default_frequencies(lo, hi) if hi > lo else np.array([lo])
-        frequencies = np.unique(np.concatenate([grid, required_f[required_f <= top]]))
-    else:  # 100 Hz to 10 kHz, or below a tenth of a slow record's rate
-        hi = min(10_000.0, top)
-        frequencies = default_frequencies(min(100.0, hi / 16), hi)
-    # on the record decimated to what the frequencies need: a 1 GHz record's would take
-    # minutes and gigabytes at its own step, for the same spectrum
-    spectral, step, factor = decimated_for(kg, dt, float(np.max(frequencies)))
-    levels = srs(spectral, step, frequencies, q)
-    spectra = {"frequencies": frequencies, "srs": levels, "q": q,
-               "pv": pseudo_velocity(frequencies, levels),
-               "equivalent": equivalent_half_sine(
-                   step * np.arange(len(spectral)), spectral, frequencies, q),
-               "step": (step, factor)}
-    if spec.srs is not None:  # log-log between the requirement's rows
-        required = np.exp(np.interp(np.log(frequencies), np.log(required_f),
-                                    np.log(np.array(spec.srs.levels_kg))))
-        spectra.update(required=required, lower=required * 10 ** (spec.srs_lower_db / 20),
-                       upper=required * 10 ** (spec.srs_upper_db / 20))
-    return pulse, spectra
-
-
-def record_verdict(args, shot, verdict, output):
-    """The verdict into the archive (a JSON file beside the shot's entries): a
-    :class:`~airgun_xl.archive.verdicts.StoredVerdict`."""
-    from ..archive.verdicts import store_verdict
-
-    return store_verdict(args.archive, shot, verdict, args.recording, output,
-                         tuple(args.argv))

@@ -127,9 +127,9 @@ def print_summary(output, filled):
 
 def settings_of(args):
     """The :class:`~airgun_xl.campaign.FillSettings` the command line asks for."""
+    from ..app.specifying import SpecFields, options_spec
     from ..campaign import FillSettings
     from ..specification import load_profile
-    from .spec_options import options_spec
 
     return FillSettings(
         args.output, args.force, args.host, args.only, args.no_charts, args.every,
@@ -138,7 +138,7 @@ def settings_of(args):
         str(archive_dir(args.archive, required=False) or "") or None, args.name,
         args.reproducible, tuple(args.argv),
         load_profile(args.profile) if args.profile else None,  # once, before any shot
-        options_spec(args))
+        options_spec(SpecFields.of(args)))
 
 
 def run(args):

@@ -6,21 +6,15 @@ import argparse
 from ..specification import CFC_CLASSES
 from .vocabulary import Alias
 
-#: What ``--cfc`` takes, said by every refusal of it.
-CFC_EXPECTED = "a J211 class (60, 180, 600 or 1000) or none"
-
 
 def cfc_value(text):
     """``--cfc``: a SAE J211 class, or ``none`` for no filter (None)."""
-    if text.strip().lower() == "none":
-        return None
+    from ..app.specifying import cfc_class
+
     try:
-        value = int(text)
-    except ValueError:
-        value = None
-    if value not in CFC_CLASSES:
-        raise argparse.ArgumentTypeError(f"found {text!r}, expected {CFC_EXPECTED}")
-    return value
+        return cfc_class(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def record_value(text):

@@ -4,16 +4,8 @@ design, accept): a profile, then the fields, each overriding the shot's Specific
 Every value is read by the specification's grammar (:data:`airgun_xl.specification.KEYS`),
 the one the profile and the sheet use; a value an option gives overrides the sheet's and the
 profile's even when it equals the default (``--time-slack 0%``)."""
-from ..specification import DURATION_DEFS, OPTIONS, PLACEMENTS, SHAPES
-
-#: The options with the grammar keys they give, from the one table
-#: (:data:`airgun_xl.specification.OPTIONS`): a quantity's option gives its tolerance too
-#: (``--peak 12kG:10%``), ``--srs-tol`` gives the two dB sides, every other option one key.
-QUANTITY_OPTIONS = tuple((key, option) for key, option in OPTIONS.items()
-                         if f"{key}_tolerance" in OPTIONS)
-PLAIN_OPTIONS = tuple((key, option) for key, option in OPTIONS.items()
-                      if option not in dict(QUANTITY_OPTIONS).values()
-                      and option not in ("--srs-tol", "--cfc"))
+from ..app.specifying import PLAIN_OPTIONS, QUANTITY_OPTIONS  # noqa: F401 (the CLI's names)
+from ..specification import DURATION_DEFS, PLACEMENTS, SHAPES
 
 #: The help of the record judged, where ``--cfc`` is a field of the specification.
 RECORD_HELP = ("the record judged: N through SAE J211 CFC N (60, 180, 600 or 1000), none "
@@ -80,81 +72,26 @@ def add_spec_options(p, cfc=True):
 
 def options_spec(args):
     """The specification fields the command line gives, without the profile; None when it
-    gives none.
+    gives none (:func:`airgun_xl.app.specifying.options_spec`).
 
     Raises
     ------
     airgun_xl.errors.OptionError
         Naming the option and what it expects.
     """
-    from ..readers.recording import read_spectrum
-    from ..specification import (
-        ALIASES,
-        KEYS,
-        OPTIONS,
-        SHOWN_UNITS,
-        SrsRequirement,
-        cfc_record,
-        parse_db_pair,
-        parse_window,
-        spec_of_keys,
-        typed_unit,
-    )
+    from ..app.specifying import SpecFields, options_spec
 
-    parsed = {}
-    for key, option in QUANTITY_OPTIONS:
-        text = getattr(args, key, None)
-        if text is not None:
-            parsed.update(_quantity_option(key, option, text))
-    for key, option in PLAIN_OPTIONS:
-        text = getattr(args, key, None)
-        if text is not None:
-            parsed[key] = KEYS[key].parse(text, option)
-    if getattr(args, "window", None) is not None:  # the alias: what the options do not say
-        window = parse_window(args.window, "--window")
-        for key in ALIASES["window"]:
-            parsed.setdefault(key, window)
-    if getattr(args, "cfc_given", None):  # --cfc none: the unfiltered record, said
-        parsed["record"] = cfc_record(args.cfc)
-    if getattr(args, "srs_tol", None) is not None:
-        parsed["srs_lower_db"], parsed["srs_upper_db"] = parse_db_pair(args.srs_tol)
-    srs = None
-    if getattr(args, "srs", None) is not None:
-        freqs, levels = read_spectrum(args.srs, getattr(args, "accel_unit", None))
-        srs = SrsRequirement(tuple(map(float, freqs)), tuple(map(float, levels)))
-    if not parsed and srs is None:
-        return None
-    units = {key: typed_unit(getattr(args, key)) for key, _ in QUANTITY_OPTIONS
-             if key in SHOWN_UNITS and getattr(args, key, None) is not None}
-    places = {key: option for key, option in OPTIONS.items() if key in parsed}
-    if "record" in parsed:
-        places["record"] = args.cfc_given  # --cfc, or its old spelling as typed
-    if getattr(args, "window", None) is not None:
-        places.update({k: "--window" for k in ALIASES["window"] if k not in places or
-                       getattr(args, k, None) is None})
-    return spec_of_keys(parsed, "options", srs, {**places, "srs": "--srs"}, units)
-
-
-def _quantity_option(key, option, text):
-    """``12kG:10%`` -> {key: 12.0, key_tolerance: (0.1, 0.1)}; ``12kG`` -> the nominal only
-    (its tolerance from the sheet or the profile)."""
-    from ..specification import KEYS
-
-    value, sep, tolerance = str(text).partition(":")
-    parsed = {key: KEYS[key].parse(value, option)}
-    if sep:
-        parsed[f"{key}_tolerance"] = KEYS[f"{key}_tolerance"].parse(tolerance, option)
-    return parsed
+    return options_spec(SpecFields.of(args))
 
 
 def resolve_spec(shot, args):
     """The specification a command judges by: the profile, then the shot's sheet, then the
-    options, each overriding the one before field by field; None when nothing is specified.
+    options (:func:`airgun_xl.app.specifying.resolve`); None when nothing is specified.
 
     Raises
     ------
     airgun_xl.errors.OptionError
     """
-    from ..specification import combine
+    from ..app.specifying import SpecFields, resolve
 
-    return combine(args.profile, shot.spec, options_spec(args))
+    return resolve(shot, SpecFields.of(args))

@@ -1,0 +1,7 @@
+"""The application layer: one module per command, each a typed function
+``run(request) -> outcome`` on frozen dataclasses (issue 44). The CLI parses its options into
+a request and prints the outcome; the Python API (:mod:`airgun_xl`) builds the same request
+from keyword arguments.
+
+Moved here so far: ``accept`` (and the specification fields every judging command takes,
+:mod:`.specifying`). The other commands are still composed in ``airgun_xl.cli``."""

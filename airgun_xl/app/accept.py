@@ -1,0 +1,213 @@
+"""Accept: did the fired shot meet its specification? The recording read (its quality
+assessed before it is judged), judged criterion by criterion, the verdict workbook written
+and the verdict archived.
+
+:func:`run` takes an :class:`AcceptRequest` and returns an :class:`AcceptOutcome`; the CLI
+(``airgun-xl accept``) and the Python API (:func:`airgun_xl.accept`) are both this."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import OptionError
+from .specifying import SpecFields, require, resolve
+
+if TYPE_CHECKING:
+    from ..shot import Shot
+    from ..specification import Specification
+    from ..studies.acceptance import Criterion, Verdict
+
+
+@dataclass(frozen=True)
+class AcceptRequest:
+    """What to judge, and what to write.
+
+    ``output`` None writes no workbook (the CLI gives its default, ``SHOT.accept.xlsx``);
+    ``archive`` keeps the verdict in that archive, naming the workbook (so needs one).
+    ``sign`` is 1 or -1 [-]; the units, where given, override the recording's header."""
+
+    shot: Path
+    recording: str
+    spec: SpecFields = field(default_factory=SpecFields)
+    output: Path | None = None
+    force: bool = False
+    archive: Path | None = None
+    channel: str | None = None
+    sign: float = 1.0
+    time_unit: str | None = None
+    accel_unit: str | None = None
+    argv: tuple[str, ...] = ()  # the command, as the archive records it
+
+
+@dataclass(frozen=True)
+class AcceptOutcome:
+    """The verdict, and everything the command wrote and said."""
+
+    verdict: Verdict
+    shot: Path
+    recording: str  # the recording's name, as read (a TDMS file's channel included)
+    output: Path | None  # the verdict workbook, if one was written
+    archived: Path | None  # the verdict's archive record, if kept
+    equivalent_half_sine: tuple[float, float]  # (peak [kG], duration [s]) whose SRS envelops
+    peak_pseudo_velocity: float  # [m/s], the record's SRS's highest
+    files: tuple[Path, ...]  # every file written
+
+    @property
+    def passed(self) -> bool:
+        """True when every criterion passed."""
+        return self.verdict.passed
+
+    @property
+    def word(self) -> str:
+        """``PASS`` or ``FAIL``."""
+        return self.verdict.word
+
+    @property
+    def criteria(self) -> list[Criterion]:
+        """The criteria judged, a line each."""
+        return self.verdict.criteria
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """Every warning the verdict carries (read them before relying on it)."""
+        return tuple(self.verdict.warnings)
+
+
+def run(request: AcceptRequest) -> AcceptOutcome:
+    """Judge ``request.recording`` against the shot's specification.
+
+    Raises
+    ------
+    airgun_xl.errors.AirgunXlError
+        Bad input (a file, a field, an option), named; nothing is written.
+    """
+    from ..readers.recording import input_file, read_trace
+    from ..shot import Shot
+    from ..studies.acceptance import expectations, judge_record
+    from ..studies.measured import prepare
+    from ..studies.shock import check_cfc
+    from ..transaction import check_output
+
+    if request.sign not in (1.0, -1.0):
+        raise OptionError(f"--sign: found {request.sign!r}, expected 1 or -1")
+    if request.output is not None:
+        check_output(request.output, request.force,
+                     inputs=[request.shot, input_file(request.recording)])
+    if request.archive is not None:  # a folder that is not an archive: refused before work
+        if request.output is None:
+            raise OptionError("--archive: found no verdict workbook to name, expected an "
+                              "output too")
+        from ..archive import Archive
+
+        Archive(request.archive, create=True, dry_run=True)
+    shot = Shot.from_workbook(request.shot)
+    spec = require(resolve(shot, request.spec), request.shot)
+    cfc = spec.judged.cfc  # --cfc is the specification's record field, over the sheet's
+    trace = read_trace(request.recording, request.time_unit, request.accel_unit, request.sign,
+                       request.channel)
+    filtering = check_cfc(cfc, trace.dt) if cfc else []
+    expected, notes = expectations(shot, spec)
+    # zeroed and its quality read; the record judged is made below
+    rec = prepare(trace, None, anti_alias="none", flat_top=spec.shape == "trapezoid",
+                  expected=expected,
+                  nominal_duration=spec.duration.nominal if spec.duration else None)
+    verdict = judge_record(rec.trace.time, rec.corrected, spec, trace.name,
+                           noise=rec.base.noise,
+                           warnings=shot.warnings + filtering + rec.warnings,
+                           quality=rec.quality)
+    verdict.definitions += notes
+    assert verdict.record is not None
+    time, kg = verdict.record
+    pulse, spectra = report_data(time, kg, spec, verdict)
+    archived = None
+    if request.output is not None:
+        archived = _write(request, shot, verdict, trace, rec, pulse, spectra)
+    eq = spectra["equivalent"]
+    files = tuple(p for p in (archived, request.output) if p is not None)
+    return AcceptOutcome(verdict, Path(request.shot), trace.name, request.output, archived,
+                         (float(eq[0]), float(eq[1])), float(np.max(spectra["pv"])), files)
+
+
+def _write(request: AcceptRequest, shot: Shot, verdict: Verdict, trace: Any, rec: Any,
+           pulse: dict[str, Any], spectra: dict[str, Any]) -> Path | None:
+    """The verdict's record first (if asked), taken back if the workbook is not published: a
+    failure or a signal leaves neither (the archive, if this made it, included). The
+    record's path."""
+    from ..reports.acceptance import write_acceptance
+    from ..transaction import signals_held
+
+    assert request.output is not None
+    about = [("Shot", str(request.shot)), ("Recording", trace.name),
+             ("Units read", f"time {trace.units[0]}, acceleration {trace.units[1]}"),
+             ("Record judged", verdict.definitions[0].removeprefix("record judged: ")),
+             ("Baseline", rec.base.words()), ("Verdict", verdict.word)]
+    stored = None
+    try:
+        if request.archive is not None:
+            from ..archive.verdicts import store_verdict
+
+            with signals_held():  # a signal comes once the record is whole, and assigned
+                stored = store_verdict(request.archive, shot, verdict, request.recording,
+                                       request.output, request.argv)
+        write_acceptance(request.output, verdict, about, pulse, spectra, request.force,
+                         shot=Path(request.shot).name)
+    except BaseException:
+        if stored is not None:
+            stored.take_back()
+        raise
+    return stored.path if stored is not None else None
+
+
+def report_data(time: np.ndarray, kg: np.ndarray, spec: Specification,
+                verdict: Verdict) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The pulse with its corridor, and the spectra, for the verdict workbook: time [s],
+    acceleration [kG], frequencies [Hz], SRS levels [kG], pseudo-velocity [m/s]."""
+    from ..studies.acceptance import (
+        corridor_limits,
+        equivalent_half_sine,
+        ideal,
+        pseudo_velocity,
+    )
+    from ..studies.shock import decimated_for, default_frequencies, srs
+
+    pulse: dict[str, Any] = {"time": time, "kg": kg}
+    if spec.corridor is not None and verdict.onset is not None:
+        assert spec.peak is not None and spec.duration is not None and verdict.window
+        tau = time - verdict.onset
+        upper, lower = corridor_limits(spec, tau)
+        lo, hi = verdict.window
+        inside = (time >= lo) & (time <= hi)
+        pulse["ideal"] = ideal(spec.shape, tau, spec.peak.nominal, spec.duration.nominal)
+        pulse["upper"] = np.where(inside, upper, np.nan)
+        pulse["lower"] = np.where(inside, lower, np.nan)
+    dt = time[1] - time[0]
+    q = spec.srs_q if spec.srs is not None and spec.srs_q is not None else 10.0
+    top = 0.1 / dt  # the SRS's highest frequency at this rate
+    if spec.srs is not None:  # the requirement's band on a 1/12-octave grid, and its rows
+        required_f = np.array(spec.srs.frequencies)
+        lo, hi = required_f.min(), min(required_f.max(), top)
+        grid = default_frequencies(lo, hi) if hi > lo else np.array([lo])
+        frequencies = np.unique(np.concatenate([grid, required_f[required_f <= top]]))
+    else:  # 100 Hz to 10 kHz, or below a tenth of a slow record's rate
+        hi = min(10_000.0, top)
+        frequencies = default_frequencies(min(100.0, hi / 16), hi)
+    # on the record decimated to what the frequencies need: a 1 GHz record's would take
+    # minutes and gigabytes at its own step, for the same spectrum
+    spectral, step, factor = decimated_for(kg, dt, float(np.max(frequencies)))
+    levels = srs(spectral, step, frequencies, q)
+    spectra: dict[str, Any] = {
+        "frequencies": frequencies, "srs": levels, "q": q,
+        "pv": pseudo_velocity(frequencies, levels),
+        "equivalent": equivalent_half_sine(step * np.arange(len(spectral)), spectral,
+                                           frequencies, q),
+        "step": (step, factor)}
+    if spec.srs is not None:  # log-log between the requirement's rows
+        assert spec.srs_lower_db is not None and spec.srs_upper_db is not None  # resolved
+        required = np.exp(np.interp(np.log(frequencies), np.log(required_f),
+                                    np.log(np.array(spec.srs.levels_kg))))
+        spectra.update(required=required, lower=required * 10 ** (spec.srs_lower_db / 20),
+                       upper=required * 10 ** (spec.srs_upper_db / 20))
+    return pulse, spectra

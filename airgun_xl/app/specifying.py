@@ -1,0 +1,173 @@
+"""The specification fields a command is given (the CLI's options, the Python API's keyword
+arguments), each as text in the specification's grammar
+(:data:`airgun_xl.specification.KEYS`, the one the profile and the sheet use), and the
+specification a shot is judged by.
+
+A field given overrides the sheet's and the profile's even when it equals the default
+(``time_slack="0%"``)."""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from ..errors import OptionError
+from ..specification import (
+    ALIASES,
+    CFC_CLASSES,
+    KEYS,
+    OPTIONS,
+    SHOWN_UNITS,
+    SrsRequirement,
+    cfc_record,
+    combine,
+    parse_db_pair,
+    parse_window,
+    spec_of_keys,
+    typed_unit,
+)
+
+if TYPE_CHECKING:
+    from ..shot import Shot
+    from ..specification import Specification
+
+#: The fields with the grammar keys they give, from the one table
+#: (:data:`airgun_xl.specification.OPTIONS`): a quantity's field gives its tolerance too
+#: (``peak="12kG:10%"``), ``srs_tol`` gives the two dB sides, every other field one key.
+QUANTITY_OPTIONS = tuple((key, option) for key, option in OPTIONS.items()
+                         if f"{key}_tolerance" in OPTIONS)
+PLAIN_OPTIONS = tuple((key, option) for key, option in OPTIONS.items()
+                      if option not in dict(QUANTITY_OPTIONS).values()
+                      and option not in ("--srs-tol", "--cfc"))
+
+#: What a record's filter takes, said by every refusal of it.
+CFC_EXPECTED = "a J211 class (60, 180, 600 or 1000) or none"
+
+
+def cfc_class(text: str) -> int | None:
+    """A record's filter: a SAE J211 class, or None for ``none`` (no filter).
+
+    Raises
+    ------
+    ValueError
+        Saying what was found and what is expected (the caller names the option).
+    """
+    if str(text).strip().lower() == "none":
+        return None
+    try:
+        value: int | None = int(text)
+    except ValueError:
+        value = None
+    if value not in CFC_CLASSES:
+        raise ValueError(f"found {text!r}, expected {CFC_EXPECTED}")
+    return value
+
+
+@dataclass(frozen=True)
+class SpecFields:
+    """The specification fields given, as text (None: not given). The names are the
+    specification's keys (:data:`~airgun_xl.specification.OPTIONS`, tied to it by
+    tests/test_app_accept.py); ``cfc`` is the record judged, given by the option (or keyword)
+    ``cfc_given`` names."""
+
+    profile: str | None = None
+    shape: str | None = None
+    peak: str | None = None  # nominal [kG, g, m/s^2] and tolerance: 12kG:10%
+    duration: str | None = None  # nominal [s, ms, us, ns] and tolerance: 5ms:10%
+    velocity_change: str | None = None  # nominal [m/s] and tolerance: 35m/s:10%
+    corridor: str | None = None  # [% of the nominal peak]
+    time_slack: str | None = None  # [% of the duration]
+    dv_window: str | None = None
+    monitor: str | None = None
+    window: str | None = None  # the old alias of both windows
+    duration_def: str | None = None
+    decay: str | None = None  # [% of the duration]
+    placement: str | None = None
+    srs: str | None = None  # a requirement's CSV file
+    srs_tol: str | None = None  # [dB] lower,upper
+    srs_q: str | None = None  # [-]
+    srs_outside: str | None = None  # [% of the frequencies]
+    cfc: int | None = None  # the J211 class of the record judged (None: none, when given)
+    cfc_given: str | None = None  # the option that gave ``cfc`` (None: not given)
+    accel_unit: str | None = None  # the requirement's unit where its file says none
+
+    @classmethod
+    def of(cls, source: Any) -> SpecFields:
+        """The fields an object holds as attributes of these names (an argparse namespace),
+        missing ones not given."""
+        return cls(**{f.name: getattr(source, f.name, None)
+                      for f in dataclasses.fields(cls)})
+
+
+def options_spec(fields: SpecFields) -> Specification | None:
+    """The specification the fields give, without the profile; None when they give none.
+
+    Raises
+    ------
+    airgun_xl.errors.OptionError
+        Naming the option and what it expects.
+    """
+    from ..readers.recording import read_spectrum
+
+    parsed: dict[str, Any] = {}
+    for key, option in QUANTITY_OPTIONS:
+        text = getattr(fields, key)
+        if text is not None:
+            parsed.update(_quantity_option(key, option, text))
+    for key, option in PLAIN_OPTIONS:
+        text = getattr(fields, key)
+        if text is not None:
+            parsed[key] = KEYS[key].parse(text, option)
+    if fields.window is not None:  # the alias: what the options do not say
+        window = parse_window(fields.window, "--window")
+        for key in ALIASES["window"]:
+            parsed.setdefault(key, window)
+    if fields.cfc_given:  # --cfc none: the unfiltered record, said
+        parsed["record"] = cfc_record(fields.cfc)
+    if fields.srs_tol is not None:
+        parsed["srs_lower_db"], parsed["srs_upper_db"] = parse_db_pair(fields.srs_tol)
+    srs = None
+    if fields.srs is not None:
+        freqs, levels = read_spectrum(fields.srs, fields.accel_unit)
+        srs = SrsRequirement(tuple(map(float, freqs)), tuple(map(float, levels)))
+    if not parsed and srs is None:
+        return None
+    units = {key: typed_unit(getattr(fields, key)) for key, _ in QUANTITY_OPTIONS
+             if key in SHOWN_UNITS and getattr(fields, key) is not None}
+    places = {key: option for key, option in OPTIONS.items() if key in parsed}
+    if "record" in parsed:
+        places["record"] = str(fields.cfc_given)  # --cfc, or its old spelling as typed
+    if fields.window is not None:
+        places.update({k: "--window" for k in ALIASES["window"] if k not in places or
+                       getattr(fields, k) is None})
+    return spec_of_keys(parsed, "options", srs, {**places, "srs": "--srs"}, units)
+
+
+def _quantity_option(key: str, option: str, text: str) -> dict[str, Any]:
+    """``12kG:10%`` -> {key: 12.0, key_tolerance: (0.1, 0.1)}; ``12kG`` -> the nominal only
+    (its tolerance from the sheet or the profile)."""
+    value, sep, tolerance = str(text).partition(":")
+    parsed = {key: KEYS[key].parse(value, option)}
+    if sep:
+        parsed[f"{key}_tolerance"] = KEYS[f"{key}_tolerance"].parse(tolerance, option)
+    return parsed
+
+
+def resolve(shot: Shot, fields: SpecFields) -> Specification | None:
+    """The specification a command judges by: the profile, then the shot's sheet, then the
+    fields, each overriding the one before field by field; None when nothing is specified.
+
+    Raises
+    ------
+    airgun_xl.errors.OptionError
+    """
+    return combine(fields.profile, shot.spec, options_spec(fields))
+
+
+def require(spec: Specification | None, shot: object) -> Specification:
+    """``spec``, or the refusal of a judgement with nothing to judge by."""
+    if spec is None:
+        raise OptionError(f"{shot}: its Specification sheet is empty and no option gives"
+                          " a criterion; expected --peak, --duration, --velocity-change, --srs"
+                          " or --profile")
+    return spec

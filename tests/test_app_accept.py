@@ -1,0 +1,139 @@
+"""Issue 44: accept as a function (airgun_xl.app.accept.run) and as the Python API
+(airgun_xl.accept), driven without the CLI.
+
+The pulses are constructed: a 40 g, 11 ms half-sine with 5 ms of rest each side, sampled at
+51.2 kHz with no noise, written to CSV with every digit (repr); the template's shot (its
+Specification sheet empty) gives only the shot's warnings."""
+import dataclasses
+import inspect
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from conftest import TEMPLATE
+
+import airgun_xl
+from airgun_xl.app.accept import AcceptRequest, run
+from airgun_xl.app.specifying import PLAIN_OPTIONS, QUANTITY_OPTIONS, SpecFields
+from airgun_xl.cli import main
+from airgun_xl.errors import OptionError
+from airgun_xl.specification import OPTIONS
+from airgun_xl.studies.acceptance import ideal
+from airgun_xl.units import KG_MS2, G
+
+A_G, D, REST, RATE = 40.0, 11e-3, 5e-3, 51_200.0
+A = A_G * G / KG_MS2  # [kG]
+
+
+@pytest.fixture
+def recording(tmp_path):
+    t = np.arange(0.0, 2 * REST + D, 1 / RATE)
+    kg = ideal("half-sine", t - REST, A, D)
+    path = tmp_path / "rec.csv"
+    path.write_text("time [s],acceleration [kG]\n" + "\n".join(
+        f"{float(a)!r},{float(b)!r}" for a, b in zip(t, kg, strict=True)) + "\n")
+    return path
+
+
+def test_the_api_judges_an_ideal_half_sine_by_its_keywords(recording):
+    """40 g:10 %, 11 ms:10 %, a half-sine judged unfiltered: the peak within 1e-5 of 40 g
+    (the nearest sample to the crest is at most 1/(2 x 51.2 kHz) off it:
+    1 - cos(pi x 9.8 us / 11 ms) = 4e-6), the duration (the base, from the 10 % crossings
+    interpolated between samples) within 1e-5 of 11 ms (O((dt/D)^2) = 3e-6), the corridor's
+    margin its 20 % (the tool's default half-width) to 1e-6 %."""
+    v = airgun_xl.accept(TEMPLATE, recording, shape="half-sine", peak="40g:10%",
+                         duration="11ms:10%", cfc="none")
+    assert v.passed and v.word == "PASS"
+    by = {c.name: c for c in v.criteria}
+    assert list(by) == ["peak", "duration", "corridor"]
+    assert by["peak"].unit == "g" and by["peak"].value == pytest.approx(40.0, rel=1e-5)
+    assert by["peak"].low == pytest.approx(36.0) and by["peak"].high == pytest.approx(44.0)
+    assert by["duration"].unit == "ms" and by["duration"].value == pytest.approx(11.0, rel=1e-5)
+    assert by["corridor"].margin == pytest.approx(20.0, abs=1e-6)
+    # a half-sine's SRS is enveloped by itself: 40 g (0.0400 kG) and 11 ms, to the 2 % of the
+    # equivalent's search grid (issue 25)
+    peak, duration = v.equivalent_half_sine
+    assert peak == pytest.approx(A, rel=2e-2) and duration == pytest.approx(D, rel=2e-2)
+    assert v.output is None and v.files == () and v.archived is None
+    # the 5 ms of rest are shorter than the default monitoring window (1D = 11 ms each side)
+    assert v.warnings == ("corridor: monitored from 0.0000 to 20.9961 ms only, what the "
+                          "record holds of the tool's default window (-6.0000 to 27.0000 ms,"
+                          " 1D before, 1D after the pulse): give --monitor to judge a window "
+                          "of your own",)
+
+
+def test_a_pulse_out_of_tolerance_fails_and_says_which_criterion(recording):
+    v = airgun_xl.accept(TEMPLATE, recording, peak="50g:10%", duration="11ms:10%", cfc="none")
+    assert not v.passed and v.word == "FAIL"
+    assert [(c.name, c.passed) for c in v.criteria] == [("peak", False), ("duration", True)]
+    # 40 g is 20 % under 50 g: 10 % past the lower limit, to the 1e-5 of the peak's reading
+    assert v.criteria[0].margin == pytest.approx(-10.0, abs=1e-3)
+
+
+def test_the_function_and_the_command_give_the_same_verdict(tmp_path, recording, capsys):
+    """The CLI is the function: the same figures printed, to the digits printed."""
+    out = tmp_path / "cli.xlsx"
+    assert main(["accept", str(TEMPLATE), str(recording), "--peak", "40g:10%", "--duration",
+                 "11ms:10%", "--cfc", "none", "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    request = AcceptRequest(TEMPLATE, str(recording),
+                            SpecFields(peak="40g:10%", duration="11ms:10%", cfc=None,
+                                       cfc_given="--cfc"), tmp_path / "app.xlsx")
+    outcome = run(request)
+    for c in outcome.criteria:
+        assert f"PASS  {c.name}: {c.value:.5g} {c.unit}" in printed
+    assert outcome.files == (tmp_path / "app.xlsx",) and (tmp_path / "app.xlsx").is_file()
+    assert f"{outcome.equivalent_half_sine[0]:.4f} kG" in printed
+
+
+def test_nothing_is_written_unless_asked_and_what_is_written_is_listed(tmp_path, recording):
+    before = sorted(tmp_path.iterdir())
+    airgun_xl.accept(TEMPLATE, recording, peak="40g:10%")
+    assert sorted(tmp_path.iterdir()) == before
+    v = airgun_xl.accept(TEMPLATE, recording, peak="40g:10%", output=tmp_path / "v.xlsx",
+                         archive=tmp_path / "lab")
+    assert v.archived is not None and v.archived.is_file()
+    assert v.files == (v.archived, tmp_path / "v.xlsx")
+    assert all(p.is_file() for p in v.files)
+
+
+@pytest.mark.parametrize("given, named", [
+    ({"peak": "12KG"}, "--peak: found the unit 'KG'"),
+    ({"peak": "40g:10%", "cfc": 42}, "--cfc: found '42', expected a J211 class"),
+    ({"peak": "40g:10%", "sign": 2}, "--sign: found 2.0, expected 1 or -1"),
+    ({"peak": "40g:10%", "archive": "lab"}, "--archive: found no verdict workbook"),
+    ({}, "its Specification sheet is empty and no option gives a criterion"),
+])
+def test_bad_keywords_are_refused_naming_the_option_and_write_nothing(tmp_path, recording,
+                                                                      given, named):
+    before = sorted(tmp_path.rglob("*"))
+    with pytest.raises(OptionError) as caught:
+        airgun_xl.accept(TEMPLATE, recording, **given)
+    assert named in str(caught.value) and "\n" not in str(caught.value)
+    assert sorted(tmp_path.rglob("*")) == before
+
+
+def test_the_keywords_are_the_specifications_fields():
+    """One declaration: the API's keywords, the request's fields and the grammar's table
+    (specification.OPTIONS) name the same fields; a field added to the table and not here
+    fails."""
+    table = {key for key, _ in QUANTITY_OPTIONS + PLAIN_OPTIONS} | {"srs", "srs_tol", "profile",
+                                                                   "cfc"}
+    assert {o for k, o in OPTIONS.items()} == {
+        "--" + k.replace("_", "-") for k in table - {"srs", "profile", "cfc"}} | {"--cfc"}
+    fields = {f.name for f in dataclasses.fields(SpecFields)}
+    assert table <= fields and fields - table == {"window", "cfc_given", "accel_unit"}
+    keywords = {name for name, p in inspect.signature(airgun_xl.accept).parameters.items()
+                if p.kind is p.KEYWORD_ONLY}
+    assert table <= keywords
+
+
+def test_importing_the_package_stays_light():
+    """accept is a function of the package, and importing the package still loads neither
+    numpy nor the application layer (the CLI sets up its signals first)."""
+    done = subprocess.run([sys.executable, "-c", "import sys, airgun_xl; "
+                           "assert callable(airgun_xl.accept); "
+                           "print(sorted(m for m in ('numpy', 'airgun_xl.app', 'pandas') "
+                           "if m in sys.modules))"], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "[]"
