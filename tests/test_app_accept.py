@@ -137,3 +137,41 @@ def test_importing_the_package_stays_light():
                            "print(sorted(m for m in ('numpy', 'airgun_xl.app', 'pandas') "
                            "if m in sys.modules))"], capture_output=True, text=True, check=True)
     assert done.stdout.strip() == "[]"
+
+
+def test_accept_json_is_the_outcome_for_a_lims(tmp_path, recording, capsys):
+    """``accept --json``: one JSON document on stdout, the same criteria as the function's,
+    the same exit status (3 on FAIL) and the warnings on stderr as well as in the document."""
+    import json
+
+    out = tmp_path / "v.xlsx"
+    code = main(["accept", str(TEMPLATE), str(recording), "--shape", "half-sine", "--peak",
+                 "50g:10%", "--duration", "11ms:10%", "--cfc", "none", "-o", str(out),
+                 "--json"])
+    captured = capsys.readouterr()
+    assert code == 3
+    document = json.loads(captured.out)
+    outcome = airgun_xl.accept(TEMPLATE, recording, shape="half-sine", peak="50g:10%",
+                               duration="11ms:10%", cfc="none")
+    assert document["verdict"] == "FAIL" and document["passed"] is False
+    assert [(c["name"], c["value"], c["unit"], c["low"], c["high"], c["passed"])
+            for c in document["criteria"]] == [
+        (c.name, c.value, c.unit, c.low, c.high, c.passed) for c in outcome.criteria]
+    assert document["files"] == [str(out)] and document["archived"] is None
+    assert document["warnings"] == list(outcome.warnings) != []
+    assert all(w in captured.err for w in outcome.warnings)
+    assert document["equivalent_half_sine"]["duration_s"] == pytest.approx(D, rel=2e-2)
+
+
+def test_accept_json_escapes_what_the_files_say(tmp_path, recording, capsys):
+    """A recording's name with a terminal's escape sequence reaches stdout escaped (JSON's
+    \\u001b), never as the control character itself."""
+    import json
+
+    hostile = tmp_path / "rec\x1b[2J.csv"
+    hostile.write_bytes(recording.read_bytes())
+    assert main(["accept", str(TEMPLATE), str(hostile), "--peak", "40g:10%", "-o",
+                 str(tmp_path / "v.xlsx"), "--json"]) == 0
+    out = capsys.readouterr().out
+    assert "\x1b" not in out and "\\u001b[2J" in out
+    assert json.loads(out)["recording"] == str(hostile)

@@ -251,3 +251,28 @@ def test_cfc_is_the_record_judged_in_every_command_that_judges(words):
                                         "of 60, 180, 600, 1000"):
         parser.parse_args([*positionals, "--record", "cfc7"])
     assert "--cfc N|none" in parser.format_usage()
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["fill", "t.xlsx", "--forse"],
+     "airgun-xl: error: fill: unrecognized arguments: --forse (did you mean --force?)\n"),
+    (["accept", "s.xlsx", "r.csv", "--peek", "12kG"],
+     "airgun-xl: error: accept: unrecognized arguments: --peek 12kG (did you mean --peak?)\n"),
+    (["history", "--jsn"],
+     "airgun-xl: error: history: unrecognized arguments: --jsn (did you mean --json?)\n"),
+    # nothing near enough (difflib's ratio under 0.75): no guess
+    (["design", "s.xlsx", "--crush-law", "LOT-2026-07"],
+     "airgun-xl: error: design: unrecognized arguments: --crush-law LOT-2026-07\n"),
+    (["--forse"], "airgun-xl: error: unrecognized arguments: --forse\n"),
+])
+def test_an_unknown_option_is_refused_by_its_command_with_the_nearest_one(argv, said, capsys,
+                                                                         tmp_path,
+                                                                         monkeypatch):
+    """Issue 44: "unrecognized arguments" named no command and guessed nothing."""
+    from airgun_xl.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    captured = capsys.readouterr()
+    assert captured.err == said and captured.out == ""
+    assert list(tmp_path.iterdir()) == []

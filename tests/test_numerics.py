@@ -236,6 +236,23 @@ def test_convergence_command(tmp_path, capsys):
     assert ws["A1"].value == "Integrator" and ws["B1"].value == "Time step (µs)"
     assert ws["B2"].value == pytest.approx(2.0, rel=1e-12)  # µs, as shown
     assert (tmp_path / "c.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert f"wrote {out} and {tmp_path / 'c.png'}" in printed
+
+
+def test_convergence_without_matplotlib_says_it_wrote_no_png(tmp_path, capsys, monkeypatch):
+    """Issue 44: without matplotlib (an extra) the workbook is written, the PNG is not, and
+    the command says so instead of naming a PNG it did not write."""
+    import sys
+
+    for name in [m for m in sys.modules if m == "matplotlib" or m.startswith("matplotlib.")]:
+        monkeypatch.delitem(sys.modules, name)
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # import matplotlib raises
+    out = tmp_path / "c.xlsx"
+    assert main(["convergence", str(TEMPLATE), "-o", str(out), "--levels", "10us,5us"]) == 0
+    captured = capsys.readouterr()
+    assert f"wrote {out}\n" in captured.out and ".png" not in captured.out
+    assert "matplotlib is not installed: no PNG" in captured.err
+    assert out.is_file() and not (tmp_path / "c.png").exists()
 
 
 def test_shot_params_for_the_reduced_model_check():

@@ -6,6 +6,8 @@ and the verdict archived.
 (``airgun-xl accept``) and the Python API (:func:`airgun_xl.accept`) are both this."""
 from __future__ import annotations
 
+import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -54,6 +56,7 @@ class AcceptOutcome:
     equivalent_half_sine: tuple[float, float]  # (peak [kG], duration [s]) whose SRS envelops
     peak_pseudo_velocity: float  # [m/s], the record's SRS's highest
     files: tuple[Path, ...]  # every file written
+    record: dict[str, Any]  # the verdict as the archive keeps it (archive/verdicts.py)
 
     @property
     def passed(self) -> bool:
@@ -75,6 +78,24 @@ class AcceptOutcome:
         """Every warning the verdict carries (read them before relying on it)."""
         return tuple(self.verdict.warnings)
 
+    def to_json(self) -> str:
+        """The outcome as one JSON document (``accept --json``, for a LIMS): the archive's
+        record of the verdict (criteria with value, limits and margin in their unit, the
+        tolerances, definitions, warnings, the recording and what it said of itself), the
+        equivalent half-sine, and the files written. A value that is not finite is null; the
+        text is ASCII, a file's control characters escaped (never sent to a terminal)."""
+        def finite(value: float) -> float | None:
+            return value if math.isfinite(value) else None
+
+        peak, duration = self.equivalent_half_sine
+        document = {**self.record, "passed": self.passed,
+                    "equivalent_half_sine": {"peak_kG": finite(peak),
+                                             "duration_s": finite(duration)},
+                    "peak_pseudo_velocity_m_s": finite(self.peak_pseudo_velocity),
+                    "archived": str(self.archived) if self.archived is not None else None,
+                    "files": [str(p) for p in self.files]}
+        return json.dumps(document, indent=1, allow_nan=False)
+
 
 def run(request: AcceptRequest) -> AcceptOutcome:
     """Judge ``request.recording`` against the shot's specification.
@@ -84,6 +105,7 @@ def run(request: AcceptRequest) -> AcceptOutcome:
     airgun_xl.errors.AirgunXlError
         Bad input (a file, a field, an option), named; nothing is written.
     """
+    from ..archive.verdicts import verdict_record
     from ..readers.recording import input_file, read_trace
     from ..shot import Shot
     from ..studies.acceptance import expectations, judge_record
@@ -127,8 +149,11 @@ def run(request: AcceptRequest) -> AcceptOutcome:
         archived = _write(request, shot, verdict, trace, rec, pulse, spectra)
     eq = spectra["equivalent"]
     files = tuple(p for p in (archived, request.output) if p is not None)
+    record = verdict_record(verdict, shot, request.recording,
+                            request.output if request.output is not None else "", request.argv)
     return AcceptOutcome(verdict, Path(request.shot), trace.name, request.output, archived,
-                         (float(eq[0]), float(eq[1])), float(np.max(spectra["pv"])), files)
+                         (float(eq[0]), float(eq[1])), float(np.max(spectra["pv"])), files,
+                         record)
 
 
 def _write(request: AcceptRequest, shot: Shot, verdict: Verdict, trace: Any, rec: Any,

@@ -31,6 +31,10 @@ def add_parser(sub):
     p.add_argument("--archive", metavar="DIR", action=One,
                    help="record the verdict in the archive (the verdict file of the shot's "
                         "next entry)")
+    p.add_argument("--json", action="store_true",
+                   help="print the verdict as one JSON document (criteria, tolerances, "
+                        "warnings, files written) instead of its lines; the exit status and "
+                        "the warnings on stderr are the same")
     p.set_defaults(run=run)
 
 
@@ -53,6 +57,10 @@ def run(args):
     from .messages import warn
 
     outcome = accept(request_of(args))
+    if args.json:
+        print(outcome.to_json())  # ASCII, control characters escaped
+        warn(list(outcome.warnings))
+        return 0 if outcome.passed else FAIL_EXIT
     if outcome.archived is not None:
         print(f"  archived the verdict as {outcome.archived}")
     print_verdict(outcome.verdict, f"{outcome.recording} against {args.shot}")

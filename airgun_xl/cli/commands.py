@@ -1,5 +1,6 @@
 """The argument parser: one subparser per subcommand module, each of which hands off."""
 import argparse
+import difflib
 import re
 
 from ..errors import OptionError
@@ -30,6 +31,34 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message):  # "fill: the following arguments are required: SHOT.xlsx"
         command = self.prog.removeprefix("airgun-xl").strip()
         raise OptionError(f"{command}: {message}" if command else message)
+
+    def parse_args(self, args=None, namespace=None):
+        """As argparse's, but an argument no parser knows is refused by the command it was
+        given to, with the nearest option it has (``fill: unrecognized arguments: --forse
+        (did you mean --force?)``)."""
+        parsed, extras = self.parse_known_args(args, namespace)
+        if extras:
+            parser, sub = self, self._subcommand(parsed)
+            while sub is not None:  # archive verify: the innermost command given
+                parser, sub = sub, sub._subcommand(parsed)
+            message = f"unrecognized arguments: {' '.join(extras)}"
+            hints = [difflib.get_close_matches(extra.partition("=")[0], parser.options(), 1,
+                                               0.75) for extra in extras
+                     if extra.startswith("-")]
+            hint = next((h[0] for h in hints if h), None)
+            parser.error(message + (f" (did you mean {hint}?)" if hint else ""))
+        return parsed
+
+    def _subcommand(self, parsed):
+        """The parser of the subcommand ``parsed`` names (None when there is none)."""
+        for action in self._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                return action.choices.get(getattr(parsed, action.dest, None) or "")
+        return None
+
+    def options(self):
+        """Every option string this parser takes (``--force``, ``-o``)."""
+        return [s for action in self._actions for s in action.option_strings]
 
 
 #: Options whose value may start with a minus sign as typed (``--srs-tol -3dB,+6dB``, and

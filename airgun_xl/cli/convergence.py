@@ -62,7 +62,7 @@ def run(args):
     warn([] if drew else ["matplotlib is not installed: no PNG (pip install "
                           "'airgun-xl[plots]')"])
     print_table(ladders)
-    print(f"wrote {output} and {png}")
+    print(f"wrote {output} and {png}" if drew else f"wrote {output}")
     return 0
 
 
