@@ -318,8 +318,13 @@ def test_an_archived_run_keeps_its_warnings_and_show_prints_units(tmp_path, caps
     assert main(["show", entry.ref, "--archive", str(archive)]) == 0
     out = capsys.readouterr().out
     assert f"warnings: {len(printed)}" in out and all(f"  - {w}" in out for w in printed)
-    assert re.search(r"time_of_peak\s+0\.\d{4} ms", out)
-    assert re.search(r"peak_kg\s+[\d,]+\.\d{5} kG", out)
+    assert re.search(r"  Time of peak\s+0\.\d{4} ms", out)
+    assert re.search(r"  Peak acceleration \(raw\)\s+[\d,]+\.\d{5} kG", out)
+    # in words, each with its unit: no record key with a unit of its own (issue 44)
+    dominant = entry.load("summary.json")["dominant_frequencies_hz"]
+    assert "  Dominant frequencies" + " " * 18 + ", ".join(
+        f"{f / 1e3:,.3f}" for f in dominant) + " kHz\n" in out
+    assert "_hz" not in out and "peak_kg" not in out
     assert "0.00029000000000000044" not in out
 
 

@@ -244,27 +244,37 @@ def run_history(args):
     return 0
 
 
-#: How ``show`` prints a figure of summary.json: (unit, factor from SI, digits after the point).
+#: How ``show`` prints a figure of summary.json: its words (the Summary sheet's), unit,
+#: factor from SI, digits after the point. ``--json`` gives the record's own keys, in SI.
 FIGURE_UNITS = {
-    "peak_kg": ("kG", 1.0, 5), "filtered_peak_kg": ("kG", 1.0, 5),
-    "time_of_peak": ("ms", 1e3, 4), "time_of_filtered_peak": ("ms", 1e3, 4),
-    "pulse_start": ("ms", 1e3, 4), "pulse_end": ("ms", 1e3, 4),
-    "pulse_duration": ("ms", 1e3, 4), "max_crush": ("m", 1.0, 4),
-    "final_length": ("m", 1.0, 4), "final_m1": ("kg", 1.0, 4), "final_m31": ("kg", 1.0, 4),
-    "obr_exit_velocity": ("m/s", 1.0, 3), "mem_final_velocity": ("m/s", 1.0, 3),
-    "natural_initial": ("kHz", 1e-3, 3), "natural_final": ("kHz", 1e-3, 3),
-    "dominant_frequencies_hz": ("kHz", 1e-3, 3), "rows": ("", 1.0, 0),
+    "peak_kg": ("Peak acceleration (raw)", "kG", 1.0, 5),
+    "time_of_peak": ("Time of peak", "ms", 1e3, 4),
+    "filtered_peak_kg": ("Peak acceleration (filtered)", "kG", 1.0, 5),
+    "time_of_filtered_peak": ("Time of filtered peak", "ms", 1e3, 4),
+    "pulse_start": ("Pulse start", "ms", 1e3, 4), "pulse_end": ("Pulse end", "ms", 1e3, 4),
+    "pulse_duration": ("Pulse duration", "ms", 1e3, 4),
+    "max_crush": ("Maximum crush", "m", 1.0, 4),
+    "final_length": ("Final mitigator length", "m", 1.0, 4),
+    "final_m1": ("Final M1", "kg", 1.0, 4), "final_m31": ("Final m31", "kg", 1.0, 4),
+    "obr_exit_velocity": ("OBR exit velocity", "m/s", 1.0, 3),
+    "mem_final_velocity": ("MEM final velocity", "m/s", 1.0, 3),
+    "natural_initial": ("Natural frequencies (initial masses)", "kHz", 1e-3, 3),
+    "natural_final": ("Natural frequencies (final masses)", "kHz", 1e-3, 3),
+    "dominant_frequencies_hz": ("Dominant frequencies", "kHz", 1e-3, 3),
+    "rows": ("Rows", "", 1.0, 0),
 }
 
 
 def shown_figure(key, value):
-    """A summary.json figure with its unit: ``0.2885 ms``, ``5.333, 4.833 kHz``, ``n/a``."""
-    unit, factor, digits = FIGURE_UNITS.get(key, ("", 1.0, None))
+    """A summary.json figure in words with its unit: ``("Time of peak", "0.2885 ms")``,
+    ``("Dominant frequencies", "5.333, 4.833 kHz")``, ``n/a`` where a value is missing; a key
+    the table does not know (a record from another version) as it is written."""
+    label, unit, factor, digits = FIGURE_UNITS.get(key, (key, "", 1.0, None))
     values = value if isinstance(value, list) else [value]
     if digits is None or not all(isinstance(v, (int, float)) or v is None for v in values):
-        return str(value)
+        return label, str(value)
     text = ", ".join("n/a" if v is None else f"{v * factor:,.{digits}f}" for v in values)
-    return f"{text} {unit}".rstrip() if values else "none"
+    return label, f"{text} {unit}".rstrip() if values else "none"
 
 
 def run_show(args):
@@ -289,7 +299,8 @@ def run_show(args):
     warnings = summary.pop("warnings", None)
     verdict = summary.pop("predicted_verdict", None)
     for k, v in summary.items():
-        say(f"  {k:<24} {shown_figure(k, v)}")
+        label, shown = shown_figure(k, v)
+        say(f"  {label:<37} {shown}")
     if isinstance(verdict, dict):
         say(f"predicted verdict: {verdict.get('verdict')} (specification from "
               f"{verdict.get('specification')})")
