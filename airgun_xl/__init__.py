@@ -67,7 +67,7 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
            cfc: int | str | None = None, output: str | os.PathLike[str] | None = None,
            force: bool = False, archive: str | os.PathLike[str] | None = None,
            channel: str | None = None, sign: float = 1.0, time_unit: str | None = None,
-           accel_unit: str | None = None) -> AcceptOutcome:
+           accel_unit: str | None = None, crush_law: str = "workbook") -> AcceptOutcome:
     """Judge a recording against the shot's specification, as ``airgun-xl accept`` does.
 
     The specification is the ``profile``'s, then the shot's Specification sheet's, then
@@ -89,6 +89,9 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
         Keep the verdict in this archive (needs ``output``, which the record names).
     sign : float
         1, or -1 when the recorder's axis is opposite to the macro's [-].
+    crush_law : str
+        The law the shot's prediction runs: ``workbook`` (its Crush law sheet's, else the
+        macro's), ``legacy`` (the macro's, Eq. 8) or ``NAME[@N]`` of ``archive``'s library.
 
     Returns
     -------
@@ -125,7 +128,7 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
     return run(AcceptRequest(
         Path(shot), os.fspath(recording), fields, Path(output) if output is not None else None,
         force, Path(archive) if archive is not None else None, channel, float(sign), time_unit,
-        accel_unit, ("accept",)))
+        accel_unit, ("accept",), crush_law))
 
 
 __all__ = [

@@ -123,24 +123,15 @@ def fill_one(path, settings, warn, note=None, progress_for=None, started=None):
     closed at the end if it has ``close``)."""
     from .archive import archive_dir
     from .archive.entry import now, shot_name
+    from .archive.laws import shot_with_law
     from .outputs import from_sheet
     from .pipeline import ArchiveRequest, Options, fill_workbook
-    from .shot import Shot
 
     started = time.perf_counter() if started is None else started
     output = _output(path, settings)
     root = archive_dir(settings.archive, required=False)
-    library = settings.crush_law not in ("workbook", "legacy")
-    if library and root is None:
-        raise OptionError(f"--crush-law: found {settings.crush_law!r} without --archive, "
-                          "expected workbook, legacy, or a law name with the archive that "
-                          "holds it")
     # --crush-law legacy (or a library law) runs that law whatever the sheet says: not read
-    shot = Shot.from_workbook(path, read_law=settings.crush_law == "workbook")
-    if library:
-        from .archive.laws import load_law
-
-        shot = shot.with_params(crush_law=load_law(root, settings.crush_law)[0])
+    shot = shot_with_law(path, settings.crush_law, root)
     if settings.unloading != "macro":
         shot = shot.with_params(unloading=settings.unloading)
     outputs = from_sheet(shot.source.outputs_block).with_flags(

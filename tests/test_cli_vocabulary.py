@@ -261,8 +261,8 @@ def test_cfc_is_the_record_judged_in_every_command_that_judges(words):
     (["history", "--jsn"],
      "airgun-xl: error: history: unrecognized arguments: --jsn (did you mean --json?)\n"),
     # nothing near enough (difflib's ratio under 0.75): no guess
-    (["design", "s.xlsx", "--crush-law", "LOT-2026-07"],
-     "airgun-xl: error: design: unrecognized arguments: --crush-law LOT-2026-07\n"),
+    (["design", "s.xlsx", "--colour", "red"],
+     "airgun-xl: error: design: unrecognized arguments: --colour red\n"),
     (["--forse"], "airgun-xl: error: unrecognized arguments: --forse\n"),
 ])
 def test_an_unknown_option_is_refused_by_its_command_with_the_nearest_one(argv, said, capsys,

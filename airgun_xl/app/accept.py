@@ -29,7 +29,9 @@ class AcceptRequest:
 
     ``output`` None writes no workbook (the CLI gives its default, ``SHOT.accept.xlsx``);
     ``archive`` keeps the verdict in that archive, naming the workbook (so needs one).
-    ``sign`` is 1 or -1 [-]; the units, where given, override the recording's header."""
+    ``sign`` is 1 or -1 [-]; the units, where given, override the recording's header.
+    ``crush_law`` is the law the shot's prediction runs (what the recording is expected to
+    show): a library law is read from ``archive`` (else $AIRGUN_XL_ARCHIVE)."""
 
     shot: Path
     recording: str
@@ -42,6 +44,7 @@ class AcceptRequest:
     time_unit: str | None = None
     accel_unit: str | None = None
     argv: tuple[str, ...] = ()  # the command, as the archive records it
+    crush_law: str = "workbook"  # workbook, legacy or NAME[@N] of the archive's library
 
 
 @dataclass(frozen=True)
@@ -105,9 +108,9 @@ def run(request: AcceptRequest) -> AcceptOutcome:
     airgun_xl.errors.AirgunXlError
         Bad input (a file, a field, an option), named; nothing is written.
     """
+    from ..archive.laws import shot_with_law
     from ..archive.verdicts import verdict_record
     from ..readers.recording import input_file, read_trace
-    from ..shot import Shot
     from ..studies.acceptance import expectations, judge_record
     from ..studies.measured import prepare
     from ..studies.shock import check_cfc
@@ -125,7 +128,7 @@ def run(request: AcceptRequest) -> AcceptOutcome:
         from ..archive import Archive
 
         Archive(request.archive, create=True, dry_run=True)
-    shot = Shot.from_workbook(request.shot)
+    shot = shot_with_law(request.shot, request.crush_law, request.archive)
     spec = require(resolve(shot, request.spec), request.shot)
     cfc = spec.judged.cfc  # --cfc is the specification's record field, over the sheet's
     trace = read_trace(request.recording, request.time_unit, request.accel_unit, request.sign,

@@ -98,3 +98,44 @@ def list_laws(root):
             out.append({"ref": f"{folder.name}@{version}", "v_range": None, "shots": 0,
                         "created": f"unreadable: {exc}"})
     return out
+
+
+#: What ``--crush-law`` takes, besides a law of the archive's library.
+BUILT_IN_LAWS = ("workbook", "legacy")
+
+
+def check_law_source(crush_law, archive):
+    """The archive folder ``crush_law`` is read from (None for the built-in ones), refused
+    before any run where a library law is named with no archive (``archive``, else
+    $AIRGUN_XL_ARCHIVE) or is not in it."""
+    from .store import archive_dir
+
+    if crush_law in BUILT_IN_LAWS:
+        return None
+    root = archive_dir(archive, required=False)
+    if root is None:
+        raise OptionError(f"--crush-law: found {short(crush_law)} without --archive, "
+                          "expected workbook, legacy, or a law name with the archive that "
+                          "holds it")
+    load_law(root, crush_law)
+    return root
+
+
+def shot_with_law(path, crush_law="workbook", archive=None):
+    """The shot at ``path`` running the crush law ``--crush-law`` names: ``workbook`` (its
+    Crush law sheet's, else the macro's), ``legacy`` (the macro's, Eq. 8, whatever the sheet
+    says: not read) or ``NAME[@N]`` of the library of ``archive`` (else
+    $AIRGUN_XL_ARCHIVE).
+
+    Raises
+    ------
+    airgun_xl.errors.OptionError
+        A library law named with no archive, or not in it: before the workbook is read.
+    """
+    from ..shot import Shot
+
+    root = check_law_source(crush_law, archive)
+    shot = Shot.from_workbook(path, read_law=crush_law == "workbook")
+    if root is not None:
+        shot = shot.with_params(crush_law=load_law(root, crush_law)[0])
+    return shot

@@ -4,7 +4,7 @@ Exit 0 on PASS, 3 on FAIL (:data:`FAIL_EXIT`), 2 for bad input."""
 from pathlib import Path
 
 from .recording_options import RECORDING_HELP, add_recording_options
-from .run_options import SHOT_HELP, add_force, add_output
+from .run_options import SHOT_HELP, add_crush_law, add_force, add_output
 from .spec_options import RECORD_HELP, add_spec_options
 from .vocabulary import One
 
@@ -30,7 +30,8 @@ def add_parser(sub):
     add_spec_options(p, cfc=False)
     p.add_argument("--archive", metavar="DIR", action=One,
                    help="record the verdict in the archive (the verdict file of the shot's "
-                        "next entry)")
+                        "next entry), and the library --crush-law NAME is read from")
+    add_crush_law(p, archive=False)
     p.add_argument("--json", action="store_true",
                    help="print the verdict as one JSON document (criteria, tolerances, "
                         "warnings, files written) instead of its lines; the exit status and "
@@ -49,7 +50,7 @@ def request_of(args):
         shot_path.stem + ".accept.xlsx")
     return AcceptRequest(shot_path, args.recording, SpecFields.of(args), output, args.force,
                          Path(args.archive) if args.archive else None, args.channel, args.sign,
-                         args.time_unit, args.accel_unit, tuple(args.argv))
+                         args.time_unit, args.accel_unit, tuple(args.argv), args.crush_law)
 
 
 def run(args):

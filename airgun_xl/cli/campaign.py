@@ -60,14 +60,9 @@ def run_batch(args, settings):
     if summary is not None:
         check_output(summary, args.force, inputs=files)  # before any shot runs
         _check_summary(summary, args.shots, files)
-    if settings.crush_law not in ("workbook", "legacy"):  # a law name: refused before any run
-        from ..archive.laws import load_law
+    from ..archive.laws import check_law_source
 
-        if settings.archive is None:
-            raise OptionError(f"--crush-law: found {settings.crush_law!r} without --archive, "
-                              "expected workbook, legacy, or a law name with the archive that "
-                              "holds it")
-        load_law(settings.archive, settings.crush_law)
+    check_law_source(settings.crush_law, settings.archive)  # refused before any run
     started = time.perf_counter()
     bar = CountBar(len(files))
 

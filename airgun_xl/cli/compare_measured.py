@@ -2,7 +2,7 @@
 from pathlib import Path
 
 from .recording_options import RECORDING_HELP, add_recording_options
-from .run_options import SHOT_HELP, add_force, add_output, add_run_options
+from .run_options import SHOT_HELP, add_crush_law, add_force, add_output, add_run_options
 
 
 def add_parser(sub):
@@ -24,6 +24,7 @@ def add_parser(sub):
                         "(or 5 sigma of its pre-trigger noise, if more) for 0.05 ms (default),"
                         " or the cross-correlation's best lag; each checks the other")
     add_run_options(p)
+    add_crush_law(p)
     p.set_defaults(run=run)
 
 
@@ -32,10 +33,10 @@ def run(args):
 
     import numpy as np
 
+    from ..archive.laws import shot_with_law
     from ..models import apply_model
     from ..readers.recording import input_file, read_trace
     from ..reports.measured import write_comparison
-    from ..shot import Shot
     from ..studies.check import after_run
     from ..studies.measured import ANTI_ALIAS_ORDER, compare
     from ..studies.shock import CFC_CLASSES, cfc_coefficients
@@ -50,7 +51,7 @@ def run(args):
     check_output(output, args.force, inputs=[args.shot, input_file(args.measured)])
     trace = read_trace(args.measured, args.time_unit, args.accel_unit, args.sign,
                        args.channel)
-    shot = Shot.from_workbook(args.shot)
+    shot = shot_with_law(args.shot, args.crush_law, args.archive)
     result = dataclasses.replace(shot, params=apply_model(shot.params, args.model)).run(
         integrator=args.integrator, track=())
     finite = np.isfinite(result.accel_kg)

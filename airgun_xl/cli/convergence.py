@@ -4,7 +4,7 @@ from pathlib import Path
 
 from ..errors import OptionError
 from ..transaction import check_output
-from .run_options import SHOT_HELP, add_force, add_integrator, add_output
+from .run_options import SHOT_HELP, add_crush_law, add_force, add_integrator, add_output
 
 
 def add_parser(sub):
@@ -21,16 +21,17 @@ def add_parser(sub):
     p.add_argument("--rtol", default="1e-3", help="tolerance on the peak (default 0.1%%)")
     add_output(p, "workbook; the PNG goes beside it", "SHOT.convergence.xlsx")
     add_force(p)
+    add_crush_law(p)
     p.set_defaults(run=run)
 
 
 def run(args):
+    from ..archive.laws import shot_with_law
     from ..reports.convergence import write_convergence
-    from ..shot import Shot
     from ..studies.convergence import default_ladder, ladder, parse_duration
     from .messages import warn
 
-    shot = Shot.from_workbook(args.shot)
+    shot = shot_with_law(args.shot, args.crush_law, args.archive)
     integrators = args.integrator
     try:
         rtol = float(args.rtol)

@@ -9,7 +9,7 @@ from ..outputs import from_sheet
 from ..units import parse_duration, parse_peak
 from .cluster_options import add_cluster_options, cluster_runner
 from .fill import print_summary
-from .run_options import SHOT_HELP, add_force, add_output, add_run_options
+from .run_options import SHOT_HELP, add_crush_law, add_force, add_output, add_run_options
 from .spec_options import add_spec_options
 from .vocabulary import Alias
 
@@ -61,6 +61,7 @@ def add_parser(sub):
     first.add_argument("--shots", type=int, default=10_000, metavar="N",
                        help="Monte Carlo shots a setting (default 10,000)")
     first.add_argument("--seed", type=int, default=1, help="of the draws (default 1)")
+    add_crush_law(p)
     p.set_defaults(run=run)
 
 
@@ -75,7 +76,7 @@ def _range(text):
 
 
 def run(args):
-    from ..shot import Shot
+    from ..archive.laws import shot_with_law
     from ..studies.design import solve_peak, solve_peak_and_duration, variable
 
     if args.target_srs is not None:
@@ -96,7 +97,7 @@ def run(args):
         raise OptionError("--vary: found two parameters, expected one (or add "
                           "--target-duration)")
     bounds = _range(args.range) if args.range else None
-    shot = Shot.from_workbook(args.shot)
+    shot = shot_with_law(args.shot, args.crush_law, args.archive)
     started = time.perf_counter()
     with cluster_runner(args) as runner:
         if duration is None:
@@ -117,8 +118,8 @@ def run(args):
 
 
 def run_srs(args):
+    from ..archive.laws import shot_with_law
     from ..readers.recording import read_spectrum
-    from ..shot import Shot
     from ..studies.design import solve_srs, variable
 
     for flag, value in (("--scheduler", args.scheduler), ("--workers", args.workers),
@@ -136,7 +137,7 @@ def run_srs(args):
     q = _srs_q(args.srs_q)
     bounds = _range(args.range) if args.range else None
     frequencies, required = read_spectrum(args.target_srs, args.accel_unit)
-    shot = Shot.from_workbook(args.shot)
+    shot = shot_with_law(args.shot, args.crush_law, args.archive)
     started = time.perf_counter()
     design = solve_srs(shot.params, frequencies, required, var, q, args.integrator,
                        args.model, bounds)
@@ -162,7 +163,7 @@ def run_spec(args):
     setting most likely to pass on the first shot."""
     import math
 
-    from ..shot import Shot
+    from ..archive.laws import shot_with_law
     from ..studies.design import Design, variable
     from ..studies.first_shot import solve_confidence, solve_middle
     from ..studies.sweep import parse_sds
@@ -191,7 +192,7 @@ def run_spec(args):
     from ..transaction import check_output
 
     check_output(design_output(args), args.force, inputs=[args.shot])  # before the study
-    shot = Shot.from_workbook(args.shot)
+    shot = shot_with_law(args.shot, args.crush_law, args.archive)
     spec = resolve_spec(shot, args)
     if spec is None:
         raise OptionError("design: found no target and an empty specification, expected "

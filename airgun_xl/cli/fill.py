@@ -7,7 +7,7 @@ from ..archive.store import prestart_index
 from ..choices import HOSTS, SIDECAR_MODES, UNLOADINGS
 from ..outputs import GROUPS
 from ..transaction import display
-from .run_options import add_force, add_integrator, add_model
+from .run_options import add_crush_law, add_force, add_integrator, add_model
 from .spec_options import add_spec_options
 from .vocabulary import One
 
@@ -48,12 +48,7 @@ def add_parser(sub):
                    help="run even when the time step is above the critical step (a diverging "
                         "run still stops)")
     add_model(p)
-    p.add_argument("--crush-law", metavar="LAW", default="workbook",
-                   help="workbook: the law the workbook's Crush law sheet names (a calibrated "
-                        "workbook's fitted law), else the macro's (default); legacy: the "
-                        "macro's polynomial, Eq. (8), whatever the workbook says; NAME or "
-                        "NAME@N: a law of the --archive's library (calibrate --archive "
-                        "--name)")
+    add_crush_law(p, archive=False)  # fill's --archive is its own (below)
     p.add_argument("--unloading", choices=UNLOADINGS, default="macro",
                    help="macro: the macro's unloading force, quirk included (default); "
                         "continuous: each unloading starts from the force before it (no jump "

@@ -76,6 +76,24 @@ def add_output(p, what, default, metavar="OUT.xlsx"):
                    help=f"{what} (default: {default})")
 
 
+def add_crush_law(p, archive=True):
+    """``--crush-law``, for every command that runs a shot; with ``archive``, the
+    ``--archive DIR`` its library laws are read from (a command whose ``--archive`` already
+    says more, fill's and accept's, gives False)."""
+    from .vocabulary import One
+
+    p.add_argument("--crush-law", metavar="LAW", default="workbook",
+                   help="workbook: the law the workbook's Crush law sheet names (a calibrated "
+                        "workbook's fitted law), else the macro's (default); legacy: the "
+                        "macro's polynomial, Eq. (8), whatever the workbook says; NAME or "
+                        "NAME@N: a law of the --archive's library (calibrate --archive "
+                        "--name)")
+    if archive:
+        p.add_argument("--archive", metavar="DIR", action=One,
+                       help="the archive whose library --crush-law NAME is read from "
+                            "(default: $AIRGUN_XL_ARCHIVE when set)")
+
+
 def add_force(p, metavar="OUT.xlsx"):
     p.add_argument("--force", action="store_true", help=f"overwrite {metavar} if it exists")
 

@@ -3,7 +3,7 @@ from pathlib import Path
 
 from ..errors import OptionError
 from .recording_options import CfcOption, cfc_value
-from .run_options import SHOT_HELP, add_force, add_output, add_run_options
+from .run_options import SHOT_HELP, add_crush_law, add_force, add_output, add_run_options
 from .vocabulary import Alias, One
 
 
@@ -35,6 +35,7 @@ def add_parser(sub):
     p.add_argument("--to", dest="hi", type=float, default=10_000.0, metavar="HZ",
                    help="highest natural frequency (default 10000)")
     add_run_options(p)
+    add_crush_law(p)
     p.set_defaults(run=run)
 
 
@@ -43,9 +44,9 @@ def run(args):
 
     import numpy as np
 
+    from ..archive.laws import shot_with_law
     from ..models import apply_model
     from ..reports.srs import write_srs
-    from ..shot import Shot
     from ..studies.check import after_run, before_run
     from ..studies.shock import (
         cfc_filter,
@@ -58,7 +59,7 @@ def run(args):
     if not (0 < args.lo < args.hi < float("inf")):
         raise OptionError(f"--from/--to: found {args.lo:g} and {args.hi:g} Hz, expected "
                           "0 < FROM < TO")
-    shot = Shot.from_workbook(args.shot)
+    shot = shot_with_law(args.shot, args.crush_law, args.archive)
     shot_path = Path(args.shot)
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".srs.xlsx")

@@ -6,7 +6,7 @@ from .. import limits
 from ..errors import OptionError
 from ..transaction import check_output
 from .cluster_options import add_cluster_options, cluster_runner
-from .run_options import SHOT_HELP, add_force, add_output, add_run_options
+from .run_options import SHOT_HELP, add_crush_law, add_force, add_output, add_run_options
 
 
 def add_parser(sub):
@@ -34,6 +34,7 @@ def add_parser(sub):
     add_output(p, "table and charts", "SHOT.sweep.xlsx")
     add_force(p)
     add_cluster_options(p)
+    add_crush_law(p)
     p.set_defaults(run=run)
 
 
@@ -49,12 +50,12 @@ def _progress_bar(total):
 
 
 def run(args):
+    from ..archive.laws import shot_with_law
     from ..reports.sweep import write_sweep
-    from ..shot import Shot
     from ..studies.sensitivity import sobol
     from ..studies.sweep import grid, monte_carlo, parse_sds, parse_vary, spread
 
-    shot = Shot.from_workbook(args.shot)
+    shot = shot_with_law(args.shot, args.crush_law, args.archive)
     varies = [parse_vary(v) for v in args.vary]
     sds = parse_sds(args.sd)
     if args.mc is not None and args.sobol is not None:
