@@ -28,7 +28,10 @@ from .errors import (
 from .version import __version__
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
     from .app.accept import AcceptOutcome
+    from .app.sweep import SweepOutcome
     from .params import ShotParams
     from .result import Result
     from .shot import Shot
@@ -131,6 +134,55 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
         accel_unit, ("accept",), crush_law))
 
 
+def sweep(shot: str | os.PathLike[str], vary: str | Sequence[str] = (), *,
+          mc: int | str | None = None, sd: str | Sequence[str] = (),
+          sobol: int | str | None = None, seed: int = 1, integrator: str = "legacy",
+          model: str = "4-mass", output: str | os.PathLike[str] | None = None,
+          force: bool = False, crush_law: str = "workbook",
+          archive: str | os.PathLike[str] | None = None, scheduler: str | None = None,
+          workers: int | None = None, chunk: int | None = None) -> SweepOutcome:
+    """Run a grid of shots, a Monte Carlo or Sobol indices, as ``airgun-xl sweep`` does.
+
+    Parameters
+    ----------
+    shot : path
+        The shot's workbook, in the report's layout.
+    vary : str or sequence of str
+        ``CELL=LO:HI:N`` (``"A28=150:250:3"``); several make a grid.
+    mc, sobol : int, optional
+        A Monte Carlo of this many shots, or Sobol indices (N, a power of 2, times the
+        inputs + 2 shots), over the spreads ``sd`` (``"E40=3%"``), drawn from ``seed``.
+    output : path, optional
+        The sweep's workbook to write (none is written if not given).
+    scheduler, workers, chunk
+        Run the shots on a Dask cluster (its scheduler's address), or a local one of
+        ``workers`` processes, ``chunk`` shots a task.
+
+    Returns
+    -------
+    airgun_xl.app.sweep.SweepOutcome
+        ``to_frame()`` gives a row a shot; ``stats``, ``sensitivity``, ``warnings``,
+        ``files``.
+
+    Raises
+    ------
+    AirgunXlError
+        Bad input, named; nothing is written.
+    """
+    from pathlib import Path
+
+    from .app.sweep import SweepRequest, run
+
+    def texts(value: str | Sequence[str]) -> tuple[str, ...]:
+        return (value,) if isinstance(value, str) else tuple(str(v) for v in value)
+
+    return run(SweepRequest(
+        Path(shot), texts(vary), None if mc is None else str(mc), texts(sd),
+        None if sobol is None else str(sobol), seed, integrator, model,
+        Path(output) if output is not None else None, force, crush_law,
+        Path(archive) if archive is not None else None, scheduler, workers, chunk))
+
+
 __all__ = [
     "AirgunXlError",
     "ArchiveError",
@@ -149,4 +201,5 @@ __all__ = [
     "__version__",
     "accept",
     "load",
+    "sweep",
 ]

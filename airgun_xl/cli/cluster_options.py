@@ -1,5 +1,4 @@
 """``--scheduler ADDRESS`` and ``--workers N``, shared by ``sweep`` and ``design``."""
-import contextlib
 
 
 def add_cluster_options(p):
@@ -14,22 +13,8 @@ def add_cluster_options(p):
                    help="shots a cluster task (default 512)")
 
 
-@contextlib.contextmanager
 def cluster_runner(args):
-    """The runner the options ask for: None (this machine's batch kernel) or a
-    :class:`~airgun_xl.studies.cluster.ClusterRunner`, shut down on leaving."""
-    if args.scheduler is None and args.workers is None:
-        if args.chunk is not None:
-            from ..errors import OptionError
+    """The runner the options ask for (:func:`airgun_xl.app.running.cluster_runner`)."""
+    from ..app.running import cluster_runner
 
-            raise OptionError("--chunk: found it without --scheduler or --workers, expected "
-                              "one of them (chunks are for a cluster)")
-        yield None
-        return
-    from ..studies.cluster import DEFAULT_CHUNK, ClusterRunner, connect
-
-    client, close = connect(args.scheduler, args.workers)
-    try:
-        yield ClusterRunner(client, args.chunk if args.chunk is not None else DEFAULT_CHUNK)
-    finally:
-        close()
+    return cluster_runner(args.scheduler, args.workers, args.chunk)

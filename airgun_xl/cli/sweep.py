@@ -1,11 +1,7 @@
 """``airgun-xl sweep SHOT.xlsx --vary A28=100:260:161``: many shots at once."""
-import time
 from pathlib import Path
 
-from .. import limits
-from ..errors import OptionError
-from ..transaction import check_output
-from .cluster_options import add_cluster_options, cluster_runner
+from .cluster_options import add_cluster_options
 from .run_options import SHOT_HELP, add_crush_law, add_force, add_output, add_run_options
 
 
@@ -44,80 +40,32 @@ def _progress_bar(total):
     from .progress import CountBar
 
     bar = CountBar(total)
-    if not bar.enabled:
-        return None, None
-    return bar, bar.advance
+    return bar if bar.enabled else None
 
 
-def run(args):
-    from ..archive.laws import shot_with_law
-    from ..reports.sweep import write_sweep
-    from ..studies.sensitivity import sobol
-    from ..studies.sweep import grid, monte_carlo, parse_sds, parse_vary, spread
+def request_of(args):
+    """The :class:`~airgun_xl.app.sweep.SweepRequest` the command line asks for (its
+    default output beside the shot)."""
+    from ..app.sweep import SweepRequest
 
-    shot = shot_with_law(args.shot, args.crush_law, args.archive)
-    varies = [parse_vary(v) for v in args.vary]
-    sds = parse_sds(args.sd)
-    if args.mc is not None and args.sobol is not None:
-        raise OptionError("--sobol: found it with --mc, expected one or the other")
-    random = "--mc" if args.mc is not None else "--sobol" if args.sobol is not None else None
-    if random is not None:
-        text = args.mc if args.mc is not None else args.sobol
-        try:
-            n = int(text)
-        except ValueError:
-            n = 0
-        if n < 2 or n > limits.MAX_SHOTS or not sds:
-            raise OptionError(f"{random}: found {text!r}{'' if sds else ' without --sd'}, "
-                              f"expected a number of shots from 2 to {limits.MAX_SHOTS:,}, "
-                              "with --sd")
-        if args.seed is not None and not 0 <= args.seed < 2**128:
-            raise OptionError(f"--seed: found {args.seed}, expected a whole number from 0 "
-                              "to 2**128 - 1")
-        if varies:
-            raise OptionError(f"--vary: found a grid with {random}, expected one or the other")
-    elif not varies:
-        raise OptionError("--vary: found none, expected CELL=LO:HI:N (or --mc N with --sd)")
     shot_path = Path(args.shot)
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".sweep.xlsx")
-    check_output(output, args.force, inputs=[args.shot])
-    total = n if args.mc is not None else n * (len(sds) + 2) if args.sobol is not None else 1
-    for _, _, values in varies:
-        total *= len(values)
-    if total > limits.MAX_SHOTS:
-        raise OptionError(f"--vary: found a grid of {total:,} shots, expected at most "
-                          f"{limits.MAX_SHOTS:,} (fewer points per cell)")
-    limits.check_memory(limits.sweep_bytes(total, shot.params.rows),
-                        f"a sweep of {total:,} shots of {shot.params.rows:,} rows",
-                        "fewer shots (--mc, or fewer points per --vary) or fewer rows")
-    started = time.perf_counter()
-    with cluster_runner(args) as runner:
-        bar, progress = _progress_bar(total)
-        try:
-            sensitivity = None
-            if args.mc is not None:
-                result = monte_carlo(shot.params, sds, n, args.seed, args.integrator,
-                                     args.model, progress, runner)
-            elif args.sobol is not None:
-                sensitivity = sobol(shot.params, sds, n, args.seed, args.integrator,
-                                    args.model, progress, runner)
-                result = sensitivity.shots
-            else:
-                result = grid(shot.params, varies, args.integrator, args.model, progress,
-                              runner)
-        finally:
-            if bar is not None:
-                bar.close()
-    seconds = time.perf_counter() - started
-    stats = spread(result.figures[:, 0])
-    write_sweep(result, output, args.force, stats if args.mc is not None else None,
-                sensitivity, shot=Path(args.shot).name,
-                seed=None if result.kind == "grid" else args.seed)
-    steps = total * (shot.params.rows - 2)
-    print(f"wrote {output}: {total:,} shots in {seconds:.2f} s ({steps / seconds:.3g} "
-          f"shot-steps/s); {int(result.diverged.sum())} diverged, "
-          f"{int(result.invalid.sum())} invalid")
+    return SweepRequest(shot_path, tuple(args.vary), args.mc, tuple(args.sd), args.sobol,
+                        args.seed, args.integrator, args.model, output, args.force,
+                        args.crush_law, Path(args.archive) if args.archive else None,
+                        args.scheduler, args.workers, args.chunk)
+
+
+def run(args):
+    from ..app.sweep import run as sweep
+    from .messages import warn
+
+    outcome = sweep(request_of(args), _progress_bar)
+    result, stats = outcome.result, outcome.stats
+    print(f"wrote {outcome.output}: {outcome.shots:,} shots in {outcome.seconds:.2f} s "
+          f"({outcome.steps_per_second:.3g} shot-steps/s); {int(result.diverged.sum())} "
+          f"diverged, {int(result.invalid.sum())} invalid")
     if result.kind == "grid":  # every combination, not a distribution: its extremes
         import numpy as np
 
@@ -127,16 +75,10 @@ def run(args):
     else:
         print(f"  peak {stats['mean']:.4f} kG mean, sd {stats['sd']:.4f}, 5-95% "
               f"{stats['p5']:.4f}-{stats['p95']:.4f} kG (seed {args.seed})")
-    flagged, cells = result.flagged()
-    if flagged:
-        from .messages import warn
-
-        warn([f"{flagged:,} of {total:,} shots have warnings, naming "
-              + ", ".join(f"{cell} ({n:,} shots)" for cell, n in sorted(cells.items()))
-              + f": see the Warnings column and sheet of {output}"])
-    if sensitivity is not None:
-        found = sensitivity.indices["peak_kg"]
+    warn(list(outcome.warnings))
+    if outcome.sensitivity is not None:
+        found = outcome.sensitivity.indices["peak_kg"]
         print("  Sobol indices of the peak: " + ", ".join(
             f"{cell} S1 {s1:.3f} ST {st:.3f}" for cell, s1, st in
-            zip(sensitivity.cells, found["S1"], found["ST"], strict=True)))
+            zip(outcome.sensitivity.cells, found["S1"], found["ST"], strict=True)))
     return 0
