@@ -31,6 +31,8 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
     from .app.accept import AcceptOutcome
+    from .app.design import DesignOutcome
+    from .app.specifying import SpecFields
     from .app.sweep import SweepOutcome
     from .params import ShotParams
     from .result import Result
@@ -56,6 +58,22 @@ def load(path: str | os.PathLike[str]) -> Shot:
     from .shot import Shot
 
     return Shot.from_workbook(path)
+
+
+def _spec_fields(cfc: int | str | None = None, **given: object) -> SpecFields:
+    """The specification fields a function's keywords give, as text in the grammar (a path
+    as its text); ``cfc`` a J211 class or ``"none"``."""
+    from .app.specifying import SpecFields, cfc_class
+
+    record = None
+    if cfc is not None:
+        try:
+            record = cfc_class(str(cfc))
+        except ValueError as exc:
+            raise OptionError(f"--cfc: {exc}") from None
+    text = {key: None if value is None else os.fspath(value) if isinstance(
+        value, os.PathLike) else str(value) for key, value in given.items()}
+    return SpecFields(**text, cfc=record, cfc_given="--cfc" if cfc is not None else None)
 
 
 def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
@@ -109,29 +127,89 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
     from pathlib import Path
 
     from .app.accept import AcceptRequest, run
-    from .app.specifying import SpecFields, cfc_class
 
-    def text(value: object) -> str | None:
-        return None if value is None else os.fspath(value) if isinstance(
-            value, os.PathLike) else str(value)
-
-    record = None
-    if cfc is not None:
-        try:
-            record = cfc_class(str(cfc))
-        except ValueError as exc:
-            raise OptionError(f"--cfc: {exc}") from None
-    fields = SpecFields(
-        profile=text(profile), shape=text(shape), peak=text(peak), duration=text(duration),
-        velocity_change=text(velocity_change), corridor=text(corridor),
-        time_slack=text(time_slack), dv_window=text(dv_window), monitor=text(monitor),
-        duration_def=text(duration_def), decay=text(decay), placement=text(placement),
-        srs=text(srs), srs_tol=text(srs_tol), srs_q=text(srs_q), srs_outside=text(srs_outside),
-        cfc=record, cfc_given="--cfc" if cfc is not None else None, accel_unit=accel_unit)
+    fields = _spec_fields(
+        profile=profile, shape=shape, peak=peak, duration=duration,
+        velocity_change=velocity_change, corridor=corridor, time_slack=time_slack,
+        dv_window=dv_window, monitor=monitor, duration_def=duration_def, decay=decay,
+        placement=placement, srs=srs, srs_tol=srs_tol, srs_q=srs_q, srs_outside=srs_outside,
+        cfc=cfc, accel_unit=accel_unit)
     return run(AcceptRequest(
         Path(shot), os.fspath(recording), fields, Path(output) if output is not None else None,
         force, Path(archive) if archive is not None else None, channel, float(sign), time_unit,
         accel_unit, ("accept",), crush_law))
+
+
+def design(shot: str | os.PathLike[str], *, target_peak: str | None = None,
+           target_duration: str | None = None,
+           target_srs: str | os.PathLike[str] | None = None, vary: str | Sequence[str] = (),
+           range: str | None = None, filtered: bool = False,
+           confidence: float | None = None, sd: str | Sequence[str] = (),
+           shots: int = 10_000, seed: int = 1,
+           peak: str | None = None, duration: str | None = None,
+           velocity_change: str | None = None, shape: str | None = None,
+           corridor: str | None = None, time_slack: str | None = None,
+           dv_window: str | None = None, monitor: str | None = None,
+           duration_def: str | None = None, decay: str | None = None,
+           placement: str | None = None, srs: str | os.PathLike[str] | None = None,
+           srs_tol: str | None = None, srs_q: str | None = None,
+           srs_outside: str | None = None, profile: str | os.PathLike[str] | None = None,
+           cfc: int | str | None = None, accel_unit: str | None = None,
+           integrator: str = "legacy", model: str = "4-mass",
+           output: str | os.PathLike[str] | None = None, force: bool = False,
+           crush_law: str = "workbook", archive: str | os.PathLike[str] | None = None,
+           scheduler: str | None = None, workers: int | None = None,
+           chunk: int | None = None) -> DesignOutcome:
+    """Design a shot, as ``airgun-xl design`` does: to ``target_peak`` (with
+    ``target_duration``, two cells in ``vary``) or ``target_srs``; without a target, to the
+    middle of the specification (the profile's, the shot's sheet's, then the fields given
+    here, as :func:`accept` takes them); with ``confidence`` and the scatter ``sd``
+    (``"A28=1.5%"``), the setting most likely to pass on the first shot.
+
+    Parameters
+    ----------
+    shot : path
+        The shot's workbook, in the report's layout.
+    vary : str or sequence of str
+        The cell(s) solved for (A28, the default, stands for A28..A30).
+    range : str, optional
+        ``LO:HI`` of the (first) cell, in its unit.
+    output : path, optional
+        The designed shot's workbook, filled (none is written if not given).
+
+    Returns
+    -------
+    airgun_xl.app.design.DesignOutcome
+        ``values`` ({cell: value}), ``reached``, ``confidence`` (P(PASS) and its interval),
+        ``designed`` (a :class:`Shot`), ``warnings``, ``files``.
+
+    Raises
+    ------
+    AirgunXlError
+        Bad input, named; nothing is written.
+    """
+    from pathlib import Path
+
+    from .app.design import DesignRequest, run
+
+    fields = _spec_fields(
+        profile=profile, shape=shape, peak=peak, duration=duration,
+        velocity_change=velocity_change, corridor=corridor, time_slack=time_slack,
+        dv_window=dv_window, monitor=monitor, duration_def=duration_def, decay=decay,
+        placement=placement, srs=srs, srs_tol=srs_tol, srs_q=srs_q, srs_outside=srs_outside,
+        cfc=cfc, accel_unit=accel_unit)
+    return run(DesignRequest(
+        Path(shot), target_peak, target_duration,
+        os.fspath(target_srs) if target_srs is not None else None, _texts(vary), range,
+        filtered, fields, confidence, _texts(sd), shots, seed, integrator, model,
+        Path(output) if output is not None else None, force, crush_law,
+        Path(archive) if archive is not None else None, scheduler, workers, chunk,
+        ("design",)))
+
+
+def _texts(value: str | Sequence[str]) -> tuple[str, ...]:
+    """One text or several, as a tuple."""
+    return (value,) if isinstance(value, str) else tuple(str(v) for v in value)
 
 
 def sweep(shot: str | os.PathLike[str], vary: str | Sequence[str] = (), *,
@@ -173,11 +251,8 @@ def sweep(shot: str | os.PathLike[str], vary: str | Sequence[str] = (), *,
 
     from .app.sweep import SweepRequest, run
 
-    def texts(value: str | Sequence[str]) -> tuple[str, ...]:
-        return (value,) if isinstance(value, str) else tuple(str(v) for v in value)
-
     return run(SweepRequest(
-        Path(shot), texts(vary), None if mc is None else str(mc), texts(sd),
+        Path(shot), _texts(vary), None if mc is None else str(mc), _texts(sd),
         None if sobol is None else str(sobol), seed, integrator, model,
         Path(output) if output is not None else None, force, crush_law,
         Path(archive) if archive is not None else None, scheduler, workers, chunk))
@@ -200,6 +275,7 @@ __all__ = [
     "WorkbookError",
     "__version__",
     "accept",
+    "design",
     "load",
     "sweep",
 ]
