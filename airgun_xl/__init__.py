@@ -31,6 +31,7 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
     from .app.accept import AcceptOutcome
+    from .app.calibrate import CalibrateOutcome
     from .app.design import DesignOutcome
     from .app.specifying import SpecFields
     from .app.sweep import SweepOutcome
@@ -138,6 +139,55 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
         Path(shot), os.fspath(recording), fields, Path(output) if output is not None else None,
         force, Path(archive) if archive is not None else None, channel, float(sign), time_unit,
         accel_unit, ("accept",), crush_law))
+
+
+def calibrate(*files: str | os.PathLike[str], law: bool = False,
+              fit: str | Sequence[str] | None = None, objective: str = "l2",
+              degree: int = 6, cfc: int | str | None = None, sign: float = 1.0,
+              time_unit: str | None = None, accel_unit: str | None = None,
+              channel: str | None = None, anti_alias: str | float = "auto",
+              integrator: str = "legacy", output: str | os.PathLike[str] | None = None,
+              force: bool = False, archive: str | os.PathLike[str] | None = None,
+              name: str | None = None) -> CalibrateOutcome:
+    """Fit the model to the shots that were fired, as ``airgun-xl calibrate`` does:
+    ``files`` are each shot's workbook followed by its recording (``"shot_01.xlsx",
+    "rec_01.csv", "shot_02.xlsx", "rec_02.csv"``).
+
+    The crush-factor law is recovered with ``law`` or when ``fit`` names nothing; ``fit``
+    names least-squares fits (``"E40"``, ``["E40", "E43"]``, ``"scale"``). ``cfc`` filters
+    both pulses (a J211 class, or ``"none"``, the default); ``name`` keeps a trusted law in
+    ``archive``'s library, for ``crush_law=NAME``.
+
+    Returns
+    -------
+    airgun_xl.app.calibrate.CalibrateOutcome
+        ``trusted``, ``fitted``, ``warnings``, ``calibration`` (errors, intervals, the scores
+        before and after), ``stored``, ``files``.
+
+    Raises
+    ------
+    AirgunXlError
+        Bad input, named; nothing is written.
+    """
+    from pathlib import Path
+
+    from .app.calibrate import CalibrateRequest, run
+    from .app.specifying import cfc_class
+
+    texts = [os.fspath(f) for f in files]
+    if len(texts) % 2:
+        raise OptionError(f"calibrate: found {len(texts)} files, expected pairs of "
+                          "SHOT.xlsx RECORDING")
+    try:
+        record = cfc_class(str(cfc)) if cfc is not None else None
+    except ValueError as exc:
+        raise OptionError(f"--cfc: {exc}") from None
+    names = fit if fit is None or isinstance(fit, str) else ",".join(fit)
+    return run(CalibrateRequest(
+        tuple(zip(texts[::2], texts[1::2], strict=True)), law, names, objective, degree,
+        record, float(sign), time_unit, accel_unit, channel, anti_alias, integrator,
+        Path(output) if output is not None else None, force,
+        Path(archive) if archive is not None else None, name, ("calibrate",)))
 
 
 def design(shot: str | os.PathLike[str], *, target_peak: str | None = None,
@@ -275,6 +325,7 @@ __all__ = [
     "WorkbookError",
     "__version__",
     "accept",
+    "calibrate",
     "design",
     "load",
     "sweep",

@@ -1,6 +1,5 @@
 """``airgun-xl calibrate SHOT.xlsx RECORDING [SHOT2.xlsx RECORDING2 ...]``: the model
 fitted to the shots that were fired."""
-import math
 from pathlib import Path
 
 from ..errors import OptionError
@@ -55,59 +54,33 @@ def _pairs(values):
     if len(values) % 2:
         raise OptionError(f"calibrate: found {len(values)} files, expected pairs of "
                           "SHOT.xlsx RECORDING")
-    return [(values[i], values[i + 1]) for i in range(0, len(values), 2)]
+    return tuple((values[i], values[i + 1]) for i in range(0, len(values), 2))
+
+
+def request_of(args):
+    """The :class:`~airgun_xl.app.calibrate.CalibrateRequest` the command line asks for
+    (its default output beside the first shot)."""
+    from ..app.calibrate import CalibrateRequest
+
+    pairs = _pairs(args.pairs)
+    first = Path(pairs[0][0])
+    output = Path(args.output) if args.output else first.with_name(
+        first.stem + ".calibrated.xlsx")
+    return CalibrateRequest(pairs, args.law, args.fit, args.objective, args.degree, args.cfc,
+                            args.sign, args.time_unit, args.accel_unit, args.channel,
+                            args.anti_alias, args.integrator, output, args.force,
+                            Path(args.archive) if args.archive else None, args.name,
+                            tuple(args.argv))
 
 
 def run(args):
-    from ..readers.recording import input_file, read_trace
-    from ..reports.calibration import write_calibration
-    from ..shot import Shot
-    from ..studies.calibrate import calibrate, check_fit
-    from ..studies.shock import CFC_CLASSES, cfc_coefficients
-    from ..transaction import check_output
+    from ..app.calibrate import run as calibrate
 
-    files = _pairs(args.pairs)
-    if args.cfc is not None and args.cfc not in CFC_CLASSES:
-        cfc_coefficients(args.cfc, 1.0)  # its one-line error, before any run
-    if not 1 <= args.degree <= 6:
-        raise OptionError(f"--degree: found {args.degree}, expected 1 to 6 (Eq. 8 is of "
-                          "degree 6)")
-    names = [n.strip() for n in (args.fit or "").split(",") if n.strip()]
-    if args.fit is not None:
-        names = check_fit(names, args.objective)
-    law = args.law or not names
-    root = _law_library(args, law or "scale" in names)
-    first = Path(files[0][0])
-    output = Path(args.output) if args.output else first.with_name(
-        first.stem + ".calibrated.xlsx")
-    check_output(output, args.force,
-                 inputs=[input_file(f) for pair in files for f in pair])
-    shots = [Shot.from_workbook(s) for s, _ in files]
-    traces = [read_trace(m, args.time_unit, args.accel_unit, args.sign, args.channel)
-              for _, m in files]
-    cal = calibrate([s.params for s in shots], traces, law=law, fit=names, cfc=args.cfc,
-                    degree=args.degree, objective=args.objective,
-                    integrator=args.integrator, anti_alias=args.anti_alias)
-    cal.warnings[:0] = [w for s in shots for w in s.warnings]
-    write_calibration(output, shots[0], cal, files, args, args.force)
-    print(f"wrote {output}: calibrated on {len(files)} shot{'s' * (len(files) > 1)} "
+    outcome = calibrate(request_of(args))
+    cal, output, n = outcome.calibration, outcome.output, len(outcome.calibration.before)
+    print(f"wrote {output}: calibrated on {n} shot{'s' * (n > 1)} "
           f"({cal.runs} runs, {cal.seconds:.2f} s)")
-    if cal.law_calibration is not None:
-        lc = cal.law_calibration
-        lo, hi = cal.params[0].crush_law.v_range
-        print(f"  crush law: {'converged' if lc.converged else 'NOT converged'} in "
-              f"{len(lc.iterations)} iterations (last change {lc.iterations[-1].change:.2%}), "
-              f"then least squares; valid {lo:.1f} to {hi:.1f} m/s (the samples' span)")
-        print("  crush law at its nodes, 95 % intervals (noise, baselines and alignment; not "
-              "model error):")
-        for node in cal.law_intervals:
-            line = (f"    {node.velocity:6.1f} m/s: {node.value:.4f} ({node.low:.4f} to "
-                    f"{node.high:.4f}, +/- {node.half_width:.1%})")
-            if node.weak:
-                line += f" WEAKLY PINNED by {node.pinned_by() or 'no shot in particular'}"
-                if node.suggested is not None:
-                    line += f"; a shot at about {node.suggested:.0f} m/s would pin it best"
-            print(line)
+    _print_law(cal)
     for name, value in cal.fitted.items():
         print(f"  {name}: {cal.start[name]:.6g} -> {value:.6g} +/- {cal.errors[name]:.3g} "
               f"(1 standard error; 95 %: {value - 1.96 * cal.errors[name]:.6g} to "
@@ -117,52 +90,40 @@ def run(args):
               f"{before.iso:.3f} -> {after.iso:.3f}")
     for text in cal.notes:
         print(f"  note: {text}")
-    if cal.warnings:
+    if not outcome.trusted:
         from .messages import warn
 
-        warn(cal.warnings)
+        warn(list(outcome.warnings))
         print(f"  verdict: NOT TRUSTED ({len(cal.warnings)} warning"
               f"{'s' * (len(cal.warnings) > 1)}, also in {output}); exit {UNTRUSTED}")
         return UNTRUSTED
     print("  verdict: every fitted value identified, within its bounds, and every shot's "
           "residual improved")
-    if root is not None:
-        from ..archive.laws import store_law
+    if outcome.stored is not None:
         from ..transaction import display
 
-        shots_record = [{"workbook": display(w), "recording": display(m), "v0": p.v31}
-                        for (w, m), p in zip(files, cal.params, strict=True)]
-        scores = [{"rms_before": b.rms, "rms_after": a.rms, "iso_before": _plain(b.iso),
-                   "iso_after": _plain(a.iso)}
-                  for b, a in zip(cal.before, cal.after, strict=True)]
-        ref = store_law(root, args.name, cal.params[0].crush_law, shots_record, scores,
-                        [display(a) for a in args.argv])
-        print(f"  stored the law as {ref} in {display(root)} (fill --crush-law {args.name} "
-              f"--archive {display(root)})")
+        root = display(outcome.archive)
+        print(f"  stored the law as {outcome.stored} in {root} (fill --crush-law {args.name} "
+              f"--archive {root})")
     return 0
 
 
-def _plain(value):
-    return None if math.isnan(value) else value  # NaN (too short a pulse): null
-
-
-def _law_library(args, fits_a_law):
-    """The archive the law goes to (``--name``), checked before any run; None without it."""
-    from ..archive import Archive, archive_dir, safe_name
-
-    if args.name is None:
-        if args.archive is not None:
-            raise OptionError("--archive: found without --name, expected --name NAME for the "
-                              "law's name in the archive's library")
-        return None
-    if not fits_a_law:
-        raise OptionError("--name: found with --fit of no law, expected a law to keep (the "
-                          "default, --law, or --fit scale)")
-    if not args.name or safe_name(args.name) != args.name or args.name.lower() in (
-            "workbook", "legacy"):
-        raise OptionError(f"--name: found {args.name!r}, expected a law name of letters, "
-                          "digits, '-', '_' and '.' (such as LOT-2026-07), not workbook or "
-                          "legacy")
-    root = archive_dir(args.archive)
-    Archive(root, create=True, dry_run=True)  # a foreign folder is refused now
-    return root
+def _print_law(cal):
+    """The law recovered: its convergence, range and intervals at its nodes."""
+    if cal.law_calibration is None:
+        return
+    lc = cal.law_calibration
+    lo, hi = cal.params[0].crush_law.v_range
+    print(f"  crush law: {'converged' if lc.converged else 'NOT converged'} in "
+          f"{len(lc.iterations)} iterations (last change {lc.iterations[-1].change:.2%}), "
+          f"then least squares; valid {lo:.1f} to {hi:.1f} m/s (the samples' span)")
+    print("  crush law at its nodes, 95 % intervals (noise, baselines and alignment; not "
+          "model error):")
+    for node in cal.law_intervals:
+        line = (f"    {node.velocity:6.1f} m/s: {node.value:.4f} ({node.low:.4f} to "
+                f"{node.high:.4f}, +/- {node.half_width:.1%})")
+        if node.weak:
+            line += f" WEAKLY PINNED by {node.pinned_by() or 'no shot in particular'}"
+            if node.suggested is not None:
+                line += f"; a shot at about {node.suggested:.0f} m/s would pin it best"
+        print(line)
