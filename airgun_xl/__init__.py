@@ -32,8 +32,10 @@ if TYPE_CHECKING:
 
     from .app.accept import AcceptOutcome
     from .app.calibrate import CalibrateOutcome
+    from .app.compare_measured import CompareMeasuredOutcome
     from .app.design import DesignOutcome
     from .app.specifying import SpecFields
+    from .app.srs import SrsOutcome
     from .app.sweep import SweepOutcome
     from .params import ShotParams
     from .result import Result
@@ -257,6 +259,80 @@ def design(shot: str | os.PathLike[str], *, target_peak: str | None = None,
         ("design",)))
 
 
+def srs(shot: str | os.PathLike[str], *, q: float | str = 10.0, cfc: int | str | None = None,
+        lo: float = 100.0, hi: float = 10_000.0, integrator: str = "legacy",
+        model: str = "4-mass", output: str | os.PathLike[str] | None = None,
+        force: bool = False, crush_law: str = "workbook",
+        archive: str | os.PathLike[str] | None = None) -> SrsOutcome:
+    """The shock response spectrum of the shot's predicted pulse, as ``airgun-xl srs``
+    does: maximax absolute acceleration [kG] at 1/12-octave frequencies from ``lo`` to ``hi``
+    [Hz] (``--from``, ``--to``), quality factor ``q`` [-], the pulse through ``cfc`` first (a
+    J211 class, or ``"none"``, the default).
+
+    Returns
+    -------
+    airgun_xl.app.srs.SrsOutcome
+        ``frequencies``, ``levels``, ``largest``, ``warnings``, ``files``.
+
+    Raises
+    ------
+    AirgunXlError
+        Bad input, named; nothing is written.
+    """
+    from pathlib import Path
+
+    from .app.specifying import cfc_class
+    from .app.srs import SrsRequest, run
+    from .specification import parse_q
+
+    try:
+        record = cfc_class(str(cfc)) if cfc is not None else None
+    except ValueError as exc:
+        raise OptionError(f"--cfc: {exc}") from None
+    return run(SrsRequest(Path(shot), parse_q(str(q), "--srs-q"), record, float(lo),
+                          float(hi), integrator, model,
+                          Path(output) if output is not None else None, force, crush_law,
+                          Path(archive) if archive is not None else None))
+
+
+def compare_measured(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
+                     cfc: int | str | None = None, align: str = "threshold",
+                     anti_alias: str | float = "auto", sign: float = 1.0,
+                     time_unit: str | None = None, accel_unit: str | None = None,
+                     channel: str | None = None, integrator: str = "legacy",
+                     model: str = "4-mass", output: str | os.PathLike[str] | None = None,
+                     force: bool = False, crush_law: str = "workbook",
+                     archive: str | os.PathLike[str] | None = None) -> CompareMeasuredOutcome:
+    """The shot's predicted pulse against a measured one, as ``airgun-xl compare-measured``
+    does: both through ``cfc`` (a J211 class, or ``"none"``, the default), aligned at the
+    impact (``align``: threshold or xcorr), scored.
+
+    Returns
+    -------
+    airgun_xl.app.compare_measured.CompareMeasuredOutcome
+        ``comparison`` (both pulses' figures, their errors, the correlation, the ISO/TS 18571
+        rating), ``warnings``, ``files``.
+
+    Raises
+    ------
+    AirgunXlError
+        Bad input, named; nothing is written.
+    """
+    from pathlib import Path
+
+    from .app.compare_measured import CompareMeasuredRequest, run
+    from .app.specifying import cfc_class
+
+    try:
+        record = cfc_class(str(cfc)) if cfc is not None else None
+    except ValueError as exc:
+        raise OptionError(f"--cfc: {exc}") from None
+    return run(CompareMeasuredRequest(
+        Path(shot), os.fspath(recording), record, align, anti_alias, float(sign), time_unit,
+        accel_unit, channel, integrator, model, Path(output) if output is not None else None,
+        force, crush_law, Path(archive) if archive is not None else None))
+
+
 def _texts(value: str | Sequence[str]) -> tuple[str, ...]:
     """One text or several, as a tuple."""
     return (value,) if isinstance(value, str) else tuple(str(v) for v in value)
@@ -326,7 +402,9 @@ __all__ = [
     "__version__",
     "accept",
     "calibrate",
+    "compare_measured",
     "design",
     "load",
+    "srs",
     "sweep",
 ]

@@ -29,51 +29,20 @@ def add_parser(sub):
 
 
 def run(args):
-    import dataclasses
-
-    import numpy as np
-
-    from ..archive.laws import shot_with_law
-    from ..models import apply_model
-    from ..readers.recording import input_file, read_trace
-    from ..reports.measured import write_comparison
-    from ..studies.check import after_run
-    from ..studies.measured import ANTI_ALIAS_ORDER, compare
-    from ..studies.shock import CFC_CLASSES, cfc_coefficients
-    from ..transaction import check_output
+    from ..app.compare_measured import CompareMeasuredRequest
+    from ..app.compare_measured import run as compare_measured
     from .messages import warn
 
-    if args.cfc is not None and args.cfc not in CFC_CLASSES:
-        cfc_coefficients(args.cfc, 1.0)  # its one-line error, before the run
     shot_path = Path(args.shot)
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".measured.xlsx")
-    check_output(output, args.force, inputs=[args.shot, input_file(args.measured)])
-    trace = read_trace(args.measured, args.time_unit, args.accel_unit, args.sign,
-                       args.channel)
-    shot = shot_with_law(args.shot, args.crush_law, args.archive)
-    result = dataclasses.replace(shot, params=apply_model(shot.params, args.model)).run(
-        integrator=args.integrator, track=())
-    finite = np.isfinite(result.accel_kg)
-    other = "rigid" if args.model == "4-mass" else "4-mass"
-    rigid = dataclasses.replace(shot, params=apply_model(shot.params, other)).run(
-        integrator=args.integrator, track=())
-    ok = np.isfinite(rigid.accel_kg)
-    c = compare(result.history.time[finite], result.accel_kg[finite], trace, args.cfc,
-                args.align, rigid=(rigid.history.time[ok], rigid.accel_kg[ok]),
-                anti_alias=args.anti_alias)
-    c.warnings[:0] = shot.warnings + [str(f) for f in after_run(result)]
-    about = [("Shot", str(args.shot)), ("Measured", trace.name),
-             ("Units read", f"time {trace.units[0]}, acceleration {trace.units[1]}"),
-             ("Filter", f"CFC {args.cfc}" if args.cfc else "none"),
-             ("Alignment", f"{args.align} (cross-checked against the other)"),
-             ("Anti-alias model", "none" if c.anti_alias is None else
-              f"{ANTI_ALIAS_ORDER}-pole Butterworth at {c.anti_alias:,.0f} Hz on the prediction"),
-             ("Warnings", f"{len(c.warnings)} (below the scores)" if c.warnings else "none")]
-    write_comparison(output, c, about, args.force, models=(args.model, other),
-                     shot=Path(args.shot).name)
-    print(f"wrote {output}: {trace.name} against {args.shot} ({len(c.time):,} samples, "
-          f"aligned by {args.align}, shift {c.shift * 1e3:.4f} ms)")
+    outcome = compare_measured(CompareMeasuredRequest(
+        shot_path, args.measured, args.cfc, args.align, args.anti_alias, args.sign,
+        args.time_unit, args.accel_unit, args.channel, args.integrator, args.model, output,
+        args.force, args.crush_law, Path(args.archive) if args.archive else None))
+    c = outcome.comparison
+    print(f"wrote {output}: {outcome.recording} against {args.shot} ({len(c.time):,} "
+          f"samples, aligned by {args.align}, shift {c.shift * 1e3:.4f} ms)")
     print(f"  peak {c.predicted.peak_kg:.4f} kG predicted, {c.measured.peak_kg:.4f} measured "
           f"({c.errors['peak_kg']:+.2%}); pulse {c.predicted.pulse_duration * 1e3:.4f} ms, "
           f"{c.measured.pulse_duration * 1e3:.4f} ({c.errors['pulse_duration']:+.2%})")
@@ -86,5 +55,5 @@ def run(args):
     print(f"  baseline: {c.baseline.words()}; impact at {c.level:.1%} of the peak; "
           "anti-alias model "
           + (f"{c.anti_alias:,.0f} Hz" if c.anti_alias else "none"))
-    warn(c.warnings)
+    warn(list(outcome.warnings))
     return 0

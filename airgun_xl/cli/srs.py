@@ -1,7 +1,6 @@
 """``airgun-xl srs SHOT.xlsx``: the shock response spectrum of the predicted pulse."""
 from pathlib import Path
 
-from ..errors import OptionError
 from .recording_options import CfcOption, cfc_value
 from .run_options import SHOT_HELP, add_crush_law, add_force, add_output, add_run_options
 from .vocabulary import Alias, One
@@ -40,53 +39,19 @@ def add_parser(sub):
 
 
 def run(args):
-    import dataclasses
-
-    import numpy as np
-
-    from ..archive.laws import shot_with_law
-    from ..models import apply_model
-    from ..reports.srs import write_srs
-    from ..studies.check import after_run, before_run
-    from ..studies.shock import (
-        cfc_filter,
-        default_frequencies,
-        srs,
-    )
-    from ..transaction import check_output
+    from ..app.srs import SrsRequest
+    from ..app.srs import run as spectrum
     from .messages import warn
 
-    if not (0 < args.lo < args.hi < float("inf")):
-        raise OptionError(f"--from/--to: found {args.lo:g} and {args.hi:g} Hz, expected "
-                          "0 < FROM < TO")
-    shot = shot_with_law(args.shot, args.crush_law, args.archive)
     shot_path = Path(args.shot)
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".srs.xlsx")
-    check_output(output, args.force, inputs=[args.shot])  # before the run, not after
-    model_params = apply_model(shot.params, args.model)
-    _, findings = before_run(model_params, args.integrator)
-    result = dataclasses.replace(shot, params=model_params).run(integrator=args.integrator,
-                                                                track=())
-    # the warnings a fill of the shot gives, with the spectrum of its run (Summary-like),
-    # each once (the checks and the run say a fractional 1/(E2*E34) in the same words)
-    warnings = list(dict.fromkeys(
-        [str(w) for w in shot.warnings] + [str(f) for f in findings if f.level != "note"]
-        + [str(w) for w in result.warnings[len(shot.warnings):]]
-        + [str(f) for f in after_run(result)]))
-    pulse = result.accel_kg[np.isfinite(result.accel_kg)]
-    dt = shot.params.delta
-    if args.cfc is not None:
-        pulse = cfc_filter(pulse, dt, args.cfc)
-    freqs = default_frequencies(args.lo, args.hi)
-    spectrum = srs(pulse, dt, freqs, args.srs_q)
-    about = [("Shot", str(args.shot)), ("Quality factor Q", f"{args.srs_q:g}"),
-             ("Filter", f"CFC {args.cfc}" if args.cfc else "none"),
-             ("Model, integrator", f"{args.model}, {args.integrator}")]
-    write_srs(output, freqs, spectrum, about, args.force, shot=shot_path.name,
-              warnings=warnings)
-    k = int(np.argmax(spectrum))
-    print(f"wrote {output}: SRS at {len(freqs)} frequencies, {args.lo:g}-{args.hi:g} Hz, "
-          f"Q = {args.srs_q:g}; largest {spectrum[k]:.4f} kG at {freqs[k]:,.0f} Hz")
-    warn(warnings)
+    outcome = spectrum(SrsRequest(shot_path, args.srs_q, args.cfc, args.lo, args.hi,
+                                  args.integrator, args.model, output, args.force,
+                                  args.crush_law,
+                                  Path(args.archive) if args.archive else None))
+    level, frequency = outcome.largest
+    print(f"wrote {output}: SRS at {len(outcome.frequencies)} frequencies, {args.lo:g}-"
+          f"{args.hi:g} Hz, Q = {outcome.q:g}; largest {level:.4f} kG at {frequency:,.0f} Hz")
+    warn(list(outcome.warnings))
     return 0

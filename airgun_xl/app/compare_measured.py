@@ -1,0 +1,117 @@
+"""Compare-measured: the shot's predicted pulse against a measured one, both filtered alike
+(SAE J211), aligned at the impact and scored (peak, its time, the pulse, the velocity change,
+their correlation, ISO/TS 18571).
+
+:func:`run` takes a :class:`CompareMeasuredRequest` and returns a
+:class:`CompareMeasuredOutcome`; the CLI (``airgun-xl compare-measured``) and the Python API
+(:func:`airgun_xl.compare_measured`) are both this."""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import OptionError
+
+
+@dataclass(frozen=True)
+class CompareMeasuredRequest:
+    """The shot and its recording, read as the options say; ``align`` ``threshold`` or
+    ``xcorr``; ``anti_alias`` the recorder's filter modelled on the prediction [Hz], auto or
+    none. ``output`` None writes no workbook (the CLI gives its default,
+    ``SHOT.measured.xlsx``)."""
+
+    shot: Path
+    recording: str
+    cfc: int | None = None
+    align: str = "threshold"
+    anti_alias: str | float = "auto"
+    sign: float = 1.0
+    time_unit: str | None = None
+    accel_unit: str | None = None
+    channel: str | None = None
+    integrator: str = "legacy"
+    model: str = "4-mass"
+    output: Path | None = None
+    force: bool = False
+    crush_law: str = "workbook"
+    archive: Path | None = None  # where a library law is read from
+
+
+@dataclass(frozen=True)
+class CompareMeasuredOutcome:
+    """The comparison (studies.measured.Comparison: both pulses' figures, their errors, the
+    correlation, the ISO/TS 18571 rating, the baseline, the shift), the recording's name,
+    units and the files written."""
+
+    comparison: Any
+    recording: str
+    units: tuple[str, str]  # (time, acceleration) as read
+    models: tuple[str, str]  # the model compared, and the other one shown beside it
+    output: Path | None
+    files: tuple[Path, ...]
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        return tuple(self.comparison.warnings)
+
+
+def run(request: CompareMeasuredRequest) -> CompareMeasuredOutcome:
+    """The prediction against the recording.
+
+    Raises
+    ------
+    airgun_xl.errors.AirgunXlError
+        Bad input, named; nothing is written.
+    """
+    from ..archive.laws import shot_with_law
+    from ..models import apply_model
+    from ..readers.recording import input_file, read_trace
+    from ..studies.check import after_run
+    from ..studies.measured import ANTI_ALIAS_ORDER, compare
+    from ..studies.shock import CFC_CLASSES, cfc_coefficients
+    from ..transaction import check_output
+
+    if request.sign not in (1.0, -1.0):
+        raise OptionError(f"--sign: found {request.sign!r}, expected 1 or -1")
+    if request.align not in ("threshold", "xcorr"):
+        raise OptionError(f"--align: found {request.align!r}, expected threshold or xcorr")
+    if request.cfc is not None and request.cfc not in CFC_CLASSES:
+        cfc_coefficients(request.cfc, 1.0)  # its one-line error, before the run
+    if request.output is not None:
+        check_output(request.output, request.force,
+                     inputs=[request.shot, input_file(request.recording)])
+    trace = read_trace(request.recording, request.time_unit, request.accel_unit,
+                       request.sign, request.channel)
+    shot = shot_with_law(request.shot, request.crush_law, request.archive)
+    result = dataclasses.replace(shot, params=apply_model(shot.params, request.model)).run(
+        integrator=request.integrator, track=())
+    finite = np.isfinite(result.accel_kg)
+    other = "rigid" if request.model == "4-mass" else "4-mass"
+    rigid = dataclasses.replace(shot, params=apply_model(shot.params, other)).run(
+        integrator=request.integrator, track=())
+    ok = np.isfinite(rigid.accel_kg)
+    c = compare(result.history.time[finite], result.accel_kg[finite], trace, request.cfc,
+                request.align, rigid=(rigid.history.time[ok], rigid.accel_kg[ok]),
+                anti_alias=request.anti_alias)
+    c.warnings[:0] = shot.warnings + [str(f) for f in after_run(result)]
+    if request.output is not None:
+        from ..reports.measured import write_comparison
+
+        about = [("Shot", str(request.shot)), ("Measured", trace.name),
+                 ("Units read", f"time {trace.units[0]}, acceleration {trace.units[1]}"),
+                 ("Filter", f"CFC {request.cfc}" if request.cfc else "none"),
+                 ("Alignment", f"{request.align} (cross-checked against the other)"),
+                 ("Anti-alias model", "none" if c.anti_alias is None else
+                  f"{ANTI_ALIAS_ORDER}-pole Butterworth at {c.anti_alias:,.0f} Hz on the "
+                  "prediction"),
+                 ("Warnings", f"{len(c.warnings)} (below the scores)" if c.warnings
+                  else "none")]
+        write_comparison(request.output, c, about, request.force,
+                         models=(request.model, other), shot=Path(request.shot).name)
+    files = (request.output,) if request.output is not None else ()
+    return CompareMeasuredOutcome(c, trace.name, tuple(trace.units), (request.model, other),
+                                  request.output, files)
