@@ -65,6 +65,27 @@ class CalibrateOutcome:
         """Why it cannot be vouched for (the shots' own warnings first)."""
         return tuple(self.calibration.warnings)
 
+    def to_json(self) -> str:
+        """The outcome as one JSON document (``calibrate --json``): trusted or not and why,
+        the fitted values (E40 [Pa], E43 [-], scale [-]) with their standard errors and
+        bounds, the law's 95 % intervals at its nodes [m/s], each shot's RMS error and
+        ISO/TS 18571 rating before and after, and the law's reference if kept."""
+        from .documents import dumps
+
+        cal = self.calibration
+        law = cal.params[0].crush_law
+        return dumps({"trusted": self.trusted, "fitted": cal.fitted, "start": cal.start,
+                      "standard_errors": cal.errors, "bounds": cal.bounds,
+                      "law": None if cal.law_calibration is None else {
+                          "coefficients": law.coefficients, "v_range_m_s": law.v_range,
+                          "converged": cal.law_calibration.converged,
+                          "intervals": cal.law_intervals},
+                      "scores": [{"before": b, "after": a}
+                                 for b, a in zip(cal.before, cal.after, strict=True)],
+                      "runs": cal.runs, "seconds": cal.seconds, "notes": cal.notes,
+                      "warnings": self.warnings, "stored": self.stored,
+                      "files": self.files})
+
     @property
     def fitted(self) -> dict[str, float]:
         """{name: value} fitted by least squares (E40 [Pa], E43 [-], scale [-])."""

@@ -58,6 +58,21 @@ class CompareMeasuredOutcome:
     def warnings(self) -> tuple[str, ...]:
         return tuple(self.comparison.warnings)
 
+    def to_json(self) -> str:
+        """The outcome as one JSON document (``compare-measured --json``): both pulses'
+        figures (peaks [kG], times [s], velocity change [m/s]), the prediction's errors
+        against the test (predicted / measured - 1), the correlation, the ISO/TS 18571
+        rating, the alignment's shift [s]."""
+        from .documents import dumps
+
+        c = self.comparison
+        return dumps({"recording": self.recording, "units_read": self.units,
+                      "models": self.models, "alignment": c.alignment, "shift_s": c.shift,
+                      "predicted": c.predicted, "measured": c.measured,
+                      "errors": c.errors, "correlation": c.correlation, "iso18571": c.iso,
+                      "anti_alias_Hz": c.anti_alias, "warnings": self.warnings,
+                      "files": self.files})
+
 
 def run(request: CompareMeasuredRequest) -> CompareMeasuredOutcome:
     """The prediction against the recording.

@@ -81,6 +81,30 @@ class DesignOutcome:
     warnings: tuple[str, ...]  # the designed shot's and the study's
     confidence: Any = None  # first_shot.Confidence (probabilities, intervals), if asked
 
+    def to_json(self) -> str:
+        """The outcome as one JSON document (``design --json``): the mode, the values solved
+        (in the cells' units), whether the specification or P was reached, first-shot
+        success's probabilities with their 95 % intervals, and the designed shot's Summary
+        figures where it was filled."""
+        from .documents import dumps
+
+        c = self.confidence
+
+        def setting(s: Any) -> dict[str, Any]:
+            return {"setting": s.setting, "probability": s.probability,
+                    "interval": s.interval, "shots": s.shots, "passes": s.passes,
+                    "failures": s.failures}
+
+        summary = self.filled.summary if self.filled is not None else None
+        return dumps({"mode": self.mode, "values": self.values, "reached": self.reached,
+                      "confidence": None if c is None else {
+                          "best": setting(c.best), "middle": setting(c.middle)},
+                      "evaluations": self.design.evaluations,
+                      "summary": None if summary is None else {
+                          k: v for k, v in dataclasses.asdict(summary).items()
+                          if k != "spectrum"},
+                      "warnings": self.warnings, "files": self.files})
+
     @property
     def values(self) -> dict[str, float]:
         """{cell: value} solved (A28 stands for A28..A30), in the cells' units."""

@@ -44,6 +44,16 @@ class SrsOutcome:
     files: tuple[Path, ...]
     warnings: tuple[str, ...]
 
+    def to_json(self) -> str:
+        """The outcome as one JSON document (``srs --json``)."""
+        from .documents import dumps
+
+        level, frequency = self.largest
+        return dumps({"q": self.q, "frequencies_Hz": self.frequencies,
+                      "levels_kG": self.levels,
+                      "largest": {"level_kG": level, "frequency_Hz": frequency},
+                      "warnings": self.warnings, "files": self.files})
+
     @property
     def largest(self) -> tuple[float, float]:
         """(level [kG], frequency [Hz]) of the spectrum's largest level."""

@@ -70,6 +70,21 @@ class SweepOutcome:
         """``grid``, ``montecarlo`` or ``sobol``."""
         return str(self.result.kind)
 
+    def to_json(self) -> str:
+        """The outcome as one JSON document (``sweep --json``): the study, the spread of the
+        peak [kG], the Sobol indices, and a row a shot as :meth:`to_frame` gives it."""
+        from .documents import dumps
+
+        sensitivity = None
+        if self.sensitivity is not None:
+            sensitivity = {"cells": list(self.sensitivity.cells),
+                           "indices": self.sensitivity.indices}
+        return dumps({"kind": self.kind, "shots": self.shots, "seed": self.seed,
+                      "seconds": self.seconds, "peak_kG": self.stats,
+                      "sensitivity": sensitivity,
+                      "rows": self.to_frame().to_dict(orient="records"),
+                      "warnings": self.warnings, "files": self.files})
+
     def to_frame(self) -> pd.DataFrame:
         """One row a shot: the varied or drawn cells (in their units), the figures
         (``peak_kg`` [kG], ``time_of_peak`` [s], ``filtered_peak_kg`` [kG],

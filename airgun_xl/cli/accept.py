@@ -4,7 +4,7 @@ Exit 0 on PASS, 3 on FAIL (:data:`FAIL_EXIT`), 2 for bad input."""
 from pathlib import Path
 
 from .recording_options import RECORDING_HELP, add_recording_options
-from .run_options import SHOT_HELP, add_crush_law, add_force, add_output
+from .run_options import SHOT_HELP, add_crush_law, add_force, add_json, add_output
 from .spec_options import RECORD_HELP, add_spec_options
 from .vocabulary import One
 
@@ -32,10 +32,7 @@ def add_parser(sub):
                    help="record the verdict in the archive (the verdict file of the shot's "
                         "next entry), and the library --crush-law NAME is read from")
     add_crush_law(p, archive=False)
-    p.add_argument("--json", action="store_true",
-                   help="print the verdict as one JSON document (criteria, tolerances, "
-                        "warnings, files written) instead of its lines; the exit status and "
-                        "the warnings on stderr are the same")
+    add_json(p, "the verdict (criteria, tolerances, warnings, files written)")
     p.set_defaults(run=run)
 
 

@@ -4,7 +4,7 @@ from pathlib import Path
 
 from ..errors import OptionError
 from .recording_options import add_recording_options
-from .run_options import add_force, add_integrator, add_output
+from .run_options import add_force, add_integrator, add_json, add_output
 from .vocabulary import One
 
 
@@ -42,6 +42,7 @@ def add_parser(sub):
     p.add_argument("--name", metavar="NAME",
                    help="the law's name in the archive, e.g. LOT-2026-07 (a honeycomb lot); "
                         "storing it again adds its next version")
+    add_json(p, "the calibration")
     p.set_defaults(run=run)
 
 
@@ -77,6 +78,12 @@ def run(args):
     from ..app.calibrate import run as calibrate
 
     outcome = calibrate(request_of(args))
+    if args.json:
+        from .messages import warn
+
+        print(outcome.to_json())
+        warn(list(outcome.warnings))
+        return 0 if outcome.trusted else UNTRUSTED
     cal, output, n = outcome.calibration, outcome.output, len(outcome.calibration.before)
     print(f"wrote {output}: calibrated on {n} shot{'s' * (n > 1)} "
           f"({cal.runs} runs, {cal.seconds:.2f} s)")

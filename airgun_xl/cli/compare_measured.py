@@ -2,7 +2,7 @@
 from pathlib import Path
 
 from .recording_options import RECORDING_HELP, add_recording_options
-from .run_options import SHOT_HELP, add_crush_law, add_force, add_output, add_run_options
+from .run_options import SHOT_HELP, add_crush_law, add_force, add_json, add_output, add_run_options
 
 
 def add_parser(sub):
@@ -25,6 +25,7 @@ def add_parser(sub):
                         " or the cross-correlation's best lag; each checks the other")
     add_run_options(p)
     add_crush_law(p)
+    add_json(p, "the scores")
     p.set_defaults(run=run)
 
 
@@ -40,6 +41,10 @@ def run(args):
         shot_path, args.measured, args.cfc, args.align, args.anti_alias, args.sign,
         args.time_unit, args.accel_unit, args.channel, args.integrator, args.model, output,
         args.force, args.crush_law, Path(args.archive) if args.archive else None))
+    if args.json:
+        print(outcome.to_json())
+        warn(list(outcome.warnings))
+        return 0
     c = outcome.comparison
     print(f"wrote {output}: {outcome.recording} against {args.shot} ({len(c.time):,} "
           f"samples, aligned by {args.align}, shift {c.shift * 1e3:.4f} ms)")

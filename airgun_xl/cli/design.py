@@ -4,7 +4,7 @@ from pathlib import Path
 from ..choices import DESIGN_VARIABLES
 from .cluster_options import add_cluster_options
 from .fill import print_summary
-from .run_options import SHOT_HELP, add_crush_law, add_force, add_output, add_run_options
+from .run_options import SHOT_HELP, add_crush_law, add_force, add_json, add_output, add_run_options
 from .spec_options import add_spec_options
 from .vocabulary import Alias
 
@@ -57,6 +57,7 @@ def add_parser(sub):
                        help="Monte Carlo shots a setting (default 10,000)")
     first.add_argument("--seed", type=int, default=1, help="of the draws (default 1)")
     add_crush_law(p)
+    add_json(p, "the design")
     p.set_defaults(run=run)
 
 
@@ -80,7 +81,10 @@ def run(args):
     from .messages import note, warn
     from .progress import Progress
 
-    outcome = design(request_of(args), warn, note, Progress.for_rows)
+    outcome = design(request_of(args), warn, note, None if args.json else Progress.for_rows)
+    if args.json:
+        print(outcome.to_json())
+        return 0 if outcome.reached else 3
     for line in outcome.lines:
         print(line)
     print_summary(outcome.output, outcome.filled)

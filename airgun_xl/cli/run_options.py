@@ -94,6 +94,15 @@ def add_crush_law(p, archive=True):
                             "(default: $AIRGUN_XL_ARCHIVE when set)")
 
 
+def add_json(p, what="the outcome"):
+    """``--json``: the command's outcome as one JSON document on stdout instead of its
+    lines (for a LIMS); its warnings still on stderr, its exit status the same; no
+    progress bar."""
+    p.add_argument("--json", action="store_true",
+                   help=f"print {what} as one JSON document instead of its lines; the exit "
+                        "status and the warnings on stderr are the same")
+
+
 def add_force(p, metavar="OUT.xlsx"):
     p.add_argument("--force", action="store_true", help=f"overwrite {metavar} if it exists")
 

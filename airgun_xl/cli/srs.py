@@ -2,7 +2,7 @@
 from pathlib import Path
 
 from .recording_options import CfcOption, cfc_value
-from .run_options import SHOT_HELP, add_crush_law, add_force, add_output, add_run_options
+from .run_options import SHOT_HELP, add_crush_law, add_force, add_json, add_output, add_run_options
 from .vocabulary import Alias, One
 
 
@@ -35,6 +35,7 @@ def add_parser(sub):
                    help="highest natural frequency (default 10000)")
     add_run_options(p)
     add_crush_law(p)
+    add_json(p, "the spectrum")
     p.set_defaults(run=run)
 
 
@@ -50,6 +51,10 @@ def run(args):
                                   args.integrator, args.model, output, args.force,
                                   args.crush_law,
                                   Path(args.archive) if args.archive else None))
+    if args.json:
+        print(outcome.to_json())
+        warn(list(outcome.warnings))
+        return 0
     level, frequency = outcome.largest
     print(f"wrote {output}: SRS at {len(outcome.frequencies)} frequencies, {args.lo:g}-"
           f"{args.hi:g} Hz, Q = {outcome.q:g}; largest {level:.4f} kG at {frequency:,.0f} Hz")

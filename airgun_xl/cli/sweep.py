@@ -2,7 +2,7 @@
 from pathlib import Path
 
 from .cluster_options import add_cluster_options
-from .run_options import SHOT_HELP, add_crush_law, add_force, add_output, add_run_options
+from .run_options import SHOT_HELP, add_crush_law, add_force, add_json, add_output, add_run_options
 
 
 def add_parser(sub):
@@ -31,6 +31,7 @@ def add_parser(sub):
     add_force(p)
     add_cluster_options(p)
     add_crush_law(p)
+    add_json(p, "the shots' figures and the spread")
     p.set_defaults(run=run)
 
 
@@ -61,7 +62,11 @@ def run(args):
     from ..app.sweep import run as sweep
     from .messages import warn
 
-    outcome = sweep(request_of(args), _progress_bar)
+    outcome = sweep(request_of(args), None if args.json else _progress_bar)
+    if args.json:
+        print(outcome.to_json())
+        warn(list(outcome.warnings))
+        return 0
     result, stats = outcome.result, outcome.stats
     print(f"wrote {outcome.output}: {outcome.shots:,} shots in {outcome.seconds:.2f} s "
           f"({outcome.steps_per_second:.3g} shot-steps/s); {int(result.diverged.sum())} "
