@@ -139,8 +139,8 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
         cfc=cfc, accel_unit=accel_unit)
     return run(AcceptRequest(
         Path(shot), os.fspath(recording), fields, Path(output) if output is not None else None,
-        force, Path(archive) if archive is not None else None, channel, float(sign), time_unit,
-        accel_unit, ("accept",), crush_law))
+        force, Path(archive) if archive is not None else None, channel,
+        _number("--sign", sign), time_unit, accel_unit, ("accept",), crush_law))
 
 
 def calibrate(*files: str | os.PathLike[str], law: bool = False,
@@ -186,8 +186,9 @@ def calibrate(*files: str | os.PathLike[str], law: bool = False,
         raise OptionError(f"--cfc: {exc}") from None
     names = fit if fit is None or isinstance(fit, str) else ",".join(fit)
     return run(CalibrateRequest(
-        tuple(zip(texts[::2], texts[1::2], strict=True)), law, names, objective, degree,
-        record, float(sign), time_unit, accel_unit, channel, anti_alias, integrator,
+        tuple(zip(texts[::2], texts[1::2], strict=True)), law, names, objective,
+        _whole("--degree", degree), record, _number("--sign", sign), time_unit, accel_unit,
+        channel, anti_alias, integrator,
         Path(output) if output is not None else None, force,
         Path(archive) if archive is not None else None, name, ("calibrate",)))
 
@@ -251,9 +252,12 @@ def design(shot: str | os.PathLike[str], *, target_peak: str | None = None,
         placement=placement, srs=srs, srs_tol=srs_tol, srs_q=srs_q, srs_outside=srs_outside,
         cfc=cfc, accel_unit=accel_unit)
     return run(DesignRequest(
-        Path(shot), target_peak, target_duration,
-        os.fspath(target_srs) if target_srs is not None else None, _texts(vary), range,
-        filtered, fields, confidence, _texts(sd), shots, seed, integrator, model,
+        Path(shot), None if target_peak is None else str(target_peak),
+        None if target_duration is None else str(target_duration),
+        os.fspath(target_srs) if target_srs is not None else None, _texts(vary),
+        None if range is None else str(range), filtered, fields,
+        None if confidence is None else _number("--confidence", confidence), _texts(sd),
+        _whole("--shots", shots), _whole("--seed", seed), integrator, model,
         Path(output) if output is not None else None, force, crush_law,
         Path(archive) if archive is not None else None, scheduler, workers, chunk,
         ("design",)))
@@ -289,8 +293,8 @@ def srs(shot: str | os.PathLike[str], *, q: float | str = 10.0, cfc: int | str |
         record = cfc_class(str(cfc)) if cfc is not None else None
     except ValueError as exc:
         raise OptionError(f"--cfc: {exc}") from None
-    return run(SrsRequest(Path(shot), parse_q(str(q), "--srs-q"), record, float(lo),
-                          float(hi), integrator, model,
+    return run(SrsRequest(Path(shot), parse_q(str(q), "--srs-q"), record,
+                          _number("--from", lo), _number("--to", hi), integrator, model,
                           Path(output) if output is not None else None, force, crush_law,
                           Path(archive) if archive is not None else None))
 
@@ -328,14 +332,38 @@ def compare_measured(shot: str | os.PathLike[str], recording: str | os.PathLike[
     except ValueError as exc:
         raise OptionError(f"--cfc: {exc}") from None
     return run(CompareMeasuredRequest(
-        Path(shot), os.fspath(recording), record, align, anti_alias, float(sign), time_unit,
+        Path(shot), os.fspath(recording), record, str(align), anti_alias,
+        _number("--sign", sign), time_unit,
         accel_unit, channel, integrator, model, Path(output) if output is not None else None,
         force, crush_law, Path(archive) if archive is not None else None))
 
 
-def _texts(value: str | Sequence[str]) -> tuple[str, ...]:
-    """One text or several, as a tuple."""
-    return (value,) if isinstance(value, str) else tuple(str(v) for v in value)
+def _texts(value: str | Sequence[str] | None) -> tuple[str, ...]:
+    """One text or several (None: none), as a tuple."""
+    if value is None:
+        return ()
+    if isinstance(value, str):
+        return (value,)
+    try:
+        return tuple(str(v) for v in value)
+    except TypeError:  # one value of another type: read as text, refused by the grammar
+        return (str(value),)
+
+
+def _number(option: str, value: object) -> float:
+    """A number given as a number or text (``"0.95"``); else one line naming the option."""
+    try:
+        return float(value if isinstance(value, (int, float)) else str(value))
+    except ValueError:
+        raise OptionError(f"{option}: found {value!r}, expected a number") from None
+
+
+def _whole(option: str, value: object) -> int:
+    """A whole number given as one or as text (``"64"``); else one line naming the option."""
+    number = _number(option, value)
+    if not number.is_integer():
+        raise OptionError(f"{option}: found {value!r}, expected a whole number")
+    return int(number)
 
 
 def sweep(shot: str | os.PathLike[str], vary: str | Sequence[str] = (), *,
@@ -379,7 +407,7 @@ def sweep(shot: str | os.PathLike[str], vary: str | Sequence[str] = (), *,
 
     return run(SweepRequest(
         Path(shot), _texts(vary), None if mc is None else str(mc), _texts(sd),
-        None if sobol is None else str(sobol), seed, integrator, model,
+        None if sobol is None else str(sobol), _whole("--seed", seed), integrator, model,
         Path(output) if output is not None else None, force, crush_law,
         Path(archive) if archive is not None else None, scheduler, workers, chunk))
 

@@ -40,6 +40,22 @@ PLAIN_OPTIONS = tuple((key, option) for key, option in OPTIONS.items()
                       if option not in dict(QUANTITY_OPTIONS).values()
                       and option not in ("--srs-tol", "--cfc"))
 
+#: Every text field with the option that gives it, as refusals name it.
+TEXT_OPTIONS = (*QUANTITY_OPTIONS, *PLAIN_OPTIONS, ("window", "--window"), ("srs", "--srs"),
+                ("srs_tol", "--srs-tol"), ("profile", "--profile"))
+
+
+def not_empty(option: str, value: object) -> None:
+    """An option (or keyword) given an empty text is refused: it would stand for none.
+
+    Raises
+    ------
+    airgun_xl.errors.OptionError
+    """
+    if isinstance(value, str) and not value.strip():
+        raise OptionError(f"{option}: found an empty value, expected one")
+
+
 #: What a record's filter takes, said by every refusal of it.
 CFC_EXPECTED = "a J211 class (60, 180, 600 or 1000) or none"
 
@@ -109,6 +125,8 @@ def options_spec(fields: SpecFields) -> Specification | None:
     """
     from ..readers.recording import read_spectrum
 
+    for key, option in TEXT_OPTIONS:  # as the command line refuses them, whoever gave them
+        not_empty(option, getattr(fields, key))
     parsed: dict[str, Any] = {}
     for key, option in QUANTITY_OPTIONS:
         text = getattr(fields, key)
@@ -161,6 +179,7 @@ def resolve(shot: Shot, fields: SpecFields) -> Specification | None:
     ------
     airgun_xl.errors.OptionError
     """
+    not_empty("--profile", fields.profile)
     return combine(fields.profile, shot.spec, options_spec(fields))
 
 

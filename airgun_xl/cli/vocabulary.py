@@ -113,11 +113,11 @@ class One(argparse.Action):
 
 
 def _not_empty(option, values):
-    """An option given an empty value (``--archive=``) is refused: it would stand for none."""
-    if isinstance(values, str) and not values.strip():
-        from ..errors import OptionError
+    """An option given an empty value (``--archive=``) is refused: it would stand for none
+    (:func:`airgun_xl.app.specifying.not_empty`, as the Python API refuses it)."""
+    from ..app.specifying import not_empty
 
-        raise OptionError(f"{option}: found an empty value, expected one")
+    not_empty(option, values)
 
 
 class Alias(argparse.Action):
