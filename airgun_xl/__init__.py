@@ -33,6 +33,7 @@ if TYPE_CHECKING:
     from .app.accept import AcceptOutcome
     from .app.calibrate import CalibrateOutcome
     from .app.compare_measured import CompareMeasuredOutcome
+    from .app.convergence import ConvergenceOutcome
     from .app.design import DesignOutcome
     from .app.specifying import SpecFields
     from .app.srs import SrsOutcome
@@ -338,6 +339,39 @@ def compare_measured(shot: str | os.PathLike[str], recording: str | os.PathLike[
         force, crush_law, Path(archive) if archive is not None else None))
 
 
+def convergence(shot: str | os.PathLike[str], levels: str | Sequence[str] | None = None, *,
+                integrators: str | Sequence[str] = ("legacy",), rtol: float | str = 1e-3,
+                output: str | os.PathLike[str] | None = None, force: bool = False,
+                crush_law: str = "workbook",
+                archive: str | os.PathLike[str] | None = None) -> ConvergenceOutcome:
+    """Run the shot over a ladder of time steps, as ``airgun-xl convergence`` does:
+    ``levels`` as typed (``"10us,5us,2us"`` or a list of them; None: the sheet's E2, then
+    1-2-5 steps down to 5 ns), with each of ``integrators``; ``rtol`` the tolerance on the
+    peak [-].
+
+    Returns
+    -------
+    airgun_xl.app.convergence.ConvergenceOutcome
+        ``ladders`` (each level's figures, errors, orders and run times [s], the Richardson
+        extrapolation), ``recommended`` ({integrator: time step [s]}), ``warnings``,
+        ``files``.
+
+    Raises
+    ------
+    AirgunXlError
+        Bad input, named; nothing is written.
+    """
+    from pathlib import Path
+
+    from .app.convergence import ConvergenceRequest, run
+
+    steps = None if levels is None else ",".join(_texts(levels))
+    return run(ConvergenceRequest(
+        Path(shot), steps, _texts(integrators), str(rtol),
+        Path(output) if output is not None else None, force, crush_law,
+        Path(archive) if archive is not None else None))
+
+
 def _texts(value: str | Sequence[str] | None) -> tuple[str, ...]:
     """One text or several (None: none), as a tuple."""
     if value is None:
@@ -431,6 +465,7 @@ __all__ = [
     "accept",
     "calibrate",
     "compare_measured",
+    "convergence",
     "design",
     "load",
     "srs",

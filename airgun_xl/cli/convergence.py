@@ -2,9 +2,14 @@
 import math
 from pathlib import Path
 
-from ..errors import OptionError
-from ..transaction import check_output
-from .run_options import SHOT_HELP, add_crush_law, add_force, add_integrator, add_output
+from .run_options import (
+    SHOT_HELP,
+    add_crush_law,
+    add_force,
+    add_integrator,
+    add_json,
+    add_output,
+)
 
 
 def add_parser(sub):
@@ -22,48 +27,27 @@ def add_parser(sub):
     add_output(p, "workbook; the PNG goes beside it", "SHOT.convergence.xlsx")
     add_force(p)
     add_crush_law(p)
+    add_json(p, "the ladders")
     p.set_defaults(run=run)
 
 
 def run(args):
-    from ..archive.laws import shot_with_law
-    from ..reports.convergence import write_convergence
-    from ..studies.convergence import default_ladder, ladder, parse_duration
+    from ..app.convergence import ConvergenceRequest
+    from ..app.convergence import run as convergence
     from .messages import warn
 
-    shot = shot_with_law(args.shot, args.crush_law, args.archive)
-    integrators = args.integrator
-    try:
-        rtol = float(args.rtol)
-    except ValueError:
-        rtol = math.nan
-    if not 0 < rtol < 1:
-        raise OptionError(f"--rtol: found {args.rtol!r}, expected a number between 0 and 1")
-    if args.levels:
-        deltas = [parse_duration(t) for t in args.levels.split(",") if t.strip()]
-    else:
-        deltas = default_ladder(shot.params.delta)
-    if len(deltas) < 2 and not args.levels:
-        raise OptionError(f"--levels: the sheet's time step E2 = {shot.params.delta:g} s is "
-                          "already at the finest default level (5 ns), expected --levels with "
-                          "two or more time steps, e.g. --levels 10ns,5ns,2ns")
-    if len(deltas) < 2:
-        raise OptionError(f"--levels: found {args.levels!r}, expected at least two time steps")
-    for d in deltas:
-        shot.params.replace(delta=d)  # each level is a valid shot (raises on the cell)
     shot_path = Path(args.shot)
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".convergence.xlsx")
-    png = output.with_suffix(".png")
-    check_output(output, args.force, inputs=[args.shot])
-    check_output(png, args.force, inputs=[args.shot], suffixes=(".png",))
-    warn(shot.warnings)
-    ladders = [ladder(shot, deltas, name, rtol) for name in integrators]
-    drew = write_convergence(ladders, output, args.force, shot, png)
-    warn([] if drew else ["matplotlib is not installed: no PNG (pip install "
-                          "'airgun-xl[plots]')"])
-    print_table(ladders)
-    print(f"wrote {output} and {png}" if drew else f"wrote {output}")
+    outcome = convergence(ConvergenceRequest(
+        shot_path, args.levels, tuple(args.integrator), args.rtol, output, args.force,
+        args.crush_law, Path(args.archive) if args.archive else None))
+    warn(list(outcome.warnings))
+    if args.json:
+        print(outcome.to_json())
+        return 0
+    print_table(outcome.ladders)
+    print(f"wrote {output} and {outcome.png}" if outcome.png else f"wrote {output}")
     return 0
 
 

@@ -1,0 +1,111 @@
+"""Convergence: the shot run at each time step of a ladder, each figure's error against the
+finest level (with Richardson extrapolation and the observed order), the coarsest time step
+that meets the tolerance on the peak; a workbook and a PNG of error against run time.
+
+:func:`run` takes a :class:`ConvergenceRequest` and returns a :class:`ConvergenceOutcome`;
+the CLI (``airgun-xl convergence``) and the Python API (:func:`airgun_xl.convergence`) are
+both this."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..errors import OptionError
+
+#: The warning where the PNG could not be drawn.
+NO_PNG = "matplotlib is not installed: no PNG (pip install 'airgun-xl[plots]')"
+
+
+@dataclass(frozen=True)
+class ConvergenceRequest:
+    """The ladder: ``levels`` the time steps as typed (``"5us,2us,1us"``; None: the sheet's
+    E2, then 1-2-5 steps down to 5 ns), run with each of ``integrators``; ``rtol`` the
+    tolerance on the peak [-], as typed. ``output`` None writes no workbook (the CLI gives
+    its default, ``SHOT.convergence.xlsx``, and the PNG beside it)."""
+
+    shot: Path
+    levels: str | None = None
+    integrators: tuple[str, ...] = ("legacy",)
+    rtol: str = "1e-3"
+    output: Path | None = None
+    force: bool = False
+    crush_law: str = "workbook"
+    archive: Path | None = None  # where a library law is read from
+
+
+@dataclass(frozen=True)
+class ConvergenceOutcome:
+    """Each integrator's ladder (studies.convergence.Ladder: its levels' figures, errors,
+    orders and run times, the Richardson extrapolation, the step recommended), the
+    warnings, and the files written."""
+
+    ladders: tuple[Any, ...]
+    output: Path | None
+    png: Path | None  # the figure, if drawn
+    files: tuple[Path, ...]
+    warnings: tuple[str, ...]
+
+    @property
+    def recommended(self) -> dict[str, float]:
+        """{integrator: the coarsest time step [s] whose peak is within the tolerance of the
+        finest level's} (NaN: none of the coarser levels)."""
+        return {lad.integrator: float(lad.recommended) for lad in self.ladders}
+
+    def to_json(self) -> str:
+        """The outcome as one JSON document (``convergence --json``); run times in s."""
+        from .documents import dumps
+
+        return dumps({"ladders": self.ladders, "recommended_s": self.recommended,
+                      "warnings": self.warnings, "files": self.files})
+
+
+def run(request: ConvergenceRequest) -> ConvergenceOutcome:
+    """Run the ladder ``request`` asks for.
+
+    Raises
+    ------
+    airgun_xl.errors.AirgunXlError
+        Bad input, named; nothing is written.
+    """
+    from ..archive.laws import shot_with_law
+    from ..studies.convergence import default_ladder, ladder, parse_duration
+    from ..transaction import check_output
+
+    shot = shot_with_law(request.shot, request.crush_law, request.archive)
+    try:
+        rtol = float(request.rtol)
+    except ValueError:
+        rtol = math.nan
+    if not 0 < rtol < 1:
+        raise OptionError(f"--rtol: found {request.rtol!r}, expected a number between 0 and 1")
+    if request.levels:
+        deltas = [parse_duration(t) for t in request.levels.split(",") if t.strip()]
+    else:
+        deltas = default_ladder(shot.params.delta)
+    if len(deltas) < 2 and not request.levels:
+        raise OptionError(f"--levels: the sheet's time step E2 = {shot.params.delta:g} s is "
+                          "already at the finest default level (5 ns), expected --levels with "
+                          "two or more time steps, e.g. --levels 10ns,5ns,2ns")
+    if len(deltas) < 2:
+        raise OptionError(f"--levels: found {request.levels!r}, expected at least two time "
+                          "steps")
+    for d in deltas:
+        shot.params.replace(delta=d)  # each level is a valid shot (raises on the cell)
+    png = request.output.with_suffix(".png") if request.output is not None else None
+    if request.output is not None and png is not None:
+        check_output(request.output, request.force, inputs=[request.shot])
+        check_output(png, request.force, inputs=[request.shot], suffixes=(".png",))
+    warnings = [str(w) for w in shot.warnings]
+    ladders = tuple(ladder(shot, deltas, name, rtol) for name in request.integrators)
+    files: tuple[Path, ...] = ()
+    if request.output is not None:
+        from ..reports.convergence import write_convergence
+
+        drew = write_convergence(list(ladders), request.output, request.force, shot, png)
+        if not drew:
+            warnings.append(NO_PNG)
+            png = None
+        files = tuple(p for p in (request.output, png) if p is not None)
+    return ConvergenceOutcome(ladders, request.output, png, files, tuple(warnings))
