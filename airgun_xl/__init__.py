@@ -29,13 +29,14 @@ from .version import __version__
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
+    from typing import Unpack
 
     from .app.accept import AcceptOutcome
     from .app.calibrate import CalibrateOutcome
     from .app.compare_measured import CompareMeasuredOutcome
     from .app.convergence import ConvergenceOutcome
     from .app.design import DesignOutcome
-    from .app.specifying import SpecFields
+    from .app.specifying import SpecKeywords
     from .app.srs import SrsOutcome
     from .app.sweep import SweepOutcome
     from .params import ShotParams
@@ -64,42 +65,19 @@ def load(path: str | os.PathLike[str]) -> Shot:
     return Shot.from_workbook(path)
 
 
-def _spec_fields(cfc: int | str | None = None, **given: object) -> SpecFields:
-    """The specification fields a function's keywords give, as text in the grammar (a path
-    as its text); ``cfc`` a J211 class or ``"none"``."""
-    from .app.specifying import SpecFields, cfc_class
-
-    record = None
-    if cfc is not None:
-        try:
-            record = cfc_class(str(cfc))
-        except ValueError as exc:
-            raise OptionError(f"--cfc: {exc}") from None
-    text = {key: None if value is None else os.fspath(value) if isinstance(
-        value, os.PathLike) else str(value) for key, value in given.items()}
-    return SpecFields(**text, cfc=record, cfc_given="--cfc" if cfc is not None else None)
-
-
 def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
-           peak: str | None = None, duration: str | None = None,
-           velocity_change: str | None = None, shape: str | None = None,
-           corridor: str | None = None, time_slack: str | None = None,
-           dv_window: str | None = None, monitor: str | None = None,
-           duration_def: str | None = None, decay: str | None = None,
-           placement: str | None = None, srs: str | os.PathLike[str] | None = None,
-           srs_tol: str | None = None, srs_q: str | None = None,
-           srs_outside: str | None = None, profile: str | os.PathLike[str] | None = None,
-           cfc: int | str | None = None, output: str | os.PathLike[str] | None = None,
-           force: bool = False, archive: str | os.PathLike[str] | None = None,
-           channel: str | None = None, sign: float = 1.0, time_unit: str | None = None,
-           accel_unit: str | None = None, crush_law: str = "workbook") -> AcceptOutcome:
+           output: str | os.PathLike[str] | None = None, force: bool = False,
+           archive: str | os.PathLike[str] | None = None, channel: str | None = None,
+           sign: float = 1.0, time_unit: str | None = None, accel_unit: str | None = None,
+           crush_law: str = "workbook", **spec: Unpack[SpecKeywords]) -> AcceptOutcome:
     """Judge a recording against the shot's specification, as ``airgun-xl accept`` does.
 
     The specification is the ``profile``'s, then the shot's Specification sheet's, then
     the fields given here, each overriding the one before field by field; every field is
-    text in the command's grammar (``peak="12kG:10%"``, ``duration="5ms:10%"``), and a
-    refusal names the option the keyword stands for (``--peak``). ``cfc`` is the record
-    judged: a SAE J211 class (60, 180, 600, 1000) or ``"none"``.
+    text in the command's grammar (``peak="12kG:10%"``, ``duration="5ms:10%"``; the fields:
+    :class:`airgun_xl.app.specifying.SpecKeywords`), and a refusal names the option the
+    keyword stands for (``--peak``). ``cfc`` is the record judged: a SAE J211 class (60,
+    180, 600, 1000) or ``"none"``.
 
     Parameters
     ----------
@@ -131,13 +109,9 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
     from pathlib import Path
 
     from .app.accept import AcceptRequest, run
+    from .app.specifying import keyword_fields
 
-    fields = _spec_fields(
-        profile=profile, shape=shape, peak=peak, duration=duration,
-        velocity_change=velocity_change, corridor=corridor, time_slack=time_slack,
-        dv_window=dv_window, monitor=monitor, duration_def=duration_def, decay=decay,
-        placement=placement, srs=srs, srs_tol=srs_tol, srs_q=srs_q, srs_outside=srs_outside,
-        cfc=cfc, accel_unit=accel_unit)
+    fields = keyword_fields("accept", dict(spec), accel_unit)
     return run(AcceptRequest(
         Path(shot), os.fspath(recording), fields, Path(output) if output is not None else None,
         force, Path(archive) if archive is not None else None, channel,
@@ -199,25 +173,17 @@ def design(shot: str | os.PathLike[str], *, target_peak: str | None = None,
            target_srs: str | os.PathLike[str] | None = None, vary: str | Sequence[str] = (),
            range: str | None = None, filtered: bool = False,
            confidence: float | None = None, sd: str | Sequence[str] = (),
-           shots: int = 10_000, seed: int = 1,
-           peak: str | None = None, duration: str | None = None,
-           velocity_change: str | None = None, shape: str | None = None,
-           corridor: str | None = None, time_slack: str | None = None,
-           dv_window: str | None = None, monitor: str | None = None,
-           duration_def: str | None = None, decay: str | None = None,
-           placement: str | None = None, srs: str | os.PathLike[str] | None = None,
-           srs_tol: str | None = None, srs_q: str | None = None,
-           srs_outside: str | None = None, profile: str | os.PathLike[str] | None = None,
-           cfc: int | str | None = None, accel_unit: str | None = None,
+           shots: int = 10_000, seed: int = 1, accel_unit: str | None = None,
            integrator: str = "legacy", model: str = "4-mass",
            output: str | os.PathLike[str] | None = None, force: bool = False,
            crush_law: str = "workbook", archive: str | os.PathLike[str] | None = None,
            scheduler: str | None = None, workers: int | None = None,
-           chunk: int | None = None) -> DesignOutcome:
+           chunk: int | None = None, **spec: Unpack[SpecKeywords]) -> DesignOutcome:
     """Design a shot, as ``airgun-xl design`` does: to ``target_peak`` (with
     ``target_duration``, two cells in ``vary``) or ``target_srs``; without a target, to the
     middle of the specification (the profile's, the shot's sheet's, then the fields given
-    here, as :func:`accept` takes them); with ``confidence`` and the scatter ``sd``
+    here, as :func:`accept` takes them, and ``srs_q`` a target SRS's Q); with
+    ``confidence`` and the scatter ``sd``
     (``"A28=1.5%"``), the setting most likely to pass on the first shot.
 
     Parameters
@@ -245,13 +211,9 @@ def design(shot: str | os.PathLike[str], *, target_peak: str | None = None,
     from pathlib import Path
 
     from .app.design import DesignRequest, run
+    from .app.specifying import keyword_fields
 
-    fields = _spec_fields(
-        profile=profile, shape=shape, peak=peak, duration=duration,
-        velocity_change=velocity_change, corridor=corridor, time_slack=time_slack,
-        dv_window=dv_window, monitor=monitor, duration_def=duration_def, decay=decay,
-        placement=placement, srs=srs, srs_tol=srs_tol, srs_q=srs_q, srs_outside=srs_outside,
-        cfc=cfc, accel_unit=accel_unit)
+    fields = keyword_fields("design", dict(spec), accel_unit)
     return run(DesignRequest(
         Path(shot), None if target_peak is None else str(target_peak),
         None if target_duration is None else str(target_duration),

@@ -15,7 +15,7 @@ from conftest import TEMPLATE
 
 import airgun_xl
 from airgun_xl.app.accept import AcceptRequest, run
-from airgun_xl.app.specifying import PLAIN_OPTIONS, QUANTITY_OPTIONS, SpecFields
+from airgun_xl.app.specifying import PLAIN_OPTIONS, QUANTITY_OPTIONS, SpecFields, SpecKeywords
 from airgun_xl.cli import main
 from airgun_xl.errors import OptionError
 from airgun_xl.specification import OPTIONS
@@ -115,18 +115,27 @@ def test_bad_keywords_are_refused_naming_the_option_and_write_nothing(tmp_path, 
 
 
 def test_the_keywords_are_the_specifications_fields():
-    """One declaration: the API's keywords, the request's fields and the grammar's table
-    (specification.OPTIONS) name the same fields; a field added to the table and not here
-    fails."""
+    """One declaration: the API's keywords (SpecKeywords, which accept and design take),
+    the request's fields and the grammar's table (specification.OPTIONS) name the same
+    fields; a field added to the table and not here fails."""
     table = {key for key, _ in QUANTITY_OPTIONS + PLAIN_OPTIONS} | {"srs", "srs_tol", "profile",
                                                                    "cfc"}
     assert {o for k, o in OPTIONS.items()} == {
         "--" + k.replace("_", "-") for k in table - {"srs", "profile", "cfc"}} | {"--cfc"}
     fields = {f.name for f in dataclasses.fields(SpecFields)}
     assert table <= fields and fields - table == {"window", "cfc_given", "accel_unit"}
-    keywords = {name for name, p in inspect.signature(airgun_xl.accept).parameters.items()
-                if p.kind is p.KEYWORD_ONLY}
-    assert table <= keywords
+    assert set(SpecKeywords.__annotations__) == table
+    for function in (airgun_xl.accept, airgun_xl.design):
+        assert str(inspect.signature(function).parameters["spec"]).startswith("**spec")
+
+
+def test_a_keyword_that_is_not_a_field_is_refused_with_the_nearest(recording):
+    with pytest.raises(OptionError, match=r"^accept: found the keyword 'peek', expected a "
+                                          r"field of the specification \(did you mean peak\?\)$"):
+        airgun_xl.accept(TEMPLATE, recording, peek="40g:10%")
+    with pytest.raises(OptionError, match="design: found the keyword 'colour', expected a "
+                                          "field of the specification .profile, shape, peak"):
+        airgun_xl.design(TEMPLATE, colour="red")
 
 
 def test_importing_the_package_stays_light():

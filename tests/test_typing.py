@@ -27,3 +27,21 @@ def test_mypy_catches_a_wrong_call(tmp_path):
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 1 and 'Argument 1 to "load" has incompatible type "int"' in \
         done.stdout, done.stdout
+
+
+def test_mypy_checks_the_commands_keywords(tmp_path):
+    """Issue 44: the functions' keywords are typed, the specification's fields too (one
+    TypedDict, SpecKeywords): a number for a field given as text, or a misspelt field, is
+    an error before the script runs."""
+    script = tmp_path / "use.py"
+    script.write_text("import airgun_xl\n"
+                      "v = airgun_xl.accept('s.xlsx', 'r.csv', peak=12)\n"
+                      "d = airgun_xl.design('s.xlsx', peek='12kG:10%')\n"
+                      "ok: bool = airgun_xl.accept('s.xlsx', 'r.csv', peak='12kG').passed\n")
+    done = subprocess.run([sys.executable, "-m", "mypy", "--follow-imports=silent",
+                           "--ignore-missing-imports", str(script)], cwd=ROOT,
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 1, done.stdout
+    assert 'Argument "peak" to "accept" has incompatible type "int"' in done.stdout
+    assert 'Unexpected keyword argument "peek" for "design"' in done.stdout
+    assert done.stdout.count("error:") == 2, done.stdout

@@ -8,8 +8,10 @@ A field given overrides the sheet's and the profile's even when it equals the de
 from __future__ import annotations
 
 import dataclasses
+import difflib
+import os
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 from ..errors import OptionError
 from ..specification import (
@@ -113,6 +115,60 @@ class SpecFields:
         missing ones not given."""
         return cls(**{f.name: getattr(source, f.name, None)
                       for f in dataclasses.fields(cls)})
+
+
+class SpecKeywords(TypedDict, total=False):
+    """The specification's fields as the Python API's keywords (:func:`airgun_xl.accept`,
+    :func:`airgun_xl.design`): the options' names, each text in the grammar
+    (``peak="12kG:10%"``), a file's as its path; ``cfc`` a J211 class or ``"none"``."""
+
+    profile: str | os.PathLike[str]
+    shape: str
+    peak: str
+    duration: str
+    velocity_change: str
+    corridor: str
+    time_slack: str
+    dv_window: str
+    monitor: str
+    duration_def: str
+    decay: str
+    placement: str
+    srs: str | os.PathLike[str]
+    srs_tol: str
+    srs_q: str
+    srs_outside: str
+    cfc: int | str
+
+
+def keyword_fields(command: str, given: dict[str, Any],
+                   accel_unit: str | None = None) -> SpecFields:
+    """The :class:`SpecFields` a function's keywords give; a keyword that is not a field is
+    refused naming the nearest (``accept: found the keyword 'peek', expected a field of the
+    specification (did you mean peak?)``).
+
+    Raises
+    ------
+    airgun_xl.errors.OptionError
+    """
+    known = tuple(SpecKeywords.__annotations__)
+    for key in given:
+        if key not in known:
+            near = difflib.get_close_matches(key, known, 1, 0.75)
+            raise OptionError(f"{command}: found the keyword {key!r}, expected a field of the "
+                              "specification" + (f" (did you mean {near[0]}?)" if near else
+                                                 f" ({', '.join(known)})"))
+    cfc = given.get("cfc")
+    record = None
+    if cfc is not None:
+        try:
+            record = cfc_class(str(cfc))
+        except ValueError as exc:
+            raise OptionError(f"--cfc: {exc}") from None
+    text = {key: None if value is None else os.fspath(value) if isinstance(
+        value, os.PathLike) else str(value) for key, value in given.items() if key != "cfc"}
+    return SpecFields(**text, cfc=record, cfc_given="--cfc" if cfc is not None else None,
+                      accel_unit=accel_unit)
 
 
 def options_spec(fields: SpecFields) -> Specification | None:
