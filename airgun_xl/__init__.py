@@ -149,16 +149,13 @@ def calibrate(*files: str | os.PathLike[str], law: bool = False,
     from pathlib import Path
 
     from .app.calibrate import CalibrateRequest, run
-    from .app.specifying import cfc_class
+    from .app.specifying import record_filter
 
     texts = [os.fspath(f) for f in files]
     if len(texts) % 2:
         raise OptionError(f"calibrate: found {len(texts)} files, expected pairs of "
                           "SHOT.xlsx RECORDING")
-    try:
-        record = cfc_class(str(cfc)) if cfc is not None else None
-    except ValueError as exc:
-        raise OptionError(f"--cfc: {exc}") from None
+    record = record_filter(cfc)
     names = fit if fit is None or isinstance(fit, str) else ",".join(fit)
     return run(CalibrateRequest(
         tuple(zip(texts[::2], texts[1::2], strict=True)), law, names, objective,
@@ -248,14 +245,11 @@ def srs(shot: str | os.PathLike[str], *, q: float | str = 10.0, cfc: int | str |
     """
     from pathlib import Path
 
-    from .app.specifying import cfc_class
+    from .app.specifying import record_filter
     from .app.srs import SrsRequest, run
     from .specification import parse_q
 
-    try:
-        record = cfc_class(str(cfc)) if cfc is not None else None
-    except ValueError as exc:
-        raise OptionError(f"--cfc: {exc}") from None
+    record = record_filter(cfc)
     return run(SrsRequest(Path(shot), parse_q(str(q), "--srs-q"), record,
                           _number("--from", lo), _number("--to", hi), integrator, model,
                           Path(output) if output is not None else None, force, crush_law,
@@ -288,12 +282,9 @@ def compare_measured(shot: str | os.PathLike[str], recording: str | os.PathLike[
     from pathlib import Path
 
     from .app.compare_measured import CompareMeasuredRequest, run
-    from .app.specifying import cfc_class
+    from .app.specifying import record_filter
 
-    try:
-        record = cfc_class(str(cfc)) if cfc is not None else None
-    except ValueError as exc:
-        raise OptionError(f"--cfc: {exc}") from None
+    record = record_filter(cfc)
     return run(CompareMeasuredRequest(
         Path(shot), os.fspath(recording), record, str(align), anti_alias,
         _number("--sign", sign), time_unit,

@@ -81,6 +81,22 @@ def cfc_class(text: str) -> int | None:
     return value
 
 
+def record_filter(cfc: object) -> int | None:
+    """``cfc`` as a keyword gives it (a class, ``"600"``, ``"none"``; None: not given), as
+    :func:`cfc_class` reads it; refused naming ``--cfc``.
+
+    Raises
+    ------
+    airgun_xl.errors.OptionError
+    """
+    if cfc is None:
+        return None
+    try:
+        return cfc_class(str(cfc))
+    except ValueError as exc:
+        raise OptionError(f"--cfc: {exc}") from None
+
+
 @dataclass(frozen=True)
 class SpecFields:
     """The specification fields given, as text (None: not given). The names are the
@@ -159,12 +175,7 @@ def keyword_fields(command: str, given: dict[str, Any],
                               "specification" + (f" (did you mean {near[0]}?)" if near else
                                                  f" ({', '.join(known)})"))
     cfc = given.get("cfc")
-    record = None
-    if cfc is not None:
-        try:
-            record = cfc_class(str(cfc))
-        except ValueError as exc:
-            raise OptionError(f"--cfc: {exc}") from None
+    record = record_filter(cfc)
     text = {key: None if value is None else os.fspath(value) if isinstance(
         value, os.PathLike) else str(value) for key, value in given.items() if key != "cfc"}
     return SpecFields(**text, cfc=record, cfc_given="--cfc" if cfc is not None else None,
