@@ -33,9 +33,11 @@ if TYPE_CHECKING:
 
     from .app.accept import AcceptOutcome
     from .app.calibrate import CalibrateOutcome
+    from .app.check import CheckOutcome
     from .app.compare_measured import CompareMeasuredOutcome
     from .app.convergence import ConvergenceOutcome
     from .app.design import DesignOutcome
+    from .app.diff import DiffOutcome
     from .app.specifying import SpecKeywords
     from .app.srs import SrsOutcome
     from .app.sweep import SweepOutcome
@@ -325,6 +327,55 @@ def convergence(shot: str | os.PathLike[str], levels: str | Sequence[str] | None
         Path(archive) if archive is not None else None))
 
 
+def check(shot: str | os.PathLike[str], *, integrator: str = "legacy") -> CheckOutcome:
+    """Can this shot's run be trusted, as ``airgun-xl check`` says: the scheme's critical
+    time step (``critical.dt_crit`` [s], ``critical.ratio``, ``stable``) and what the shot
+    stretches (``findings``, ``warnings``). No run, nothing written.
+
+    Raises
+    ------
+    AirgunXlError
+        A bad workbook or cell, named.
+    """
+    from pathlib import Path
+
+    from .app.check import CheckRequest, run
+
+    return run(CheckRequest(Path(shot), integrator))
+
+
+def diff(legacy: str | os.PathLike[str], new: str | os.PathLike[str], *,
+         rtol: float = 1e-12, atol: float = 0.0,
+         report: str | os.PathLike[str] | None = None, force: bool = False) -> DiffOutcome:
+    """Compare a workbook the macro filled with one airgun-xl filled, as ``airgun-xl diff``
+    does: the parameter cells, then every result column, each within ``rtol`` of the
+    column's largest magnitude (or ``atol``); ``report`` also writes the error table and the
+    worst column's curves.
+
+    Returns
+    -------
+    airgun_xl.app.diff.DiffOutcome
+        ``same``, ``report`` (each column's largest difference), ``files``.
+
+    Raises
+    ------
+    AirgunXlError
+        A file that cannot be read, named.
+    """
+    from .app.diff import run
+
+    return run(os.fspath(legacy), os.fspath(new), _number("--rtol", rtol),
+               _number("--atol", atol), None if report is None else os.fspath(report), force)
+
+
+def template(output: str | os.PathLike[str], *, force: bool = False) -> os.PathLike[str]:
+    """Write a fresh shot A workbook in the report's layout, as ``airgun-xl template``
+    does; the path written."""
+    from .app.template import run
+
+    return run(os.fspath(output), force)
+
+
 def _texts(value: str | Sequence[str] | None) -> tuple[str, ...]:
     """One text or several (None: none), as a tuple."""
     if value is None:
@@ -417,10 +468,13 @@ __all__ = [
     "__version__",
     "accept",
     "calibrate",
+    "check",
     "compare_measured",
     "convergence",
     "design",
+    "diff",
     "load",
     "srs",
     "sweep",
+    "template",
 ]

@@ -32,7 +32,7 @@ def _median(fn, repeat):
 
 def bench_reading(repeat, tmp):
     import airgun_xl
-    from airgun_xl.diff import read_results
+    from airgun_xl.app.diff import read_results
     from airgun_xl.outputs import Outputs
     from airgun_xl.readers import guard
 

@@ -3,7 +3,8 @@
 a request and prints the outcome; the Python API (:mod:`airgun_xl`) builds the same request
 from keyword arguments.
 
-Moved here so far: ``accept``, ``calibrate``, ``compare_measured``, ``convergence``,
-``design``, ``srs`` and ``sweep``; the specification fields every judging command takes
-(:mod:`.specifying`), where a study's shots run (:mod:`.running`), outcomes as JSON
-(:mod:`.documents`). The other commands are still composed in ``airgun_xl.cli``."""
+Moved here so far: ``accept``, ``calibrate``, ``check``, ``compare_measured``,
+``convergence``, ``design``, ``diff``, ``srs``, ``sweep`` and ``template``; the
+specification fields every judging command takes (:mod:`.specifying`), where a study's shots
+run (:mod:`.running`), outcomes as JSON (:mod:`.documents`). Fill (``pipeline``,
+``campaign``) and the archive's commands are still composed in ``airgun_xl.cli``."""

@@ -100,6 +100,26 @@ class AcceptOutcome:
         return json.dumps(document, indent=1, allow_nan=False)
 
 
+def verdict_lines(verdict: Verdict, what: str) -> list[str]:
+    """The verdict as the command says it: its word (and how many warnings), a line a
+    criterion with the tolerances used, the definitions, a profile's notes. What files gave
+    (a profile's notes, names) is made printable text, never control codes."""
+    from ..studies.acceptance import limits_text
+    from ..untrusted_json import printable
+
+    n = len(verdict.warnings)
+    lines = [f"{verdict.word}: {what}" + (
+        f" (with {n} warning{'s' * (n != 1)}: read them before relying on it)" if n else "")]
+    for c in verdict.criteria:
+        margin = f"{c.margin:+.2f} {c.margin_unit}"
+        lines.append(f"  {'PASS' if c.passed else 'FAIL'}  {c.name}: {c.value:.5g} {c.unit} "
+                     f"(limits {limits_text(c)}; margin {margin})"
+                     + (f"; {c.detail}" if c.detail else ""))
+    lines += [f"  {line}" for line in verdict.definitions]
+    lines += [f"  note: {line}" for line in verdict.spec.notes]  # a profile's caveats
+    return [printable(line) for line in lines]
+
+
 def run(request: AcceptRequest) -> AcceptOutcome:
     """Judge ``request.recording`` against the shot's specification.
 

@@ -56,6 +56,13 @@ class CalibrateOutcome:
     files: tuple[Path, ...]
 
     @property
+    def archive_shown(self) -> str | None:
+        """The archive as messages show it (relative to the working folder where inside)."""
+        from ..transaction import display
+
+        return None if self.archive is None else str(display(self.archive))
+
+    @property
     def trusted(self) -> bool:
         """Every fitted value identified and within its bounds, every residual improved."""
         return not self.calibration.warnings

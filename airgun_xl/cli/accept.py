@@ -72,22 +72,8 @@ def run(args):
 
 
 def print_verdict(verdict, what):
-    """The verdict, a line a criterion, with the tolerances used; what files gave (a
-    profile's notes, names) reaches the terminal as text, never as control codes."""
-    from ..untrusted_json import printable
+    """The verdict, a line a criterion (:func:`airgun_xl.app.accept.verdict_lines`)."""
+    from ..app.accept import verdict_lines
 
-    n = len(verdict.warnings)
-    print(printable(f"{verdict.word}: {what}" + (
-        f" (with {n} warning{'s' * (n != 1)}: read them before relying on it)" if n else "")))
-    from ..studies.acceptance import limits_text
-
-    for c in verdict.criteria:
-        limits = limits_text(c)
-        margin = f"{c.margin:+.2f} {c.margin_unit}"
-        print(printable(f"  {'PASS' if c.passed else 'FAIL'}  {c.name}: {c.value:.5g} "
-                        f"{c.unit} (limits {limits}; margin {margin})"
-                        + (f"; {c.detail}" if c.detail else "")))
-    for line in verdict.definitions:
-        print(printable(f"  {line}"))
-    for line in verdict.spec.notes:  # a profile's caveats, with every verdict judged by it
-        print(printable(f"  note: {line}"))
+    for line in verdict_lines(verdict, what):
+        print(line)

@@ -336,7 +336,7 @@ def run_compare(args):
     pb = {p["cell"]: p for p in b.load("params.json")}
     differing = [(c, pa[c]["label"], pa[c]["value"], pb[c]["value"]) for c in pa
                  if pa[c]["value"] != pb[c]["value"]]
-    from ..diff import diff_histories, format_report
+    from ..app.diff import diff_histories, format_report
 
     report = diff_histories(a.ref, _history(a), b.ref, _history(b), rtol, atol)
     report.inputs = differing  # the entries' parameter cells, compared above

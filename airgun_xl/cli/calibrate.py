@@ -107,9 +107,7 @@ def run(args):
     print("  verdict: every fitted value identified, within its bounds, and every shot's "
           "residual improved")
     if outcome.stored is not None:
-        from ..transaction import display
-
-        root = display(outcome.archive)
+        root = outcome.archive_shown
         print(f"  stored the law as {outcome.stored} in {root} (fill --crush-law {args.name} "
               f"--archive {root})")
     return 0

@@ -14,26 +14,26 @@ def add_parser(sub):
 
 
 def run(args):
-    from ..engine.stability import compacted_length, full_length
-    from ..shot import Shot
-    from ..studies.check import before_run
+    from pathlib import Path
 
-    shot = Shot.from_workbook(args.shot)
-    p = shot.params
-    crit, findings = before_run(p, args.integrator)
+    from ..app.check import CheckRequest
+    from ..app.check import run as check
+
+    outcome = check(CheckRequest(Path(args.shot), args.integrator))
+    p, crit = outcome.params, outcome.critical
     print(f"{args.shot}: {p.model}, {args.integrator} integrator")
     print(f"  time step E2 = {p.delta:.4g} s, critical {crit.dt_crit:.4g} s for the OBR chain "
           f"(the springs that always act), ratio {crit.ratio:.3g}: {crit.verdict}")
     print(f"  set by {crit.limiting}")
     print(f"  while the mitigator unloads: critical {crit.dt_unloading:.4g} s at full length "
-          f"{full_length(p):.4g} m, {crit.dt_compacted:.4g} s fully compacted (length "
-          f"{compacted_length(p):.4g} m, E37 = {p.ec:g})")
+          f"{outcome.full_length:.4g} m, {crit.dt_compacted:.4g} s fully compacted (length "
+          f"{outcome.compacted_length:.4g} m, E37 = {p.ec:g})")
     if crit.unstable_crush is not None:
         print(f"  unstable while unloading once crushed by {crit.unstable_crush:.4g} m (length "
               f"below {crit.unstable_length:.4g} m): the run is watched and stops where it "
               "diverges")
-    for message in shot.warnings:
+    for message in outcome.warnings:
         print(f"  warning: {message}")
-    for f in findings:
+    for f in outcome.findings:
         print(f"  {f.level}: {f}")
-    return 2 if crit.ratio > 1 else 0
+    return 0 if outcome.stable else 2

@@ -3,7 +3,7 @@ import json
 
 from .run_options import ATOL_HELP, RTOL_HELP, add_force, tolerance
 
-DEFAULT_RTOL = 1e-12  # as airgun_xl.diff.DEFAULT_RTOL; the module loads only for a diff
+DEFAULT_RTOL = 1e-12  # as airgun_xl.app.diff.DEFAULT_RTOL; the module loads only for a diff
 
 
 def add_parser(sub):
@@ -24,16 +24,19 @@ def add_parser(sub):
 
 
 def run(args):
-    from ..diff import diff_workbooks, format_report
-    from ..reports.diff_report import write_diff_report
+    from ..app.diff import format_report
+    from ..app.diff import run as diff
 
     rtol, atol = tolerance("--rtol", args.rtol), tolerance("--atol", args.atol)
-    if args.report:
-        from ..transaction import check_output
+    if args.report:  # refused before the comparison, not after its text is printed
+        from ..app.diff import check_report
 
-        check_output(args.report, args.force, inputs=[args.legacy, args.new])
-    report = diff_workbooks(args.legacy, args.new, rtol, atol)
+        check_report(args.report, args.force, [args.legacy, args.new])
+    outcome = diff(args.legacy, args.new, rtol, atol)
+    report = outcome.report
     print(json.dumps(report.as_dict(), indent=1) if args.json else format_report(report))
     if args.report:
-        write_diff_report(report, args.report, args.force)
+        from ..app.diff import write_report
+
+        write_report(report, args.report, args.force)
     return 0 if report.same else 1

@@ -12,8 +12,8 @@ def add_parser(sub):
 
 
 def run(args):
-    from ..reports.template import write_template
+    from ..app.template import run as template
 
-    write_template(args.output, force=args.force)
+    template(args.output, args.force)
     print(f"wrote {args.output}")
     return 0

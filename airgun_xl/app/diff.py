@@ -5,16 +5,19 @@ matched by the macro's position and header; rows by time. A column is compared w
 files hold numbers in it: the legacy macro writes only the header of column O, so O is "only
 in new" rather than a column of differences.
 """
+from __future__ import annotations
+
 import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from . import limits
-from .cells import CELLS
-from .errors import WorkbookError
-from .readers import guard
+from .. import limits
+from ..cells import CELLS
+from ..errors import WorkbookError
+from ..readers import guard
 
 #: Default tolerance: Calc and Excel keep 15 significant digits.
 DEFAULT_RTOL = 1e-12
@@ -22,7 +25,7 @@ DEFAULT_RTOL = 1e-12
 FIRST_RESULT_COL = 7  # column H, 0-based
 
 
-def _letter(col):
+def _letter(col: Any) -> str:
     from xlsxwriter.utility import xl_col_to_name
 
     return xl_col_to_name(col)
@@ -40,13 +43,13 @@ class ResultSheet:
     finals: tuple  # (final M1, final m31) below column I, NaN when absent
 
 
-def _number(v):
+def _number(v: object) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         return math.nan
     return float(v)
 
 
-def _first_sheet(path):
+def _first_sheet(path: str | Path) -> Any:
     """The first sheet's values as a float grid, its text cells, and the raw bytes; every cap
     of :mod:`airgun_xl.readers.guard` is checked before python-calamine runs."""
     import io
@@ -82,7 +85,7 @@ def _first_sheet(path):
     return grid, text, data
 
 
-def read_results(path):
+def read_results(path: str | Path) -> ResultSheet:
     """Read a filled workbook.
 
     Raises
@@ -95,7 +98,7 @@ def read_results(path):
     grid, text, data = _first_sheet(path)
     height, width = grid.shape
 
-    def cell(r, c):
+    def cell(r: int, c: int) -> Any:
         if r >= height or c >= width:
             return ""
         v = grid[r, c]
@@ -134,7 +137,7 @@ def read_results(path):
     return ResultSheet(path, params, headers, columns, column[:n].copy(), finals)
 
 
-def _error_cells(data, addresses):
+def _error_cells(data: bytes, addresses: Any) -> dict[str, str]:
     """calamine reads an error cell as blank; openpyxl keeps its text (#DIV/0!, ...)."""
     import io
 
@@ -189,24 +192,24 @@ class DiffReport:
     worst: tuple | None = None
 
     @property
-    def same(self):
+    def same(self) -> bool:
         return (not self.inputs and self.rows[0] == self.rows[1]
                 and all(c.outside == 0 for c in self.columns))
 
-    def as_dict(self):
+    def as_dict(self) -> dict[str, Any]:
         out = asdict(self)
         out.pop("worst", None)  # arrays, for the report workbook only
         out["same"] = self.same
         return out
 
 
-def _same_param(a, b):
+def _same_param(a: object, b: object) -> bool:
     if isinstance(a, (int, float)) and isinstance(b, (int, float)):
         return a == b or abs(a - b) <= 1e-12 * max(abs(a), abs(b))
     return a == b
 
 
-def _align(a, b):
+def _align(a: Any, b: Any) -> tuple[np.ndarray, np.ndarray]:
     """Indices into a and b of rows with equal time (the grids may differ in length)."""
     if len(a.time) == len(b.time) and np.allclose(a.time, b.time, rtol=0,
                                                   atol=1e-9 * np.ptp(a.time) + 1e-300):
@@ -220,7 +223,8 @@ def _align(a, b):
     return np.flatnonzero(ok), best[ok]
 
 
-def _compare(col, header, x, y, times, rtol, atol):
+def _compare(col: Any, header: str, x: np.ndarray, y: np.ndarray, times: Any,
+             rtol: float, atol: float) -> ColumnDiff:
     """Column diff of aligned arrays x (legacy) and y (new)."""
     scale = float(np.nanmax(np.abs(x))) if np.isfinite(x).any() else 0.0
     both = np.isfinite(x) & np.isfinite(y)
@@ -240,7 +244,8 @@ def _compare(col, header, x, y, times, rtol, atol):
                       int(bad.sum()), first)
 
 
-def diff_workbooks(legacy_path, new_path, rtol=DEFAULT_RTOL, atol=0.0):
+def diff_workbooks(legacy_path: str | Path, new_path: str | Path, rtol: float = DEFAULT_RTOL,
+                   atol: float = 0.0) -> DiffReport:
     """Compare two filled workbooks; see the module docstring: the parameter cells
     (:func:`_differing_inputs`), the result columns by time (:func:`_compare_columns`), the
     final masses (:func:`_compare_finals`), and the column furthest apart
@@ -263,20 +268,22 @@ def diff_workbooks(legacy_path, new_path, rtol=DEFAULT_RTOL, atol=0.0):
                       notes, worst=_worst_column(a, b, ia, ib))
 
 
-def _differing_inputs(a, b):
+def _differing_inputs(a: ResultSheet, b: ResultSheet) -> list[Any]:
     """(cell, label, legacy, new) of the parameter cells that differ."""
     labels = {c.address: c.label for c in CELLS}
     return [(addr, labels[addr], a.params[addr], b.params[addr]) for addr in a.params
             if not _same_param(a.params[addr], b.params[addr])]
 
 
-def _compare_columns(a, b, ia, ib, rtol, atol):
+def _compare_columns(a: ResultSheet, b: ResultSheet, ia: np.ndarray, ib: np.ndarray,
+                     rtol: float, atol: float) -> Any:
     """Each result column both sheets fill under one header, compared on the shared times
     (AB by row: its rows may run past the time grid); and the columns only one side fills
     (or fills under another header)."""
     columns, only_legacy, only_new = [], [], []
     for col in sorted(set(a.data) | set(b.data)):
-        xa, xb = a.data.get(col), b.data.get(col)
+        xa: Any = a.data.get(col)
+        xb: Any = b.data.get(col)
         ha, hb = a.headers.get(col, ""), b.headers.get(col, "")
         has_a = xa is not None and np.isfinite(xa).any()
         has_b = xb is not None and np.isfinite(xb).any()
@@ -299,7 +306,7 @@ def _compare_columns(a, b, ia, ib, rtol, atol):
     return columns, only_legacy, only_new
 
 
-def _compare_finals(a, b, rtol, atol):
+def _compare_finals(a: ResultSheet, b: ResultSheet, rtol: float, atol: float) -> Any:
     """The final masses below column I, each compared as a one-row column."""
     out = []
     for k, label in enumerate(("Final M1", "Final m31")):
@@ -313,7 +320,7 @@ def _compare_finals(a, b, rtol, atol):
     return out
 
 
-def _worst_column(a, b, ia, ib):
+def _worst_column(a: ResultSheet, b: ResultSheet, ia: np.ndarray, ib: np.ndarray) -> Any:
     """(name, time, legacy, new) of the column whose largest difference is the largest
     fraction of its magnitude (AB and empty columns aside); None when there is none."""
     worst = None
@@ -329,7 +336,9 @@ def _worst_column(a, b, ia, ib):
     return worst[1:] if worst else None
 
 
-def diff_histories(name_a, a, name_b, b, rtol=DEFAULT_RTOL, atol=0.0):
+def diff_histories(name_a: str, a: dict[str, np.ndarray], name_b: str,
+                   b: dict[str, np.ndarray], rtol: float = DEFAULT_RTOL,
+                   atol: float = 0.0) -> DiffReport:
     """Compare two full time histories (``{column: array}`` with a ``time`` column), as
     :func:`diff_workbooks` compares sheet columns; for archived runs."""
     ta, tb = np.asarray(a["time"]), np.asarray(b["time"])
@@ -348,7 +357,7 @@ def diff_histories(name_a, a, name_b, b, rtol=DEFAULT_RTOL, atol=0.0):
                       atol, labels=(name_a, name_b), inputs_compared=False)
 
 
-def format_report(report):
+def format_report(report: DiffReport) -> str:
     """The report as a readable table."""
     if report.labels == ("LEGACY", "NEW"):
         lines = [f"LEGACY {report.legacy} ({report.rows[0]:,} rows)",
@@ -382,3 +391,52 @@ def format_report(report):
     lines.append(f"{verdict} (rtol {report.rtol:g} of each column's largest magnitude, "
                  f"atol {report.atol:g})")
     return "\n".join(lines)
+
+
+@dataclass(frozen=True)
+class DiffOutcome:
+    """The comparison (:class:`DiffReport`: the parameter cells, every column, the worst), and
+    the files written."""
+
+    report: DiffReport
+    files: tuple[Path, ...]
+
+    @property
+    def same(self) -> bool:
+        """Every column within tolerance (the CLI's exit 0; 1 otherwise)."""
+        return bool(self.report.same)
+
+
+def run(legacy: str | Path, new: str | Path, rtol: float = DEFAULT_RTOL, atol: float = 0.0,
+        report: str | Path | None = None, force: bool = False) -> DiffOutcome:
+    """Compare a legacy workbook with a new one; with ``report``, also write the error table
+    and the worst column's curves there.
+
+    Raises
+    ------
+    airgun_xl.errors.AirgunXlError
+        A file that cannot be read, or a report that exists (without ``force``).
+    """
+    if report is not None:
+        check_report(report, force, [legacy, new])
+    found = diff_workbooks(legacy, new, rtol, atol)
+    files: tuple[Path, ...] = ()
+    if report is not None:
+        write_report(found, report, force)
+        files = (Path(report),)
+    return DiffOutcome(found, files)
+
+
+def check_report(report: str | Path, force: bool, inputs: list[str | Path]) -> None:
+    """Refuse a report workbook that exists (without ``force``) or is one of the inputs,
+    before any work."""
+    from ..transaction import check_output
+
+    check_output(report, force, inputs=inputs)
+
+
+def write_report(found: DiffReport, report: str | Path, force: bool = False) -> None:
+    """The comparison's workbook: the error table and the worst column's curves."""
+    from ..reports.diff_report import write_diff_report
+
+    write_diff_report(found, report, force)
