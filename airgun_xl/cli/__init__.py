@@ -82,6 +82,26 @@ def _unraisable(hook):
     return quiet
 
 
+def _run(args):
+    """The command, its stdout silenced with ``--quiet`` (but for ``--json``'s document),
+    and no notice or progress bar."""
+    from .progress import QUIET
+
+    if not getattr(args, "quiet", False):
+        return args.run(args)
+    QUIET[:] = [True]
+    try:
+        if getattr(args, "json", False):
+            return args.run(args)
+        with contextlib.redirect_stdout(open(os.devnull, "w")) as sink:
+            try:
+                return args.run(args)
+            finally:
+                sink.close()
+    finally:
+        QUIET.clear()
+
+
 def main(argv=None):
     """Run the CLI; return the exit code (0 ok, 1 differences, 2 bad input, 128+N signal N)."""
     _WARNED.clear()
@@ -111,7 +131,7 @@ def main(argv=None):
                 for developers in (DeprecationWarning, PendingDeprecationWarning, FutureWarning,
                                    ImportWarning, ResourceWarning):  # not the user's business
                     warnings.simplefilter("ignore", developers)
-                code = args.run(args)
+                code = _run(args)
             say_later()  # an old spelling's note: after a success, a refusal stays one line
             # after a success, said as the tool's own warnings; a refusal drops them (one line)
             warn(sorted({f"{w.category.__name__} from a library: {str(w.message)[:300]}"

@@ -91,4 +91,9 @@ def build_parser():
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for module in COMMANDS:
         module.add_parser(sub)
+    for command in sub.choices.values():  # every command, the same way
+        command.add_argument("--quiet", action="store_true",
+                             help="print nothing but warnings and errors (and --json's "
+                                  "document): no figures, notices or progress bar; the exit "
+                                  "status is the same")
     return parser

@@ -37,7 +37,12 @@ def say_later():
 
 
 def note(messages):
-    """Print notices (what a run will cost, before it starts), one line each, to stderr."""
+    """Print notices (what a run will cost, before it starts), one line each, to stderr;
+    none with ``--quiet``."""
+    from .progress import QUIET
+
+    if QUIET:
+        return
     for message in messages:
         _say(f"airgun-xl: note: {message}")
 

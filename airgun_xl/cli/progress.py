@@ -24,6 +24,9 @@ WIDTH = 30
 #: The bar on screen now, if any: other messages clear its line first.
 ACTIVE: list = []
 
+#: ``--quiet`` given: no bar, whatever the stream.
+QUIET: list = []
+
 
 def clear_line(stream):
     """Clear the bar's line before another message is printed on ``stream``."""
@@ -94,6 +97,8 @@ class Progress:
 
 
 def _is_terminal(stream):
+    if QUIET:
+        return False
     try:
         return stream.isatty()
     except (AttributeError, ValueError):
