@@ -74,3 +74,34 @@ def test_bad_keywords_are_one_line_naming_the_option_and_write_nothing(given, sa
         airgun_xl.design(TEMPLATE, output=tmp_path / "d.xlsx", **given)
     assert str(caught.value).startswith(said) and "\n" not in str(caught.value)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_first_shot_success_tells_its_progress_shot_by_shot():
+    """design --confidence ran silent for 20-30 s: the study now tells its progress as its
+    Monte Carlo shots end (the CLI draws a bar on a terminal), counted against the most
+    shots it can run, and closes it."""
+    from airgun_xl.app.design import DesignRequest, run
+    from airgun_xl.app.specifying import SpecFields
+
+    class Recorder:
+        def __init__(self, total):
+            self.total, self.done, self.closed = total, 0, False
+
+        def advance(self, k):
+            self.done += k
+
+        def close(self):
+            self.closed = True
+
+    made = []
+
+    def progress_for(total):
+        made.append(Recorder(total))
+        return made[-1]
+
+    request = DesignRequest(TEMPLATE, spec=SpecFields(peak="12kG:10%", duration="5ms:10%"),
+                            confidence=0.95, sd=("A28=1.5%", "E40=5%"), shots=400)
+    outcome = run(request, shots_progress_for=progress_for)
+    (bar,) = made
+    assert bar.closed and 0 < bar.done <= bar.total
+    assert bar.done == sum(r.shots for r in outcome.confidence.tried)

@@ -13,10 +13,11 @@ shot's workbook.
 (``airgun-xl design``) and the Python API (:func:`airgun_xl.design`) are both this."""
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -127,12 +128,15 @@ def _label(var: Any) -> str:
 
 
 def run(request: DesignRequest, warn: Say | None = None, note: Say | None = None,
-        progress_for: Callable[[int], Any] | None = None) -> DesignOutcome:
+        progress_for: Callable[[int], Any] | None = None,
+        shots_progress_for: Callable[[int], Any] | None = None) -> DesignOutcome:
     """Design the shot ``request`` asks for, and fill it (``request.output``).
 
     ``warn`` and ``note`` are told the fill's warnings and notices as they come (they are in
     the outcome too); ``progress_for(rows)`` makes the fill's progress callback (told each
-    stage, closed at the end if it has ``close``).
+    stage, closed at the end if it has ``close``); ``shots_progress_for(shots)`` the first-shot
+    study's (told ``advance(k)`` as its Monte Carlo shots end, closed at the end), given the
+    most shots the study can run.
 
     Raises
     ------
@@ -145,7 +149,10 @@ def run(request: DesignRequest, warn: Say | None = None, note: Say | None = None
         mode, study = ("middle" if request.confidence is None else "confidence"), _solve_spec
     else:
         mode, study = "target", _solve_target
-    shot, design, lines, extra = study(request)
+    if study is _solve_spec:
+        shot, design, lines, extra = _solve_spec(request, shots_progress_for)
+    else:
+        shot, design, lines, extra = study(request)
     return _fill(request, mode, shot, design, lines, extra, warn, note, progress_for)
 
 
@@ -242,7 +249,8 @@ def _check_spec_options(request: DesignRequest) -> list[Any]:
     return sds
 
 
-def _solve_spec(request: DesignRequest) -> tuple[Shot, Design, list[str], dict[str, Any]]:
+def _solve_spec(request: DesignRequest, shots_progress_for: Callable[[int], Any] | None = None
+                ) -> tuple[Shot, Design, list[str], dict[str, Any]]:
     """By the specification: the middle of its tolerances, or with ``confidence`` the
     setting most likely to pass on the first shot."""
     from ..archive.laws import shot_with_law
@@ -285,9 +293,11 @@ def _solve_spec(request: DesignRequest) -> tuple[Shot, Design, list[str], dict[s
             notes_after = [f"design by the specification: {label} = {value:.6g} {var.unit}, "
                            f"the largest smallest margin ({middle.margin:+.2%} of a nominal)"]
         else:
-            c = confidence = solve_confidence(shot.params, spec, var, sds, request.shots,
-                                              request.seed, bounds, request.integrator,
-                                              request.model, runner)
+            with _shots_progress(shots_progress_for, request.shots) as progress:
+                c = confidence = solve_confidence(shot.params, spec, var, sds,
+                                                  request.shots, request.seed, bounds,
+                                                  request.integrator, request.model, runner,
+                                                  progress)
             value, evaluations = c.best.setting, sum(r.shots for r in c.tried)
             lo, hi = c.best.interval
             worst = c.best.most_failing()
@@ -320,6 +330,23 @@ def _solve_spec(request: DesignRequest) -> tuple[Shot, Design, list[str], dict[s
     lines.append(f"  {evaluations:,} simulations in {time.perf_counter() - started:.2f} s")
     return shot, design, lines, {"spec": spec, "notes": tuple(notes + notes_after),
                                  "reached": reached, "confidence": confidence}
+
+
+@contextlib.contextmanager
+def _shots_progress(progress_for: Callable[[int], Any] | None,
+                    n: int) -> Iterator[Callable[[int], None] | None]:
+    """The first-shot study's progress callback, for the most shots it runs (every
+    candidate's first round and the finalists' full one), closed on leaving."""
+    from ..studies.first_shot import CANDIDATES, FINALISTS, FIRST_ROUND
+
+    most = (CANDIDATES + 1) * max(200, int(round(n * FIRST_ROUND))) + (FINALISTS + 1) * n
+    made = progress_for(most) if progress_for is not None else None
+    try:
+        yield getattr(made, "advance", made)
+    finally:
+        close = getattr(made, "close", None)
+        if close is not None:
+            close()
 
 
 def _fill(request: DesignRequest, mode: str, shot: Shot, design: Design, lines: list[str],

@@ -79,9 +79,11 @@ def request_of(args):
 def run(args):
     from ..app.design import run as design
     from .messages import note, warn
-    from .progress import Progress
+    from .progress import Progress, count_bar
 
-    outcome = design(request_of(args), warn, note, None if args.json else Progress.for_rows)
+    quiet = args.json  # a document on stdout: no bar on stderr either
+    outcome = design(request_of(args), warn, note, None if quiet else Progress.for_rows,
+                     None if quiet else count_bar)
     if args.json:
         print(outcome.to_json())
         return 0 if outcome.reached else 3

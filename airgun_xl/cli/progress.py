@@ -144,3 +144,10 @@ class CountBar:
         ACTIVE.clear()
         self.stream.write("\r\x1b[K")
         self.stream.flush()
+
+
+def count_bar(total):
+    """A :class:`CountBar` of ``total`` things (shots) on a terminal; None in logs, CI, or
+    with ``--quiet``: what a study's ``progress_for`` makes."""
+    bar = CountBar(total)
+    return bar if bar.enabled else None

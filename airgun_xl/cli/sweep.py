@@ -35,15 +35,6 @@ def add_parser(sub):
     p.set_defaults(run=run)
 
 
-def _progress_bar(total):
-    """The one progress bar (cli/progress.py) on a terminal; nothing when stderr is not a TTY
-    (logs, CI)."""
-    from .progress import CountBar
-
-    bar = CountBar(total)
-    return bar if bar.enabled else None
-
-
 def request_of(args):
     """The :class:`~airgun_xl.app.sweep.SweepRequest` the command line asks for (its
     default output beside the shot)."""
@@ -61,8 +52,9 @@ def request_of(args):
 def run(args):
     from ..app.sweep import run as sweep
     from .messages import warn
+    from .progress import count_bar
 
-    outcome = sweep(request_of(args), None if args.json else _progress_bar)
+    outcome = sweep(request_of(args), None if args.json else count_bar)
     if args.json:
         print(outcome.to_json())
         warn(list(outcome.warnings))
