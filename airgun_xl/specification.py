@@ -306,6 +306,16 @@ class Specification:
         """Where a field (a :data:`KEYS` name) came from, or None if no source gave it."""
         return dict(self.origins).get(key)
 
+    def _shown_as_typed(self, key: str) -> str:
+        """A key's value to 6 significant digits, a nominal peak or duration in the unit it
+        was typed in (``40g``, not ``0.0400271kG``)."""
+        value = value_of(self, key)
+        typed = dict(self.units).get(key)
+        if key in SHOWN_UNITS and typed and value is not None:
+            unit, factor = shown_unit(self, key)
+            return f"{float(f'{value * factor:.6g}'):g}{unit}"
+        return show(self, key, digits=6)
+
     def provenance(self) -> list[str]:
         """Where each field came from, a line a source, the defaults last: what a verdict
         prints under its criteria."""
@@ -313,7 +323,7 @@ class Specification:
         for key, where in self.origins:
             if key in KEYS:
                 by_source.setdefault(where, []).append(
-                    f"{key_label(key)} {show(self, key, digits=6)}")
+                    f"{key_label(key)} {self._shown_as_typed(key)}")
             elif key == "srs" and self.srs is not None:
                 by_source.setdefault(where, []).append(
                     f"SRS requirement ({len(self.srs.frequencies)} rows)")

@@ -56,6 +56,9 @@ def test_the_api_judges_an_ideal_half_sine_by_its_keywords(recording):
     peak, duration = v.equivalent_half_sine
     assert peak == pytest.approx(A, rel=2e-2) and duration == pytest.approx(D, rel=2e-2)
     assert v.output is None and v.files == () and v.archived is None
+    # where the fields came from, each in the unit it was typed in (not 0.0400271kG)
+    assert v.verdict.sources()[0].startswith("from options: peak 40g, peak tolerance 10%, "
+                                             "duration 11ms, duration tolerance 10%")
     # the 5 ms of rest are shorter than the default monitoring window (1D = 11 ms each side)
     assert v.warnings == ("corridor: monitored from 0.0000 to 20.9961 ms only, what the "
                           "record holds of the tool's default window (-6.0000 to 27.0000 ms,"
