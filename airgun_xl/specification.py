@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import OptionError
-from .units import KG_MS2, G
+from .units import KG_MS2, NAMED_UNITS, PEAK_UNITS, TIME_UNITS, VELOCITY_UNITS, G
 
 #: The pulse shapes a specification can name; "none" judges the limits only (no corridor).
 SHAPES = ("half-sine", "sawtooth", "trapezoid", "none")
@@ -347,13 +347,8 @@ def judged_fields() -> tuple[str, ...]:
 _NUMBER = r"(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
 _SIGNED = re.compile(r"^\s*(?P<sign>[-+±]?)\s*" + _NUMBER + r"\s*(?P<unit>.*?)\s*$")
 
-#: Units of each quantity: name -> the factor to the inside unit, exactly as typed.
-PEAK_UNITS = {"kG": 1.0, "g": G / KG_MS2, "m/s^2": 1 / KG_MS2, "m/s2": 1 / KG_MS2,
-              "m/s²": 1 / KG_MS2}
-#: The units a message names (the others are spellings of these).
-_SHOWN_UNITS = ("kG", "g", "m/s^2", "s", "ms", "us", "ns", "m/s")
-TIME_UNITS = {"s": "1", "ms": "1e-3", "us": "1e-6", "µs": "1e-6", "ns": "1e-9"}
-VELOCITY_UNITS = {"m/s": 1.0}
+#: Units of each quantity: the one table (:mod:`airgun_xl.units`).
+_SHOWN_UNITS = NAMED_UNITS
 
 
 def _q(text: object) -> str:
@@ -612,6 +607,19 @@ def parse_window(text: str, where: str) -> tuple:
         else:
             sides.append((_time("window", zero=True)(part, where), "s"))
     return tuple(sides * 2) if len(sides) == 1 else tuple(sides)
+
+
+def parse_target(key: str, text: str, option: str) -> float:
+    """A design target (``peak`` [kG], ``duration`` [s]) read by the grammar every quantity
+    is read by: the same reading, or the same refusal, as the specification's field.
+
+    Raises
+    ------
+    airgun_xl.errors.OptionError
+        Naming ``option``.
+    """
+    value: float = KEYS[key].parse(text, option)
+    return value
 
 
 def show_window(window: tuple) -> str:

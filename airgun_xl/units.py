@@ -1,5 +1,7 @@
-"""Quantities with units on the command line: peaks in kG, g or m/s^2; durations in s, ms,
-us (or µs) and ns."""
+"""Quantities' units, decided once: peaks in kG, g or m/s^2; durations in s, ms, us (or µs)
+and ns; velocities in m/s; the macro's kG and standard gravity. The grammar that reads a
+quantity with them is :mod:`airgun_xl.specification`'s (options, profiles, sheets, design's
+targets); recordings' headers read the same tables (:mod:`airgun_xl.readers.recording`)."""
 import math
 import re
 from decimal import Decimal
@@ -11,22 +13,19 @@ KG_MS2 = 9800.0  # the macro's kG: a / 9800 (so 1 kG = 9800 m/s^2, not 1000 g)
 #: The macro's kG in standard g [g/kG]: shock labs give spectra in g.
 G_PER_KG = KG_MS2 / G
 
-_PEAK = {"kg": 1.0, "g": G / KG_MS2, "m/s2": 1 / KG_MS2, "m/s^2": 1 / KG_MS2,
-         "m/s²": 1 / KG_MS2}
-_TIME = {"s": "e0", "ms": "e-3", "us": "e-6", "µs": "e-6", "ns": "e-9"}
+#: The one table of each quantity's units, used by every reader of a quantity (the options,
+#: profiles, the Specification sheet, the design targets, recordings' headers): name ->
+#: the factor to the inside unit, exactly as typed. Units are case sensitive (``Kg`` is a
+#: mass, ``MS`` megasiemens): a unit a case away is refused with the one meant.
+PEAK_UNITS = {"kG": 1.0, "g": G / KG_MS2, "m/s^2": 1 / KG_MS2, "m/s2": 1 / KG_MS2,
+              "m/s²": 1 / KG_MS2}  # [kG per unit]
+TIME_UNITS = {"s": "1", "ms": "1e-3", "us": "1e-6", "µs": "1e-6", "ns": "1e-9"}  # [s], decimal
+VELOCITY_UNITS = {"m/s": 1.0}  # [m/s per unit]
+#: The units a message names (the others are spellings of these).
+NAMED_UNITS = ("kG", "g", "m/s^2", "s", "ms", "us", "ns", "m/s")
+_TIME = {unit: "e" + scale.partition("e")[2] if "e" in scale else "e0"
+         for unit, scale in TIME_UNITS.items()}
 _NUMBER = r"\s*([0-9]*\.?[0-9]+(?:[eE][+-]?[0-9]+)?)\s*"
-
-
-def parse_peak(text, option="--target-peak"):
-    """``"12kG"`` -> 12.0; ``"11750g"`` and ``"1.2e5m/s2"`` in kG as the macro defines it."""
-    match = re.fullmatch(_NUMBER + r"(kG|g|m/s2|m/s\^2|m/s²)\s*", str(text), re.IGNORECASE)
-    if not match:
-        raise OptionError(f"{option}: found {text!r}, expected a peak such as 12kG, 11750g "
-                          "or 1.2e5m/s2")
-    value = float(match.group(1)) * _PEAK[match.group(2).lower()]
-    if not (value > 0 and math.isfinite(value)):
-        raise OptionError(f"{option}: found {text!r}, expected a positive peak")
-    return value
 
 
 def parse_duration(text, option="--target-duration"):

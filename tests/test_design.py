@@ -13,6 +13,7 @@ from airgun_xl.engine.batch import FIGURES, run_batch
 from airgun_xl.engine.summary import summarize
 from airgun_xl.errors import DesignError, OptionError
 from airgun_xl.models import apply_model
+from airgun_xl.specification import parse_target
 from airgun_xl.stiffness import (
     LB_PER_IN,
     axial_stiffness_inch,
@@ -20,7 +21,7 @@ from airgun_xl.stiffness import (
     stiffness_from_frequency,
 )
 from airgun_xl.studies.design import VARIABLES, solve_peak
-from airgun_xl.units import parse_duration, parse_peak
+from airgun_xl.units import parse_duration
 
 SHOT_A = airgun_xl.load(TEMPLATE).params  # dt = 0.5 us, as the acceptance asks
 
@@ -52,7 +53,7 @@ def test_an_infeasible_target_explains_the_range(tmp_path, capsys):
 
 def test_design_other_parameters_and_units():
     """Yield stress for a peak given in g; the solution meets it within 0.1 %."""
-    target = parse_peak("11000g")
+    target = parse_target("peak", "11000g", "--target-peak")
     design = solve_peak(SHOT_A, target, VARIABLES["E40"])
     assert design.peak_kg == pytest.approx(target, rel=1e-3)
     assert design.params.sigmay != SHOT_A.sigmay
@@ -72,14 +73,20 @@ def test_design_peak_and_duration(tmp_path, capsys):
 
 
 def test_units():
-    assert parse_peak("12kG") == 12.0
-    assert parse_peak("9800m/s2") == 1.0
-    assert parse_peak("1000g") == pytest.approx(1000 * 9.80665 / 9800)
-    assert parse_duration("5ms") == 0.005 and parse_duration("500us") == 5e-4
-    assert parse_duration("250µs") == 2.5e-4 and parse_duration("0.5") == 0.5
-    for bad in ("12", "fast", "-3kG"):
-        with pytest.raises(OptionError):
-            parse_peak(bad)
+    """Design's targets are read by the grammar of every quantity (issue 44): the same
+    reading, or refusal, as --peak and --duration."""
+    def peak(text):
+        return parse_target("peak", text, "--target-peak")
+
+    assert peak("12kG") == 12.0
+    assert peak("9800m/s2") == 1.0
+    assert peak("1000g") == pytest.approx(1000 * 9.80665 / 9800)
+    assert parse_target("duration", "5ms", "--target-duration") == 0.005
+    assert parse_target("duration", "500us", "--target-duration") == 5e-4
+    assert parse_duration("250µs") == 2.5e-4 and parse_duration("0.5") == 0.5  # --levels
+    for bad in ("12", "fast", "-3kG", "12KG"):
+        with pytest.raises(OptionError, match="^--target-peak: found"):
+            peak(bad)
 
 
 def test_batch_equals_single_shots_to_the_last_bit():

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import OptionError
-from ..units import parse_duration, parse_peak
+from ..specification import parse_target
 from .running import cluster_runner
 from .specifying import SpecFields, resolve
 
@@ -164,8 +164,10 @@ def _solve_target(request: DesignRequest) -> tuple[Shot, Design, list[str], dict
         raise OptionError("--confidence: found with --target-peak, expected a design by the "
                           "specification (its fields, with no --target-*)")
     assert request.target_peak is not None
-    target = parse_peak(request.target_peak)
-    duration = parse_duration(request.target_duration) if request.target_duration else None
+    # the grammar of every quantity: the same reading, or refusal, as --peak and --duration
+    target = parse_target("peak", request.target_peak, "--target-peak")
+    duration = parse_target("duration", request.target_duration, "--target-duration") \
+        if request.target_duration else None
     variables = [variable(n) for n in request.vary or ("A28",)]
     if duration is not None and len(variables) != 2:
         raise OptionError("--target-duration: found one --vary, expected two (the first meets "

@@ -16,19 +16,19 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import limits
+from .. import limits, units
 from ..errors import AirgunXlError, OptionError, WorkbookError
 from ..transaction import display
-from ..units import KG_MS2, G
 from .guard import read_bytes
 
-#: Time units [s per unit].
-TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
+#: Time units [s per unit]: the one table's (:data:`airgun_xl.units.TIME_UNITS`).
+TIME_UNITS = {unit: float(scale) for unit, scale in units.TIME_UNITS.items()}
 
-#: Acceleration units [kG per unit]: a recorder's g is standard gravity (units.G, 9.80665
-#: m/s^2); the kG is the macro's, 9800 m/s^2 (its Acceleration (kG's) column), so 1 g is
-#: 1.000679e-3 kG. The macro's 9800 applies to the macro's columns only.
-ACCEL_UNITS = {"g": G / KG_MS2, "kG": 1.0, "m/s^2": 1 / KG_MS2, "m/s2": 1 / KG_MS2}
+#: Acceleration units [kG per unit], the one table's (:data:`airgun_xl.units.PEAK_UNITS`): a
+#: recorder's g is standard gravity (units.G, 9.80665 m/s^2); the kG is the macro's, 9800
+#: m/s^2 (its Acceleration (kG's) column), so 1 g is 1.000679e-3 kG. The macro's 9800
+#: applies to the macro's columns only.
+ACCEL_UNITS = dict(units.PEAK_UNITS)
 
 #: A step may differ from the median step by this fraction before it is a gap.
 GAP_TOLERANCE = 0.01

@@ -1,0 +1,79 @@
+"""Issue 44: one grammar for every quantity. The units are one table (airgun_xl.units) that
+the options, profiles, the Specification sheet, design's targets and recordings' headers
+all read; the same text is read alike, or refused in the same words, wherever it is given."""
+import argparse
+import json
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from airgun_xl import units
+from airgun_xl.cli.spec_options import options_spec
+from airgun_xl.errors import AirgunXlError
+from airgun_xl.readers.recording import read_trace
+from airgun_xl.specification import load_profile, parse_target
+
+
+@pytest.mark.parametrize("unit", sorted(units.PEAK_UNITS))
+def test_a_recordings_acceleration_header_reads_every_unit_an_option_does(unit, tmp_path):
+    """One kG-equivalent per unit: a recording of 1 <unit> reads what --peak 1<unit> reads
+    (the header's ² is the option's ²)."""
+    path = tmp_path / "r.csv"
+    path.write_text(f"time [s],acceleration [{unit}]\n" + "".join(
+        f"{k * 1e-5!r},1\n" for k in range(32)), encoding="utf-8")
+    trace = read_trace(str(path))
+    assert trace.accel_kg[0] == pytest.approx(parse_target("peak", f"1{unit}", "--peak"),
+                                              rel=1e-15)
+
+
+@pytest.mark.parametrize("unit", sorted(units.TIME_UNITS))
+def test_a_recordings_time_header_reads_every_unit_an_option_does(unit, tmp_path):
+    """Recordings' headers knew neither ns nor µs's other spelling: the step of a record
+    in <unit> is what --duration 1<unit> reads."""
+    path = tmp_path / "r.csv"
+    path.write_text(f"time [{unit}],acceleration [kG]\n" + "".join(
+        f"{k},1\n" for k in range(32)), encoding="utf-8")
+    trace = read_trace(str(path))
+    assert trace.dt == pytest.approx(parse_target("duration", f"1{unit}", "--duration"),
+                                     rel=1e-12)
+
+
+def _option(text):
+    ns = argparse.Namespace(peak=text)
+    try:
+        return options_spec(ns).peak.nominal
+    except AirgunXlError as exc:
+        return str(exc).removeprefix("--peak: ")
+
+
+def _target(text):
+    try:
+        return parse_target("peak", text, "--target-peak")
+    except AirgunXlError as exc:
+        return str(exc).removeprefix("--target-peak: ")
+
+
+def _profile(text, folder):
+    path = folder / "profile.json"
+    path.write_text(json.dumps({"peak": text}))
+    try:
+        return load_profile(str(path)).peak.nominal
+    except AirgunXlError as exc:
+        return str(exc).partition(": peak: ")[2]
+
+
+TEXT = st.one_of(st.text(max_size=14).filter(lambda t: ":" not in t and t.strip()),
+                 st.sampled_from(["12kG", "12KG", "12kg", "11750g", "1.2e5m/s^2", "1.2e5m/s²",
+                                  "9800m/s2", "12 kG", "-1kG", "+1kG", "0kG", "1e999kG",
+                                  "12", "kG", "nan kG", "1e-7kG", "12Kg", "12 g"]))
+
+
+@settings(max_examples=200, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(text=TEXT)
+def test_an_option_a_profile_and_a_design_target_read_a_peak_alike(text, tmp_path):
+    """``--peak X``, a profile's ``"peak": X`` and ``design --target-peak X`` (a peak
+    without a tolerance): the same value, or the same refusal after the place's name."""
+    option, target, profile = _option(text), _target(text), _profile(text, tmp_path)
+    assert option == target == profile, (text, option, target, profile)
