@@ -103,12 +103,17 @@ def test_docs_layout_draws_the_layers_the_contract_declares():
     assert [int(k) for k, _ in rows] == list(range(len(LAYERS), 0, -1))
 
 
+def _copy_package(folder):
+    """The package's sources and the contracts, copied to ``folder`` to be broken there."""
+    shutil.copytree(PACKAGE, folder / "airgun_xl",
+                    ignore=shutil.ignore_patterns("__pycache__", "*.so", "*.pyd"))
+    shutil.copy(ROOT / "pyproject.toml", folder / "pyproject.toml")
+
+
 def test_the_contract_fails_when_a_reader_imports_up(tmp_path):
     """The same contract on a copy of the package where the recording reader imports the
     CLI: lint-imports names that import and exits 1 (the check can fail)."""
-    shutil.copytree(PACKAGE, tmp_path / "airgun_xl",
-                    ignore=shutil.ignore_patterns("__pycache__", "*.so", "*.pyd"))
-    shutil.copy(ROOT / "pyproject.toml", tmp_path / "pyproject.toml")
+    _copy_package(tmp_path)
     reader = tmp_path / "airgun_xl" / "readers" / "recording.py"
     reader.write_text(reader.read_text() + "\n\ndef _up():\n    from ..cli import main\n"
                       "    return main\n")
@@ -122,9 +127,7 @@ def test_the_thin_cli_contract_fails_when_a_moved_command_reaches_below_app(tmp_
     """Issue 44: on a copy of the package where cli/srs.py (a command under app/) imports a
     study itself, lint-imports names that import under the forbidden contract; its ignore
     list holds only the commands not yet moved (each of them a line to go)."""
-    shutil.copytree(PACKAGE, tmp_path / "airgun_xl",
-                    ignore=shutil.ignore_patterns("__pycache__", "*.so", "*.pyd"))
-    shutil.copy(ROOT / "pyproject.toml", tmp_path / "pyproject.toml")
+    _copy_package(tmp_path)
     command = tmp_path / "airgun_xl" / "cli" / "srs.py"
     command.write_text(command.read_text() + "\n\ndef _down():\n"
                        "    from ..studies.shock import srs\n    return srs\n")

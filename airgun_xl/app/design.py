@@ -13,18 +13,17 @@ shot's workbook.
 (``airgun-xl design``) and the Python API (:func:`airgun_xl.design`) are both this."""
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import math
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import OptionError
 from ..specification import parse_target
-from .running import cluster_runner
+from .running import cluster_runner, shots_progress
 from .specifying import SpecFields, resolve
 
 if TYPE_CHECKING:
@@ -295,7 +294,7 @@ def _solve_spec(request: DesignRequest, shots_progress_for: Callable[[int], Any]
             notes_after = [f"design by the specification: {label} = {value:.6g} {var.unit}, "
                            f"the largest smallest margin ({middle.margin:+.2%} of a nominal)"]
         else:
-            with _shots_progress(shots_progress_for, request.shots) as progress:
+            with shots_progress(shots_progress_for, _most_shots(request.shots)) as progress:
                 c = confidence = solve_confidence(shot.params, spec, var, sds,
                                                   request.shots, request.seed, bounds,
                                                   request.integrator, request.model, runner,
@@ -334,21 +333,12 @@ def _solve_spec(request: DesignRequest, shots_progress_for: Callable[[int], Any]
                                  "reached": reached, "confidence": confidence}
 
 
-@contextlib.contextmanager
-def _shots_progress(progress_for: Callable[[int], Any] | None,
-                    n: int) -> Iterator[Callable[[int], None] | None]:
-    """The first-shot study's progress callback, for the most shots it runs (every
-    candidate's first round and the finalists' full one), closed on leaving."""
+def _most_shots(n: int) -> int:
+    """The most shots the first-shot study runs for ``n`` a setting: every candidate's first
+    round and the finalists' full one."""
     from ..studies.first_shot import CANDIDATES, FINALISTS, FIRST_ROUND
 
-    most = (CANDIDATES + 1) * max(200, int(round(n * FIRST_ROUND))) + (FINALISTS + 1) * n
-    made = progress_for(most) if progress_for is not None else None
-    try:
-        yield getattr(made, "advance", made)
-    finally:
-        close = getattr(made, "close", None)
-        if close is not None:
-            close()
+    return (CANDIDATES + 1) * max(200, int(round(n * FIRST_ROUND))) + (FINALISTS + 1) * n
 
 
 def _fill(request: DesignRequest, mode: str, shot: Shot, design: Design, lines: list[str],

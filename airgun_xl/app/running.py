@@ -1,9 +1,9 @@
-"""Where a study's shots run: this machine's batch kernel, or a Dask cluster (shared by
-sweep and design)."""
+"""Where a study's shots run (this machine's batch kernel, or a Dask cluster) and how their
+progress is told: shared by sweep and design."""
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from ..errors import OptionError
@@ -35,3 +35,18 @@ def cluster_runner(scheduler: str | None = None, workers: int | None = None,
         yield ClusterRunner(client, chunk if chunk is not None else DEFAULT_CHUNK)
     finally:
         close()
+
+
+@contextlib.contextmanager
+def shots_progress(progress_for: Callable[[int], Any] | None,
+                   total: int) -> Iterator[Callable[[int], None] | None]:
+    """The callback ``progress_for`` makes for ``total`` shots (None without one): its
+    ``advance``, told ``k`` as ``k`` shots end (or the callback itself, if a plain
+    function); closed on leaving, if it has ``close``."""
+    made = progress_for(total) if progress_for is not None else None
+    try:
+        yield getattr(made, "advance", made)
+    finally:
+        close = getattr(made, "close", None)
+        if close is not None:
+            close()

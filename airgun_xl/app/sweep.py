@@ -5,9 +5,8 @@ batch kernel, on this machine or a Dask cluster; the table, charts and spread wr
 (``airgun-xl sweep``) and the Python API (:func:`airgun_xl.sweep`) are both this."""
 from __future__ import annotations
 
-import contextlib
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -16,7 +15,7 @@ import numpy as np
 
 from .. import limits
 from ..errors import OptionError
-from .running import cluster_runner
+from .running import cluster_runner, shots_progress
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -117,20 +116,6 @@ def _count(option: str, text: str | None, sds: list[Any]) -> int:
     return n
 
 
-@contextlib.contextmanager
-def _progress(progress_for: Callable[[int], Any] | None,
-              total: int) -> Iterator[Callable[[int], None] | None]:
-    """The callback ``progress_for`` makes for ``total`` shots (None without one), closed on
-    leaving."""
-    made = progress_for(total) if progress_for is not None else None
-    try:
-        yield getattr(made, "advance", made)
-    finally:
-        close = getattr(made, "close", None)
-        if close is not None:
-            close()
-
-
 def run(request: SweepRequest,
         progress_for: Callable[[int], Any] | None = None) -> SweepOutcome:
     """Run the study ``request`` asks for. ``progress_for(shots)``, once the shots are
@@ -177,7 +162,7 @@ def run(request: SweepRequest,
                         "fewer shots (--mc, or fewer points per --vary) or fewer rows")
     started = time.perf_counter()
     with cluster_runner(request.scheduler, request.workers, request.chunk) as runner, \
-            _progress(progress_for, total) as progress:
+            shots_progress(progress_for, total) as progress:
         sensitivity = None
         if request.mc is not None:
             result = monte_carlo(shot.params, sds, n, request.seed, request.integrator,
