@@ -32,12 +32,16 @@ if TYPE_CHECKING:
     from typing import Unpack
 
     from .app.accept import AcceptOutcome
+    from .app.archive import CompareOutcome, HistoryOutcome, ShowOutcome
     from .app.calibrate import CalibrateOutcome
+    from .app.campaign import CampaignOutcome
     from .app.check import CheckOutcome
     from .app.compare_measured import CompareMeasuredOutcome
     from .app.convergence import ConvergenceOutcome
     from .app.design import DesignOutcome
     from .app.diff import DiffOutcome
+    from .app.fill import FillOutcome
+    from .app.settings import FillSettings
     from .app.specifying import SpecKeywords
     from .app.srs import SrsOutcome
     from .app.sweep import SweepOutcome
@@ -450,6 +454,130 @@ def sweep(shot: str | os.PathLike[str], vary: str | Sequence[str] = (), *,
         Path(archive) if archive is not None else None, scheduler, workers, chunk))
 
 
+def _fill_settings(command: str, output: str | os.PathLike[str] | None,
+                   archive: str | os.PathLike[str] | None, options: dict[str, object],
+                   spec: dict[str, object]) -> FillSettings:
+    """The :class:`~airgun_xl.app.settings.FillSettings` of :func:`fill`'s and
+    :func:`campaign`'s keywords (the specification's fields read as ``accept`` reads them)."""
+    from .app.archive import archive_root
+    from .app.settings import FillSettings
+    from .app.specifying import keyword_fields, options_spec
+    from .specification import load_profile
+
+    fields = keyword_fields(command, dict(spec))
+    profile = load_profile(fields.profile) if fields.profile else None
+    return FillSettings(
+        output=os.fspath(output) if output is not None else None,
+        archive=archive_root(os.fspath(archive) if archive is not None else None),
+        profile=profile, spec=options_spec(fields), argv=(command,),
+        **options)  # type: ignore[arg-type]
+
+
+def fill(shot: str | os.PathLike[str], *, output: str | os.PathLike[str] | None = None,
+         force: bool = False, host: str = "excel", only: str | None = None,
+         no_charts: bool = False, every: int | str | None = None,
+         max_sheet_rows: int | str | None = None, sidecar: str | None = None,
+         integrator: str = "legacy", allow_unstable: bool = False, model: str = "4-mass",
+         crush_law: str = "workbook", unloading: str = "macro", compare_models: bool = False,
+         archive: str | os.PathLike[str] | None = None, name: str | None = None,
+         reproducible: bool = False, **spec: Unpack[SpecKeywords]) -> FillOutcome:
+    """Run the shot in a workbook and write a new filled workbook, as ``airgun-xl fill``
+    does (``output`` defaults to SHOT.out.xlsx beside the shot; the shot is never changed).
+
+    The keywords are the command's options (``only="summary,charts"``, ``every=10``); the
+    specification fields (``peak="12kG:10%"``, ``profile=``) judge the prediction, over the
+    shot's Specification sheet. With ``archive`` (or ``$AIRGUN_XL_ARCHIVE``) the run is also
+    stored as a new entry.
+
+    Returns
+    -------
+    airgun_xl.app.fill.FillOutcome
+        ``result`` (the :class:`Result`), ``summary``, ``verdict``, ``warnings``, ``files``,
+        ``lines`` (what the command prints).
+
+    Raises
+    ------
+    AirgunXlError
+        Bad input or an unstable run, named; nothing is written.
+    """
+    from .app.fill import FillRequest, run
+
+    settings = _fill_settings("fill", output, archive, {
+        "force": force, "host": host, "only": only, "no_charts": no_charts,
+        "every": None if every is None else str(every),
+        "max_sheet_rows": None if max_sheet_rows is None else str(max_sheet_rows),
+        "sidecar": sidecar, "integrator": integrator, "allow_unstable": allow_unstable,
+        "model": model, "crush_law": crush_law, "unloading": unloading,
+        "compare_models": compare_models, "name": name, "reproducible": reproducible},
+        dict(spec))
+    return run(FillRequest(os.fspath(shot), settings))
+
+
+def campaign(shots: str | os.PathLike[str] | Sequence[str | os.PathLike[str]], *,
+             jobs: int | str | None = None, summary: str | os.PathLike[str] | None = None,
+             force: bool = False, integrator: str = "legacy", model: str = "4-mass",
+             crush_law: str = "workbook", archive: str | os.PathLike[str] | None = None,
+             reproducible: bool = False, **spec: Unpack[SpecKeywords]) -> CampaignOutcome:
+    """Fill many shots (workbooks, or folders of them), each its own transaction, in ``jobs``
+    worker processes, as ``airgun-xl fill a.xlsx b.xlsx day/ --jobs N --summary DAY.xlsx``
+    does. A bad shot is its row's status; the others go on.
+
+    Returns
+    -------
+    airgun_xl.app.campaign.CampaignOutcome
+        ``rows`` (one a shot: status, figures, warnings), ``counts``, ``failure`` (why it is
+        not a success, or None), ``files``.
+    """
+    from .app.campaign import CampaignRequest, run
+
+    given = [shots] if isinstance(shots, (str, os.PathLike)) else list(shots)
+    settings = _fill_settings("fill", None, archive, {
+        "force": force, "integrator": integrator, "model": model, "crush_law": crush_law,
+        "reproducible": reproducible}, dict(spec))
+    return run(CampaignRequest(tuple(os.fspath(p) for p in given), settings, jobs,
+                               os.fspath(summary) if summary is not None else None))
+
+
+def history(archive: str | os.PathLike[str] | None = None, *, shot: str | None = None,
+            since: str | None = None, where: str | Sequence[str] = (),
+            output: str | os.PathLike[str] | None = None,
+            force: bool = False) -> HistoryOutcome:
+    """The runs stored in an archive (default ``$AIRGUN_XL_ARCHIVE``), as ``airgun-xl
+    history`` lists them: ``rows`` (one a run: its figures and provenance, what its records
+    could not give named), the archive's ``laws`` and ``verdicts``; ``where`` selects by
+    input cell (``"E40=2.6e7:2.8e7"``); ``output`` also writes the table."""
+    from .app.archive import HistoryRequest
+    from .app.archive import history as listed
+
+    return listed(HistoryRequest(os.fspath(archive) if archive is not None else None, shot,
+                                 since, _texts(where),
+                                 os.fspath(output) if output is not None else None, force))
+
+
+def show(entry: str, archive: str | os.PathLike[str] | None = None) -> ShowOutcome:
+    """One archived run (``"SHOT"``, ``"SHOT@VERSION"`` or ``"#ID"``): ``doc`` holds its
+    inputs, figures, provenance and files as stored; refused when ``archive verify`` would
+    report it."""
+    from .app.archive import show as shown
+
+    return shown(entry, os.fspath(archive) if archive is not None else None)
+
+
+def compare(entry1: str, entry2: str, archive: str | os.PathLike[str] | None = None, *,
+            rtol: float = 1e-12, atol: float = 0.0,
+            report: str | os.PathLike[str] | None = None,
+            force: bool = False) -> CompareOutcome:
+    """Two archived runs compared, inputs first, then every series of their histories, as
+    ``airgun-xl compare`` does: ``same``, ``report`` (the error table), ``files``."""
+    from .app.archive import CompareRequest
+    from .app.archive import compare as compared
+
+    return compared(CompareRequest(
+        entry1, entry2, os.fspath(archive) if archive is not None else None,
+        _number("--rtol", rtol), _number("--atol", atol),
+        os.fspath(report) if report is not None else None, force))
+
+
 __all__ = [
     "AirgunXlError",
     "ArchiveError",
@@ -468,12 +596,17 @@ __all__ = [
     "__version__",
     "accept",
     "calibrate",
+    "campaign",
     "check",
+    "compare",
     "compare_measured",
     "convergence",
     "design",
     "diff",
+    "fill",
+    "history",
     "load",
+    "show",
     "srs",
     "sweep",
     "template",

@@ -30,3 +30,6 @@ DESIGN_VARIABLES = ("A28", "E13", "E16", "E40", "A2")
 
 #: The environment variable that names the default archive folder.
 ARCHIVE_ENV = "AIRGUN_XL_ARCHIVE"
+
+#: The environment variable that names the PostgreSQL server of a new archive's index.
+INDEX_ENV = "AIRGUN_XL_INDEX"

@@ -72,3 +72,23 @@ def test_calibrate_json_holds_the_fit_and_its_error(tmp_path, capsys):
     assert doc["fitted"] == outcome.fitted
     assert doc["standard_errors"]["E40"] == outcome.calibration.errors["E40"]
     assert doc["scores"][0]["after"]["rms"] == outcome.calibration.after[0].rms
+
+
+def test_check_json_holds_the_critical_steps_and_exit_2_when_unstable(tmp_path, capsys):
+    from conftest import template_with
+
+    code, doc, _ = _document(["check", str(TEMPLATE)], capsys)
+    outcome = airgun_xl.check(TEMPLATE)
+    assert code == 0 and doc["stable"] is True
+    assert doc["critical_time_step_s"] == outcome.critical.dt_crit
+    assert doc["ratio"] == outcome.params.delta / outcome.critical.dt_crit
+    coarse = template_with(tmp_path, E2=2 * outcome.critical.dt_crit)
+    code, doc, _ = _document(["check", str(coarse)], capsys)
+    assert code == 2 and doc["stable"] is False
+    assert [f["level"] for f in doc["findings"]][:1] == ["error"]
+
+
+def test_template_json_names_the_file(tmp_path, capsys):
+    code, doc, _ = _document(["template", str(tmp_path / "t.xlsx")], capsys)
+    assert code == 0 and doc == {"files": [str(tmp_path / "t.xlsx")]}
+    assert airgun_xl.load(tmp_path / "t.xlsx").params == airgun_xl.load(TEMPLATE).params

@@ -5,9 +5,9 @@ import io
 import openpyxl
 from conftest import TEMPLATE
 
+from airgun_xl.app.fill import notices, sidecar_bytes
 from airgun_xl.cli import main, progress
 from airgun_xl.limits import fill_bytes
-from airgun_xl.pipeline import notices, sidecar_bytes
 
 
 class Terminal(io.StringIO):

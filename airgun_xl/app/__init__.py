@@ -3,8 +3,9 @@
 a request and prints the outcome; the Python API (:mod:`airgun_xl`) builds the same request
 from keyword arguments.
 
-Moved here so far: ``accept``, ``calibrate``, ``check``, ``compare_measured``,
-``convergence``, ``design``, ``diff``, ``srs``, ``sweep`` and ``template``; the
-specification fields every judging command takes (:mod:`.specifying`), where a study's shots
-run (:mod:`.running`), outcomes as JSON (:mod:`.documents`). Fill (``pipeline``,
-``campaign``) and the archive's commands are still composed in ``airgun_xl.cli``."""
+The commands: ``accept``, ``archive`` (history, show, compare, archive init, migrate and
+verify), ``calibrate``, ``campaign``, ``check``, ``compare_measured``, ``convergence``,
+``design``, ``diff``, ``fill``, ``srs``, ``sweep`` and ``template``; beside them, what fill's
+options ask of each shot (:mod:`.settings`), the specification fields every judging command
+takes (:mod:`.specifying`), where a study's shots run (:mod:`.running`), a command's signals
+(:mod:`.session`), outcomes as JSON (:mod:`.documents`)."""

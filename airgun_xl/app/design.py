@@ -75,7 +75,7 @@ class DesignOutcome:
     designed: Shot  # the shot with the solved values in its cells
     reached: bool  # False: no setting met the specification (middle) or reached P
     lines: tuple[str, ...]  # what the command prints of the solution, before the fill's
-    filled: Any  # the designed shot's fill (pipeline.Filled), None without an output
+    filled: Any  # the designed shot's fill (app.fill.Filled), None without an output
     output: Path | None
     files: tuple[Path, ...]
     warnings: tuple[str, ...]  # the designed shot's and the study's
@@ -346,7 +346,7 @@ def _fill(request: DesignRequest, mode: str, shot: Shot, design: Design, lines: 
           progress_for: Callable[[int], Any] | None) -> DesignOutcome:
     """The designed shot, filled into ``request.output`` (if given)."""
     from ..outputs import from_sheet
-    from ..pipeline import Options, fill_workbook
+    from .fill import Options, fill_workbook
 
     designed = with_cells(shot, design)  # its warnings go with the designed shot's figures
     designed = dataclasses.replace(designed, warnings=list(designed.warnings)

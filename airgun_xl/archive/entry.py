@@ -60,12 +60,12 @@ def prepare_entry(archive, request, shot, workbook, filled, options, seconds):
     Parameters
     ----------
     archive : airgun_xl.archive.Archive
-    request : airgun_xl.pipeline.ArchiveRequest
+    request : airgun_xl.app.fill.ArchiveRequest
     shot : airgun_xl.shot.Shot
     workbook : pathlib.Path
         The output workbook as written (its temp file, not yet published).
-    filled : airgun_xl.pipeline.Filled
-    options : airgun_xl.pipeline.Options
+    filled : airgun_xl.app.fill.Filled
+    options : airgun_xl.app.fill.Options
     seconds : float
         Run time so far [s].
     """

@@ -23,6 +23,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from ..choices import INDEX_ENV
 from ..errors import ArchiveError, OptionError
 from ..transaction import display
 from ..untrusted_json import printable
@@ -30,10 +31,8 @@ from .agent import Link, LinkError, agent, prestart
 
 INDEX = "index.sqlite"
 
-#: The environment variable that gives a server archive's address (a libpq URL or
-#: ``key=value`` string, without a password); libpq's own variables and service file work too.
-INDEX_ENV = "AIRGUN_XL_INDEX"
-
+# INDEX_ENV (choices) gives a server archive's address (a libpq URL or ``key=value`` string,
+# without a password); libpq's own variables and service file work too.
 #: How long a writer waits for another's lock on the index [s].
 LOCK_WAIT = 120
 

@@ -6,80 +6,21 @@ written), 3 a shot or a design that fails its specification (accept, design --co
 is half published); SIGXFSZ is ignored, so a file-size limit (``ulimit -f``) is a write error.
 """
 import contextlib
-import errno
 import os
-import signal
 import sys
 import warnings
 
+from ..app.session import (
+    Interrupted,
+    command_signals,
+    interrupt_behind,
+    late_signal,
+    quiet_full_disk,
+)
 from ..errors import AirgunXlError
-from ..transaction import SIGNALS, Interrupted, note_signal, on_signal, reset_signals
 from .messages import _LATER, _WARNED, _say, note, say_later, warn
 
 __all__ = ["main", "note", "warn"]
-
-
-@contextlib.contextmanager
-def _signals(restore=True):
-    """SIGTERM and SIGHUP raise like SIGINT; SIGXFSZ is ignored (in the main thread only).
-
-    Afterwards the handlers are restored, or, for the command itself (``restore=False``),
-    the signals are ignored: the work is done, and interpreter shutdown must not turn a late
-    Ctrl-C into a traceback."""
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    wanted: dict = {getattr(signal, n): on_signal for n in ("SIGINT", "SIGTERM", "SIGHUP")
-                    if hasattr(signal, n)}
-    if hasattr(signal, "SIGXFSZ"):
-        wanted[signal.SIGXFSZ] = signal.SIG_IGN
-    reset_signals()
-    saved = {s: signal.signal(s, h) for s, h in wanted.items()}
-    hook = sys.unraisablehook
-
-    def swallowed(unraisable):  # an interrupt raised inside a finalizer: keep it for later
-        if isinstance(unraisable.exc_value, KeyboardInterrupt):
-            note_signal(getattr(unraisable.exc_value, "signum", signal.SIGINT))
-        else:
-            hook(unraisable)
-
-    sys.unraisablehook = swallowed
-    try:
-        yield
-    finally:
-        for s, h in saved.items():
-            signal.signal(s, h if restore else signal.SIG_IGN)
-        sys.unraisablehook = hook
-
-
-def _interrupt_behind(exc):
-    """The :class:`Interrupted` a signal raised inside an import, which the importing module
-    (numpy, for one) turned into an ImportError; None when there is none."""
-    seen = 0
-    while exc is not None and seen < 20:
-        if isinstance(exc, Interrupted):
-            return exc
-        exc = exc.__cause__ or exc.__context__
-        seen += 1
-    return None
-
-
-#: Write errors a full disk or ``ulimit -f`` gives: already said in one line by the command.
-_FULL = (errno.EFBIG, errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC))
-
-
-def _unraisable(hook):
-    """An unraisable-exception hook that drops a full disk's second report: a zip file the
-    failed write left open retries its flush when it is collected (ZipFile.__del__), and would
-    print a traceback after the one-line error (issue 23.16)."""
-    def quiet(unraisable):
-        error = unraisable.exc_value
-        if isinstance(error, OSError) and error.errno in _FULL:
-            return
-        hook(unraisable)
-    return quiet
 
 
 def _run(args):
@@ -110,14 +51,14 @@ def main(argv=None):
     if archive_index is not None:  # an earlier in-process command's
         archive_index.take_notices()
     if argv is None:  # the command itself, not a caller's in-process run
-        sys.unraisablehook = _unraisable(sys.unraisablehook)
+        sys.unraisablehook = quiet_full_disk(sys.unraisablehook)
     for stream in (sys.stdout, sys.stderr):  # a file name may hold undecodable bytes
         reconfigure = getattr(stream, "reconfigure", None)  # a TextIOWrapper's
         with contextlib.suppress(ValueError, OSError):
             if reconfigure is not None:
                 reconfigure(errors="backslashreplace")
     try:
-        with _signals(restore=argv is not None):  # before numpy and the engine load
+        with command_signals(restore=argv is not None):  # before numpy and the engine load
             from .commands import build_parser, joined_values
 
             parser = build_parser()
@@ -139,8 +80,8 @@ def main(argv=None):
             archive_index = sys.modules.get("airgun_xl.archive.index")  # loaded if used
             if archive_index is not None:
                 warn(archive_index.take_notices())  # a server role that may rewrite history
-            if SIGNALS["pending"] is not None and SIGNALS["committed"]:
-                _say(f"airgun-xl: signal {SIGNALS['pending']} arrived after the outputs were "
+            if late_signal() is not None:
+                _say(f"airgun-xl: signal {late_signal()} arrived after the outputs were "
                      "complete; nothing was lost")
             return code
     except AirgunXlError as exc:
@@ -150,7 +91,7 @@ def main(argv=None):
         _say(f"airgun-xl: stopped by signal {exc.signum}; nothing was left half-written")
         return 128 + exc.signum
     except ImportError as exc:  # a signal during a lazy import: the import reports it
-        signal_error = _interrupt_behind(exc)
+        signal_error = interrupt_behind(exc)
         if signal_error is None:
             raise
         _say(f"airgun-xl: stopped by signal {signal_error.signum}; nothing was left "

@@ -1,5 +1,7 @@
 """``airgun-xl template OUT.xlsx [--force]``: write a fresh shot A template."""
-from .run_options import add_force
+import json
+
+from .run_options import add_force, add_json
 
 
 def add_parser(sub):
@@ -8,12 +10,13 @@ def add_parser(sub):
                                    "the report's appendix ran it, with live formulas.")
     p.add_argument("output", metavar="OUT.xlsx", help="where to write the template")
     add_force(p)
+    add_json(p, "the file written")
     p.set_defaults(run=run)
 
 
 def run(args):
     from ..app.template import run as template
 
-    template(args.output, args.force)
-    print(f"wrote {args.output}")
+    written = template(args.output, args.force)
+    print(json.dumps({"files": [str(written)]}) if args.json else f"wrote {args.output}")
     return 0

@@ -32,6 +32,7 @@ from xlsxwriter.utility import xl_rowcol_to_cell
 from ..cells import PARAMETER_COLUMNS
 from ..engine.summary import SPECTRUM_MAX_HZ, summarize
 from ..outputs import SHEET_NAME, Outputs
+from ..provenance import Provenance
 from ..readers.formula_eval import Evaluator, FormulaFailure
 from ..readers.law_sheet import SHEET_NAME as LAW_SHEET
 from ..transaction import atomic_path, check_output, display
@@ -247,8 +248,8 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
         Which groups, sheets and charts to write, and the row stride.
     summary : airgun_xl.engine.summary.Summary, optional
         Computed here when a selected output needs it and none is given.
-    info : dict, optional
-        Provenance for the Summary sheet (input, SHA-256, run times, ...).
+    info : airgun_xl.provenance.Provenance, optional
+        What the Summary says of the run (input, SHA-256, run times, warnings, ...).
     shown : path, optional
         The output's final name, for messages.
 
@@ -263,19 +264,18 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
     needs_summary = outputs.groups & {"summary", "spectrum", "charts"}
     if summary is None and needs_summary:
         summary = summarize(result)
-    info = dict(info or {}, every=stride, sheet_rows=len(keep))
     wb = new_workbook(tmp)
     names = sheet_names(source.sheet_title if source is not None else None)
     refs, warnings = _write_sheet1(wb, result, outputs, keep, stride, names["first"])
     shot = display(source.path.name) if source is not None else None
-    info["shot"] = shot
+    info = (info or Provenance()).written(stride, len(keep), shot)
     if "summary" in outputs:
         write_parameters(wb, result.params, shot, names["Parameters"])
         write_summary(wb, result, summary, info, names["Summary"])
     charts_ws = wb.add_worksheet(names["Charts"]) if "charts" in outputs else None
-    if info.get("srs_requirement") is not None:
-        _write_srs_sheets(wb, result, info["srs_requirement"], shot, names["SRS"],
-                          info.get("warnings", []))
+    if info.srs_requirement is not None:
+        _write_srs_sheets(wb, result, info.srs_requirement, shot, names["SRS"],
+                          list(info.warnings))
     if source is not None and source.outputs_block:
         outputs_ws = wb.add_worksheet(names[SHEET_NAME], worksheet_class=ColumnsWorksheet)
         warnings += write_cells(outputs_ws, source.outputs_block, style=Style(wb))
@@ -289,7 +289,7 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
         refs.update(write_spectrum(wb, summary.spectrum, ColumnsWorksheet, names["Spectrum"],
                                    shot))
     if charts_ws is not None:
-        compared = info.get("compared")
+        compared = info.compared
         data = series_data(result, summary.spectrum, compared, summary.natural_initial)
         placed = write_chart_data(wb, data, refs, ColumnsWorksheet, names["ChartData"],
                                   budget=len(keep),  # --every N thins the copies too

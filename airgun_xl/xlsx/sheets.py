@@ -196,7 +196,7 @@ def variant_name(result):
     return f"{result.model} model"
 
 
-def _summary_rows(result, summary, timings):
+def _summary_rows(result, summary, prov):
     """(label, value in SI, quantity code of :data:`~airgun_xl.xlsx.report.QUANTITIES`
     or "" for text, definition) per Summary row."""
     p = result.params
@@ -231,7 +231,7 @@ def _summary_rows(result, summary, timings):
             rows.append((f"OBR chain natural frequency {i + 1} ({label} masses)", f, "Hz",
                          "sqrt of the eigenvalues of M^-1 K of the bird's springs / 2 pi"
                          if i == 0 and label == "initial" else ""))
-    compared = timings.get("compared")
+    compared = prov.compared
     if compared is not None:
         name = variant_name(compared)
         rows += [(f"Peak acceleration, {name}", compared.peak_kg, "kG",
@@ -249,27 +249,27 @@ def _summary_rows(result, summary, timings):
          f"the archive's law {p.crush_law.source} (calibrate --archive --name)"
          if p.crush_law.source else "the Crush law sheet (airgun-xl calibrate)"),
         ("Time step", p.delta, "step", "E2"),
-        ("Critical time step", timings.get("dt_crit")
-         if timings.get("dt_crit") != float("inf") else "none: implicit in the OBR chain",
+        ("Critical time step", prov.dt_crit
+         if prov.dt_crit != float("inf") else "none: implicit in the OBR chain",
          "step", "largest step stable for the OBR chain, the springs that always act "
          "(airgun-xl check)"),
-        ("Critical time step, unloading", timings.get("dt_unloading"), "step",
+        ("Critical time step, unloading", prov.dt_unloading, "step",
          "largest step stable while the mitigator unloads at full length"),
-        ("Critical time step, compacted", timings.get("dt_compacted"), "step",
+        ("Critical time step, compacted", prov.dt_compacted, "step",
          "largest step stable while the mitigator unloads fully compacted"),
-        ("Time step / critical", timings.get("dt_ratio"), "ratio",
+        ("Time step / critical", prov.dt_ratio, "ratio",
          "above 1 the run diverges from its first steps"),
         ("Rows", result.rows, "count", "time rows of the run"),
-        ("Rows on the sheets", timings.get("sheet_rows"), "count", ""),
-        ("Every N-th row", timings.get("every"), "count", "1: every row is on the sheets"),
-        ("Engine version", timings.get("version"), "", "airgun-xl"),
-        ("Input file", timings.get("input"), "", ""),
-        ("Input SHA-256", timings.get("sha256"), "", ""),
+        ("Rows on the sheets", prov.sheet_rows, "count", ""),
+        ("Every N-th row", prov.every, "count", "1: every row is on the sheets"),
+        ("Engine version", prov.version, "", "airgun-xl"),
+        ("Input file", prov.input, "", ""),
+        ("Input SHA-256", prov.sha256, "", ""),
     ]
-    if "kernel_seconds" in timings:
-        rows += [("Kernel run time", timings["kernel_seconds"], "runtime-fine",
+    if prov.kernel_seconds is not None:
+        rows += [("Kernel run time", prov.kernel_seconds, "runtime-fine",
                   "time stepping alone"),
-                 ("Run time", timings["run_seconds"], "runtime",
+                 ("Run time", prov.run_seconds, "runtime",
                   "reading, stepping and post-processing, before writing")]
     return rows
 
@@ -306,7 +306,7 @@ def write_predicted_verdict(wb, ws, verdict, row, style, doubted=()):
     return row
 
 
-def write_summary(wb, result, summary, timings, name="Summary"):
+def write_summary(wb, result, summary, prov, name="Summary"):
     """The Summary sheet: one labelled cell per figure (label A, value B in the unit of C, with
     a number format fit for it, definition D); printed as one landscape page."""
     ws = wb.add_worksheet(name)
@@ -318,8 +318,8 @@ def write_summary(wb, result, summary, timings, name="Summary"):
     text = style.get(align="left")
     for col, heading in enumerate(("Quantity", "Value", "Unit", "Definition")):
         ws.write_string(0, col, heading, style.bold)
-    rows = _summary_rows(result, summary, timings)
-    flags = flagged_figures(timings.get("warnings", []))
+    rows = _summary_rows(result, summary, prov)
+    flags = flagged_figures(list(prov.warnings))
     for row, (label, value, code, definition) in enumerate(rows, 1):
         ws.write_string(row, 0, label)
         note = definition
@@ -339,15 +339,15 @@ def write_summary(wb, result, summary, timings, name="Summary"):
         if note:
             ws.write_string(row, 3, note)
     row = len(rows) + 2
-    if timings.get("verdict") is not None:
-        row = write_predicted_verdict(wb, ws, timings["verdict"], row, style,
+    if prov.verdict is not None:
+        row = write_predicted_verdict(wb, ws, prov.verdict, row, style,
                                       flags.get("Peak acceleration (raw)", [])) + 1
-    for note in timings.get("study_notes") or ():
+    for note in prov.study_notes:
         ws.write_string(row, 0, "Design", style.bold)
         ws.write_string(row, 3, note)
         row += 1
-    last = write_warnings(wb, ws, row, timings.get("warnings", []), 3)
-    one_page(ws, last, 3, shot=timings.get("shot"), title="Summary")
+    last = write_warnings(wb, ws, row, list(prov.warnings), 3)
+    one_page(ws, last, 3, shot=prov.shot, title="Summary")
     ws.freeze_panes(1, 0)
     return ws
 

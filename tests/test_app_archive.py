@@ -1,0 +1,71 @@
+"""Issue 44: the archive's commands as functions (airgun_xl.app.archive) and as the Python
+API (airgun_xl.history, show, compare), driven without the CLI: what they return is what the
+fill stored, and their lines are what the commands print."""
+import json
+
+import pytest
+from conftest import template_with
+
+import airgun_xl
+from airgun_xl.app import archive
+from airgun_xl.cli import main
+from airgun_xl.errors import ArchiveError, OptionError
+
+
+@pytest.fixture
+def filled(tmp_path):
+    """An archive with two runs of shot A (A28 200 and 250 m/s)."""
+    root = tmp_path / "arch"
+    runs = []
+    for v in (200, 250):
+        (tmp_path / f"v{v}").mkdir()
+        shot = template_with(tmp_path / f"v{v}", A28=v)
+        runs.append(airgun_xl.fill(shot, archive=root, only="summary", name=f"v{v}"))
+    return root, runs
+
+
+def test_history_lists_what_the_fills_stored(filled, capsys):
+    root, runs = filled
+    outcome = airgun_xl.history(root)
+    assert [r["ref"] for r in outcome.rows] == [run.filled.entry.ref for run in runs]
+    assert [r["peak_kg"] for r in outcome.rows] == [run.result.peak_kg for run in runs]
+    assert [r["v0"] for r in outcome.rows] == [200.0, 250.0] and outcome.total == 2
+    only = airgun_xl.history(root, where="A28=240:260")
+    assert [r["v0"] for r in only.rows] == [250.0] and only.lines[-1] == "1 entry of 2 (--where)"
+    assert main(["history", "--archive", str(root)]) == 0
+    assert capsys.readouterr().out.splitlines() == list(outcome.lines)
+    with pytest.raises(OptionError, match="--where: found 'Z9=1'"):
+        airgun_xl.history(root, where="Z9=1")
+
+
+def test_show_gives_the_entrys_records(filled, capsys):
+    root, runs = filled
+    outcome = airgun_xl.show("v250", root)
+    assert outcome.doc["summary"]["peak_kg"] == runs[1].result.peak_kg
+    assert {p["cell"]: p["value"] for p in outcome.doc["params"]}["A28"] == 250
+    assert f"  {'Peak acceleration (raw)':<37} {runs[1].result.peak_kg:,.5f} kG" \
+        in outcome.lines
+    assert main(["show", "v250", "--archive", str(root), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out) == json.loads(json.dumps(outcome.doc))
+    with pytest.raises(ArchiveError):
+        airgun_xl.show("nothing", root)
+
+
+def test_compare_names_the_differing_input_and_the_series(filled):
+    root, runs = filled
+    same = airgun_xl.compare("v200", "v200", root)
+    assert same.same and "inputs: the 23 parameter cells agree" in same.lines
+    differ = airgun_xl.compare("v200", "v250", root)
+    assert not differ.same and [c for c, *_ in differ.report.inputs] == ["A28", "A29", "A30"]
+
+
+def test_init_and_verify(tmp_path, filled):
+    made = archive.init(str(tmp_path / "new"))
+    assert made.lines == (f"made the archive {tmp_path / 'new'}, its index in the folder",)
+    root, _ = filled
+    clean = archive.verify(str(root))
+    assert clean.problems == () and clean.lines == (f"2 entries, 0 problems in {root}",)
+    summary = next(root.rglob("summary.json"))
+    summary.write_text(summary.read_text().replace("peak_kg", "peak_kG"))
+    broken = archive.verify(str(root))
+    assert len(broken.problems) == 1 and "summary.json" in broken.problems[0]
