@@ -160,3 +160,18 @@ def test_the_old_paths_still_import_with_a_deprecation_warning(old, new, name):
         warnings.simplefilter("ignore", DeprecationWarning)
         shim = importlib.import_module(f"airgun_xl.workbook.{old}")
     assert getattr(shim, name) is getattr(importlib.import_module(new), name)
+
+
+def test_no_function_of_the_cli_is_over_40_lines():
+    """Issue 44: the CLI parses into a request and prints the outcome; a function that grows
+    past 40 lines is composing work that belongs under app/."""
+    import ast
+
+    long = []
+    for path in sorted((PACKAGE / "cli").glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                size = node.end_lineno - node.lineno + 1
+                if size > 40:
+                    long.append(f"{path.name}:{node.name} ({size} lines)")
+    assert long == []

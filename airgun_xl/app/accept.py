@@ -259,3 +259,15 @@ def report_data(time: np.ndarray, kg: np.ndarray, spec: Specification,
         spectra.update(required=required, lower=required * 10 ** (spec.srs_lower_db / 20),
                        upper=required * 10 ** (spec.srs_upper_db / 20))
     return pulse, spectra
+
+
+def lines(request: AcceptRequest, outcome: AcceptOutcome) -> list[str]:
+    """What ``accept`` prints: where the verdict was kept, the verdict (a line a criterion),
+    the workbook, the equivalent half-sine and the pseudo-velocity."""
+    said = [] if outcome.archived is None else [f"  archived the verdict as {outcome.archived}"]
+    said += verdict_lines(outcome.verdict, f"{outcome.recording} against {request.shot}")
+    peak, duration = outcome.equivalent_half_sine
+    return said + [f"  wrote {outcome.output}",
+                   f"  equivalent half-sine (its SRS envelops the record's): {peak:.4f} kG, "
+                   f"{duration * 1e3:.4f} ms; pseudo-velocity up to "
+                   f"{outcome.peak_pseudo_velocity:.3f} m/s"]

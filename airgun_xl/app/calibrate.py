@@ -194,3 +194,58 @@ def _store(request: CalibrateRequest, root: Path, cal: Any) -> str:
     assert request.name is not None
     return str(store_law(root, request.name, cal.params[0].crush_law, shots_record, scores,
                          [display(a) for a in request.argv]))
+
+
+#: The exit status of a calibration that was written but cannot be vouched for (a value at a
+#: bound or not identified, a law not converged, a residual made worse): its warnings say why.
+UNTRUSTED = 3
+
+
+def lines(request: CalibrateRequest, outcome: CalibrateOutcome) -> list[str]:
+    """What ``calibrate`` prints: the workbook, the law recovered (its nodes' intervals), each
+    value fitted with its interval, each shot's residual before and after, the verdict, where
+    the law was stored."""
+    cal, output, n = outcome.calibration, outcome.output, len(outcome.calibration.before)
+    said = [f"wrote {output}: calibrated on {n} shot{'s' * (n > 1)} "
+            f"({cal.runs} runs, {cal.seconds:.2f} s)", *_law_lines(cal)]
+    for name, value in cal.fitted.items():
+        error = cal.errors[name]
+        said.append(f"  {name}: {cal.start[name]:.6g} -> {value:.6g} +/- {error:.3g} "
+                    f"(1 standard error; 95 %: {value - 1.96 * error:.6g} to "
+                    f"{value + 1.96 * error:.6g})")
+    for i, (before, after) in enumerate(zip(cal.before, cal.after, strict=True), start=1):
+        said.append(f"  shot {i}: RMS error {before.rms:.2%} -> {after.rms:.2%}; "
+                    f"ISO/TS 18571 {before.iso:.3f} -> {after.iso:.3f}")
+    said += [f"  note: {text}" for text in cal.notes]
+    if not outcome.trusted:
+        return said + [f"  verdict: NOT TRUSTED ({len(cal.warnings)} warning"
+                       f"{'s' * (len(cal.warnings) > 1)}, also in {output}); exit {UNTRUSTED}"]
+    said.append("  verdict: every fitted value identified, within its bounds, and every "
+                "shot's residual improved")
+    if outcome.stored is not None:
+        root = outcome.archive_shown
+        said.append(f"  stored the law as {outcome.stored} in {root} (fill --crush-law "
+                    f"{request.name} --archive {root})")
+    return said
+
+
+def _law_lines(cal: Any) -> list[str]:
+    """The law recovered: its convergence, range and intervals at its nodes."""
+    if cal.law_calibration is None:
+        return []
+    lc = cal.law_calibration
+    lo, hi = cal.params[0].crush_law.v_range
+    said = [f"  crush law: {'converged' if lc.converged else 'NOT converged'} in "
+            f"{len(lc.iterations)} iterations (last change {lc.iterations[-1].change:.2%}), "
+            f"then least squares; valid {lo:.1f} to {hi:.1f} m/s (the samples' span)",
+            "  crush law at its nodes, 95 % intervals (noise, baselines and alignment; not "
+            "model error):"]
+    for node in cal.law_intervals:
+        line = (f"    {node.velocity:6.1f} m/s: {node.value:.4f} ({node.low:.4f} to "
+                f"{node.high:.4f}, +/- {node.half_width:.1%})")
+        if node.weak:
+            line += f" WEAKLY PINNED by {node.pinned_by() or 'no shot in particular'}"
+            if node.suggested is not None:
+                line += f"; a shot at about {node.suggested:.0f} m/s would pin it best"
+        said.append(line)
+    return said

@@ -130,3 +130,25 @@ def run(request: CompareMeasuredRequest) -> CompareMeasuredOutcome:
     files = (request.output,) if request.output is not None else ()
     return CompareMeasuredOutcome(c, trace.name, tuple(trace.units), (request.model, other),
                                   request.output, files)
+
+
+def lines(request: CompareMeasuredRequest, outcome: CompareMeasuredOutcome) -> list[str]:
+    """What ``compare-measured`` prints: the alignment, each figure predicted against
+    measured, the ISO/TS 18571 rating, the baseline and the recorder's filter."""
+    c = outcome.comparison
+    said = [f"wrote {outcome.output}: {outcome.recording} against {request.shot} "
+            f"({len(c.time):,} samples, aligned by {request.align}, shift "
+            f"{c.shift * 1e3:.4f} ms)",
+            f"  peak {c.predicted.peak_kg:.4f} kG predicted, {c.measured.peak_kg:.4f} measured "
+            f"({c.errors['peak_kg']:+.2%}); pulse {c.predicted.pulse_duration * 1e3:.4f} ms, "
+            f"{c.measured.pulse_duration * 1e3:.4f} ({c.errors['pulse_duration']:+.2%})",
+            f"  velocity change {c.predicted.delta_v:.3f} m/s, {c.measured.delta_v:.3f} "
+            f"({c.errors['delta_v']:+.2%}); correlation r = {c.correlation:.4f}"]
+    r = c.iso
+    if r is not None:
+        said.append(f"  ISO/TS 18571 rating {r.overall:.3f} ({r.grade}): corridor "
+                    f"{r.corridor:.3f}, phase {r.phase:.3f}, magnitude {r.magnitude:.3f}, "
+                    f"slope {r.slope:.3f}")
+    said.append(f"  baseline: {c.baseline.words()}; impact at {c.level:.1%} of the peak; "
+                "anti-alias model " + (f"{c.anti_alias:,.0f} Hz" if c.anti_alias else "none"))
+    return said

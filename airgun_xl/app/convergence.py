@@ -109,3 +109,31 @@ def run(request: ConvergenceRequest) -> ConvergenceOutcome:
             png = None
         files = tuple(p for p in (request.output, png) if p is not None)
     return ConvergenceOutcome(ladders, request.output, png, files, tuple(warnings))
+
+
+def lines(request: ConvergenceRequest, outcome: ConvergenceOutcome) -> list[str]:
+    """What ``convergence`` prints: a table an integrator (each level's step, rows, times,
+    peak and crush with their errors and orders), Richardson's peak, the coarsest step
+    within the tolerance; the files."""
+    said = []
+    for lad in outcome.ladders:
+        said += [f"{lad.integrator} integrator:",
+                 f"  {'dt':>9} {'rows':>10} {'kernel s':>9} {'total s':>8} {'peak kG':>10} "
+                 f"{'rel.err':>9} {'order':>6} {'crush m':>8} {'rel.err':>9}"]
+        for lv in lad.levels:
+            order = lv.order.get("peak_kg")
+            said.append(f"  {lv.delta:9.3g} {lv.rows:10,} {lv.kernel_seconds:9.4f} "
+                        f"{lv.total_seconds:8.3f} {lv.figures['peak_kg']:10.5f} "
+                        f"{lv.errors['peak_kg']:9.2e} "
+                        f"{'' if order is None else f'{order:6.2f}':>6} "
+                        f"{lv.figures['max_crush']:8.5f} {lv.errors['max_crush']:9.2e}")
+        extrapolated = lad.richardson["peak_kg"]
+        finest = lad.levels[-1].figures["peak_kg"]
+        rec = lad.recommended
+        said += [f"  Richardson: peak {extrapolated:.5f} kG (finest level off by "
+                 f"{abs(finest - extrapolated) / abs(extrapolated):.1e})",
+                 f"  coarsest dt with peak within {lad.rtol:.1%} of the finest: "
+                 + (f"{rec:.3g} s" if not math.isnan(rec) else "none of the coarser levels")]
+    said.append(f"wrote {outcome.output} and {outcome.png}" if outcome.png else
+                f"wrote {outcome.output}")
+    return said

@@ -18,7 +18,7 @@ from typing import Any
 
 from ..transaction import SIGNALS, Interrupted, note_signal, on_signal, reset_signals
 
-__all__ = ["Interrupted", "command_signals", "interrupt_behind", "late_signal",
+__all__ = ["Interrupted", "archive_notices", "command_signals", "interrupt_behind", "late_signal",
            "quiet_full_disk"]
 
 
@@ -88,3 +88,11 @@ def quiet_full_disk(hook: Callable[[Any], Any]) -> Callable[[Any], Any]:
             return
         hook(unraisable)
     return quiet
+
+
+def archive_notices() -> list[str]:
+    """What the archive's index noticed while the command ran (a server role that may rewrite
+    history), taken so that the next in-process command starts clean; [] when no archive
+    was opened (the index is not loaded for that)."""
+    index = sys.modules.get("airgun_xl.archive.index")
+    return list(index.take_notices()) if index is not None else []

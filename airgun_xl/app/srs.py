@@ -109,3 +109,11 @@ def run(request: SrsRequest) -> SrsOutcome:
                   shot=Path(request.shot).name, warnings=warnings)
     files = (request.output,) if request.output is not None else ()
     return SrsOutcome(freqs, spectrum, q, request.output, files, tuple(warnings))
+
+
+def lines(request: SrsRequest, outcome: SrsOutcome) -> list[str]:
+    """What ``srs`` prints: the workbook, the band, Q and the largest level."""
+    level, frequency = outcome.largest
+    return [f"wrote {outcome.output}: SRS at {len(outcome.frequencies)} frequencies, "
+            f"{request.lo:g}-{request.hi:g} Hz, Q = {outcome.q:g}; largest {level:.4f} kG at "
+            f"{frequency:,.0f} Hz"]

@@ -194,3 +194,25 @@ def run(request: SweepRequest,
     return SweepOutcome(result, stats, sensitivity, seed, total, seconds,
                         steps / seconds if seconds > 0 else float("inf"), request.output,
                         files, tuple(warnings))
+
+
+def lines(request: SweepRequest, outcome: SweepOutcome) -> list[str]:
+    """What ``sweep`` prints: the shots run, how fast, how many diverged; the peak's range
+    over a grid or its spread over the draws; Sobol's indices."""
+    result, stats = outcome.result, outcome.stats
+    said = [f"wrote {outcome.output}: {outcome.shots:,} shots in {outcome.seconds:.2f} s "
+            f"({outcome.steps_per_second:.3g} shot-steps/s); {int(result.diverged.sum())} "
+            f"diverged, {int(result.invalid.sum())} invalid"]
+    if result.kind == "grid":  # every combination, not a distribution: its extremes
+        peaks = result.figures[:, 0][np.isfinite(result.figures[:, 0])]
+        if len(peaks):
+            said.append(f"  peak from {peaks.min():.4f} to {peaks.max():.4f} kG over the grid")
+    else:
+        said.append(f"  peak {stats['mean']:.4f} kG mean, sd {stats['sd']:.4f}, 5-95% "
+                    f"{stats['p5']:.4f}-{stats['p95']:.4f} kG (seed {request.seed})")
+    if outcome.sensitivity is not None:
+        found = outcome.sensitivity.indices["peak_kg"]
+        said.append("  Sobol indices of the peak: " + ", ".join(
+            f"{cell} S1 {s1:.3f} ST {st:.3f}" for cell, s1, st in
+            zip(outcome.sensitivity.cells, found["S1"], found["ST"], strict=True)))
+    return said

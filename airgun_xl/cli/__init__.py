@@ -12,6 +12,7 @@ import warnings
 
 from ..app.session import (
     Interrupted,
+    archive_notices,
     command_signals,
     interrupt_behind,
     late_signal,
@@ -43,13 +44,11 @@ def _run(args):
         QUIET.clear()
 
 
-def main(argv=None):
-    """Run the CLI; return the exit code (0 ok, 1 differences, 2 bad input, 128+N signal N)."""
+def _fresh(argv):
+    """What an earlier in-process command left is forgotten; the streams take any name."""
     _WARNED.clear()
     _LATER.clear()
-    archive_index = sys.modules.get("airgun_xl.archive.index")
-    if archive_index is not None:  # an earlier in-process command's
-        archive_index.take_notices()
+    archive_notices()  # an earlier in-process command's
     if argv is None:  # the command itself, not a caller's in-process run
         sys.unraisablehook = quiet_full_disk(sys.unraisablehook)
     for stream in (sys.stdout, sys.stderr):  # a file name may hold undecodable bytes
@@ -57,33 +56,42 @@ def main(argv=None):
         with contextlib.suppress(ValueError, OSError):
             if reconfigure is not None:
                 reconfigure(errors="backslashreplace")
+
+
+def _command(argv):
+    """Parse and run the command; after a success, what it must still say."""
+    from .commands import build_parser, joined_values
+
+    given = sys.argv[1:] if argv is None else argv
+    parser = build_parser()
+    args = parser.parse_args(joined_values(given))
+    args.argv = ["airgun-xl", *given]
+    if args.command is None:  # the usage goes with the exit status, to stderr (23.26)
+        parser.print_help(sys.stderr)
+        return 2
+    with warnings.catch_warnings(record=True) as caught:  # libraries' own (23.23)
+        warnings.simplefilter("always")
+        for developers in (DeprecationWarning, PendingDeprecationWarning, FutureWarning,
+                           ImportWarning, ResourceWarning):  # not the user's business
+            warnings.simplefilter("ignore", developers)
+        code = _run(args)
+    say_later()  # an old spelling's note: after a success, a refusal stays one line
+    # after a success, said as the tool's own warnings; a refusal drops them (one line)
+    warn(sorted({f"{w.category.__name__} from a library: {str(w.message)[:300]}"
+                 for w in caught}))
+    warn(archive_notices())  # a server role that may rewrite history
+    if late_signal() is not None:
+        _say(f"airgun-xl: signal {late_signal()} arrived after the outputs were complete; "
+             "nothing was lost")
+    return code
+
+
+def main(argv=None):
+    """Run the CLI; return the exit code (0 ok, 1 differences, 2 bad input, 128+N signal N)."""
+    _fresh(argv)
     try:
         with command_signals(restore=argv is not None):  # before numpy and the engine load
-            from .commands import build_parser, joined_values
-
-            parser = build_parser()
-            args = parser.parse_args(joined_values(sys.argv[1:] if argv is None else argv))
-            args.argv = ["airgun-xl", *(sys.argv[1:] if argv is None else argv)]
-            if args.command is None:  # the usage goes with the exit status, to stderr (23.26)
-                parser.print_help(sys.stderr)
-                return 2
-            with warnings.catch_warnings(record=True) as caught:  # libraries' own (23.23)
-                warnings.simplefilter("always")
-                for developers in (DeprecationWarning, PendingDeprecationWarning, FutureWarning,
-                                   ImportWarning, ResourceWarning):  # not the user's business
-                    warnings.simplefilter("ignore", developers)
-                code = _run(args)
-            say_later()  # an old spelling's note: after a success, a refusal stays one line
-            # after a success, said as the tool's own warnings; a refusal drops them (one line)
-            warn(sorted({f"{w.category.__name__} from a library: {str(w.message)[:300]}"
-                         for w in caught}))
-            archive_index = sys.modules.get("airgun_xl.archive.index")  # loaded if used
-            if archive_index is not None:
-                warn(archive_index.take_notices())  # a server role that may rewrite history
-            if late_signal() is not None:
-                _say(f"airgun-xl: signal {late_signal()} arrived after the outputs were "
-                     "complete; nothing was lost")
-            return code
+            return _command(argv)
     except AirgunXlError as exc:
         _say(f"airgun-xl: error: {exc}")
         return exc.exit_code

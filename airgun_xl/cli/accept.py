@@ -51,29 +51,11 @@ def request_of(args):
 
 
 def run(args):
+    from ..app.accept import lines
     from ..app.accept import run as accept
-    from .messages import warn
+    from .messages import report
 
-    outcome = accept(request_of(args))
-    if args.json:
-        print(outcome.to_json())  # ASCII, control characters escaped
-        warn(list(outcome.warnings))
-        return 0 if outcome.passed else FAIL_EXIT
-    if outcome.archived is not None:
-        print(f"  archived the verdict as {outcome.archived}")
-    print_verdict(outcome.verdict, f"{outcome.recording} against {args.shot}")
-    print(f"  wrote {outcome.output}")
-    peak, duration = outcome.equivalent_half_sine
-    print(f"  equivalent half-sine (its SRS envelops the record's): {peak:.4f} kG, "
-          f"{duration * 1e3:.4f} ms; pseudo-velocity up to {outcome.peak_pseudo_velocity:.3f}"
-          " m/s")
-    warn(list(outcome.warnings))
-    return 0 if outcome.passed else FAIL_EXIT
-
-
-def print_verdict(verdict, what):
-    """The verdict, a line a criterion (:func:`airgun_xl.app.accept.verdict_lines`)."""
-    from ..app.accept import verdict_lines
-
-    for line in verdict_lines(verdict, what):
-        print(line)
+    request = request_of(args)
+    outcome = accept(request)
+    return report(outcome, lines(request, outcome), args.json,
+                  0 if outcome.passed else FAIL_EXIT)

@@ -10,9 +10,18 @@ from ..untrusted_json import printable
 from .run_options import ATOL_HELP, RTOL_HELP, add_force, tolerance
 from .vocabulary import One
 
+WHERE = f"DIR defaults to ${ENV}."
+
 
 def add_parser(sub):
-    where = f"DIR defaults to ${ENV}."
+    _add_history(sub)
+    _add_show(sub)
+    _add_compare(sub)
+    _add_archive(sub)
+
+
+def _add_history(sub):
+    where = WHERE
     h = sub.add_parser("history", help="list the runs stored in an archive, and its crush laws",
                        description=f"List archived runs with their key figures (peak, "
                                    f"filtered peak, pulse, crush, warnings, integrator, crush "
@@ -32,12 +41,20 @@ def add_parser(sub):
     add_force(h, "SHOTS.xlsx")
     h.add_argument("--json", action="store_true", help="print the list as JSON")
     h.set_defaults(run=run_history)
+
+
+def _add_show(sub):
+    where = WHERE
     s = sub.add_parser("show", help="print one archived run: inputs, figures, provenance",
                        description=f"Print one archived run. {where}")
     s.add_argument("entry", metavar="ENTRY", help="SHOT (its latest run), SHOT@VERSION or #ID")
     s.add_argument("--archive", metavar="DIR", action=One, help="the archive folder")
     s.add_argument("--json", action="store_true", help="print the run as JSON")
     s.set_defaults(run=run_show)
+
+
+def _add_compare(sub):
+    where = WHERE
     c = sub.add_parser("compare", help="diff two archived runs: inputs, then every series",
                        description=f"Compare two archived runs: the parameter cells first, "
                                    f"then every series of their full histories. Exit 0 when "
@@ -52,6 +69,10 @@ def add_parser(sub):
                    help="also write a workbook: the input cells that differ and the error table")
     add_force(c, "REPORT.xlsx")
     c.set_defaults(run=run_compare)
+
+
+def _add_archive(sub):
+    where = WHERE
     a = sub.add_parser("archive", help="archive maintenance: init, migrate, verify",
                        description=f"init: make a new archive in a new or empty folder, its "
                                    f"index in the folder (SQLite, one machine) or, with "

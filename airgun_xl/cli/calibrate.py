@@ -46,11 +46,6 @@ def add_parser(sub):
     p.set_defaults(run=run)
 
 
-#: The exit status of a calibration that was written but cannot be vouched for (a value at a
-#: bound or not identified, a law not converged, a residual made worse): its warnings say why.
-UNTRUSTED = 3
-
-
 def _pairs(values):
     if len(values) % 2:
         raise OptionError(f"calibrate: found {len(values)} files, expected pairs of "
@@ -75,60 +70,11 @@ def request_of(args):
 
 
 def run(args):
+    from ..app.calibrate import UNTRUSTED, lines
     from ..app.calibrate import run as calibrate
+    from .messages import report
 
-    outcome = calibrate(request_of(args))
-    if args.json:
-        from .messages import warn
-
-        print(outcome.to_json())
-        warn(list(outcome.warnings))
-        return 0 if outcome.trusted else UNTRUSTED
-    cal, output, n = outcome.calibration, outcome.output, len(outcome.calibration.before)
-    print(f"wrote {output}: calibrated on {n} shot{'s' * (n > 1)} "
-          f"({cal.runs} runs, {cal.seconds:.2f} s)")
-    _print_law(cal)
-    for name, value in cal.fitted.items():
-        print(f"  {name}: {cal.start[name]:.6g} -> {value:.6g} +/- {cal.errors[name]:.3g} "
-              f"(1 standard error; 95 %: {value - 1.96 * cal.errors[name]:.6g} to "
-              f"{value + 1.96 * cal.errors[name]:.6g})")
-    for i, (before, after) in enumerate(zip(cal.before, cal.after, strict=True), start=1):
-        print(f"  shot {i}: RMS error {before.rms:.2%} -> {after.rms:.2%}; ISO/TS 18571 "
-              f"{before.iso:.3f} -> {after.iso:.3f}")
-    for text in cal.notes:
-        print(f"  note: {text}")
-    if not outcome.trusted:
-        from .messages import warn
-
-        warn(list(outcome.warnings))
-        print(f"  verdict: NOT TRUSTED ({len(cal.warnings)} warning"
-              f"{'s' * (len(cal.warnings) > 1)}, also in {output}); exit {UNTRUSTED}")
-        return UNTRUSTED
-    print("  verdict: every fitted value identified, within its bounds, and every shot's "
-          "residual improved")
-    if outcome.stored is not None:
-        root = outcome.archive_shown
-        print(f"  stored the law as {outcome.stored} in {root} (fill --crush-law {args.name} "
-              f"--archive {root})")
-    return 0
-
-
-def _print_law(cal):
-    """The law recovered: its convergence, range and intervals at its nodes."""
-    if cal.law_calibration is None:
-        return
-    lc = cal.law_calibration
-    lo, hi = cal.params[0].crush_law.v_range
-    print(f"  crush law: {'converged' if lc.converged else 'NOT converged'} in "
-          f"{len(lc.iterations)} iterations (last change {lc.iterations[-1].change:.2%}), "
-          f"then least squares; valid {lo:.1f} to {hi:.1f} m/s (the samples' span)")
-    print("  crush law at its nodes, 95 % intervals (noise, baselines and alignment; not "
-          "model error):")
-    for node in cal.law_intervals:
-        line = (f"    {node.velocity:6.1f} m/s: {node.value:.4f} ({node.low:.4f} to "
-                f"{node.high:.4f}, +/- {node.half_width:.1%})")
-        if node.weak:
-            line += f" WEAKLY PINNED by {node.pinned_by() or 'no shot in particular'}"
-            if node.suggested is not None:
-                line += f"; a shot at about {node.suggested:.0f} m/s would pin it best"
-        print(line)
+    request = request_of(args)
+    outcome = calibrate(request)
+    return report(outcome, lines(request, outcome), args.json,
+                  0 if outcome.trusted else UNTRUSTED)

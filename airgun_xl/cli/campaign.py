@@ -10,31 +10,34 @@ from ..errors import CampaignError
 from ..untrusted_json import printable
 
 
+def _said(row, bar):
+    """A shot's outcome as it comes: its error, its skip or its warnings; the bar moves."""
+    from .messages import _say, note, warn
+
+    name = row["file"]
+    if row["status"] in ("failed", "lost"):  # named once, though the message may name it
+        message = str(row["message"])
+        if row["status"] == "lost":
+            message = f"lost: {message}"
+        _say(f"airgun-xl: error: {message}" if message.startswith(f"{name}: ") else
+             f"airgun-xl: error: {name}: {message}")
+    elif row["status"] == "skipped":
+        note([f"{name}: skipped, {row['message']}"])  # exists, or its row was lost
+    else:
+        warn([f"{name}: {w}" for w in row["warnings"]])
+    bar.update(row["status"] in ("failed", "lost"))
+
+
 def run_batch(args, settings):
     from ..app.campaign import CampaignRequest, checked_files, run
-    from .messages import _say, note, warn
+    from .messages import _say
     from .progress import CountBar
 
     request = CampaignRequest(tuple(args.shots), settings, args.jobs, args.summary)
     files, jobs = checked_files(request)
     bar = CountBar(len(files), enabled=False if args.json else None)
-
-    def said(row):  # each shot's outcome as it comes
-        name = row["file"]
-        if row["status"] in ("failed", "lost"):  # named once, though the message may name it
-            message = str(row["message"])
-            if row["status"] == "lost":
-                message = f"lost: {message}"
-            _say(f"airgun-xl: error: {message}" if message.startswith(f"{name}: ") else
-                 f"airgun-xl: error: {name}: {message}")
-        elif row["status"] == "skipped":
-            note([f"{name}: skipped, {row['message']}"])  # exists, or its row was lost
-        else:
-            warn([f"{name}: {w}" for w in row["warnings"]])
-        bar.update(row["status"] in ("failed", "lost"))
-
     try:
-        outcome = run(request, said, (files, jobs))
+        outcome = run(request, lambda row: _said(row, bar), (files, jobs))
     except Interrupted as exc:
         bar.close()
         done = [r for r in getattr(exc, "rows", []) if r["status"] == "filled"]

@@ -30,35 +30,16 @@ def add_parser(sub):
 
 
 def run(args):
-    from ..app.compare_measured import CompareMeasuredRequest
+    from ..app.compare_measured import CompareMeasuredRequest, lines
     from ..app.compare_measured import run as compare_measured
-    from .messages import warn
+    from .messages import report
 
     shot_path = Path(args.shot)
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".measured.xlsx")
-    outcome = compare_measured(CompareMeasuredRequest(
+    request = CompareMeasuredRequest(
         shot_path, args.measured, args.cfc, args.align, args.anti_alias, args.sign,
         args.time_unit, args.accel_unit, args.channel, args.integrator, args.model, output,
-        args.force, args.crush_law, Path(args.archive) if args.archive else None))
-    if args.json:
-        print(outcome.to_json())
-        warn(list(outcome.warnings))
-        return 0
-    c = outcome.comparison
-    print(f"wrote {output}: {outcome.recording} against {args.shot} ({len(c.time):,} "
-          f"samples, aligned by {args.align}, shift {c.shift * 1e3:.4f} ms)")
-    print(f"  peak {c.predicted.peak_kg:.4f} kG predicted, {c.measured.peak_kg:.4f} measured "
-          f"({c.errors['peak_kg']:+.2%}); pulse {c.predicted.pulse_duration * 1e3:.4f} ms, "
-          f"{c.measured.pulse_duration * 1e3:.4f} ({c.errors['pulse_duration']:+.2%})")
-    print(f"  velocity change {c.predicted.delta_v:.3f} m/s, {c.measured.delta_v:.3f} "
-          f"({c.errors['delta_v']:+.2%}); correlation r = {c.correlation:.4f}")
-    r = c.iso
-    if r is not None:
-        print(f"  ISO/TS 18571 rating {r.overall:.3f} ({r.grade}): corridor {r.corridor:.3f}, "
-              f"phase {r.phase:.3f}, magnitude {r.magnitude:.3f}, slope {r.slope:.3f}")
-    print(f"  baseline: {c.baseline.words()}; impact at {c.level:.1%} of the peak; "
-          "anti-alias model "
-          + (f"{c.anti_alias:,.0f} Hz" if c.anti_alias else "none"))
-    warn(list(outcome.warnings))
-    return 0
+        args.force, args.crush_law, Path(args.archive) if args.archive else None)
+    outcome = compare_measured(request)
+    return report(outcome, lines(request, outcome), args.json)

@@ -23,6 +23,20 @@ def add_parser(sub):
                                    "setting most likely to pass, its probability with a 95 % "
                                    "interval, and exit 3 when no setting reaches P.")
     p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
+    _add_targets(p)
+    add_run_options(p)
+    add_output(p, "designed shot, filled", "SHOT.design.xlsx")
+    add_force(p)
+    add_cluster_options(p)
+    add_spec_options(p)
+    _add_first_shot(p)
+    add_crush_law(p)
+    add_json(p, "the design")
+    p.set_defaults(run=run)
+
+
+def _add_targets(p):
+    """What is solved for, and to which target."""
     target = p.add_mutually_exclusive_group()
     target.add_argument("--target-peak", metavar="PEAK",
                         help="requested peak: 12kG, 11750g or 1.2e5m/s2")
@@ -41,11 +55,10 @@ def add_parser(sub):
     p.add_argument("--range", metavar="LO:HI",
                    help="search range of the (first) varied parameter, in its unit")
     p.add_argument("--filtered", action="store_true", help="match the filtered peak")
-    add_run_options(p)
-    add_output(p, "designed shot, filled", "SHOT.design.xlsx")
-    add_force(p)
-    add_cluster_options(p)
-    add_spec_options(p)
+
+
+def _add_first_shot(p):
+    """First-shot success: the confidence asked, the scatter, the Monte Carlo's size."""
     first = p.add_argument_group("first-shot success (with a specification, no --target-*)")
     first.add_argument("--confidence", type=float, metavar="P",
                        help="find the setting most likely to pass with the scatter of --sd, "
@@ -56,9 +69,6 @@ def add_parser(sub):
     first.add_argument("--shots", type=int, default=10_000, metavar="N",
                        help="Monte Carlo shots a setting (default 10,000)")
     first.add_argument("--seed", type=int, default=1, help="of the draws (default 1)")
-    add_crush_law(p)
-    add_json(p, "the design")
-    p.set_defaults(run=run)
 
 
 def request_of(args):

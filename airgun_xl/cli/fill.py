@@ -29,6 +29,15 @@ def add_parser(sub):
     p.add_argument("--summary", metavar="DAY.xlsx",
                    help="also write the campaign's table: one row a shot, the peak against "
                         "v0, every warning")
+    _add_outputs(p)
+    _add_run(p)
+    add_spec_options(p)
+    add_json(p, "the filled shot (a campaign's rows)")
+    p.set_defaults(run=run)
+
+
+def _add_outputs(p):
+    """What the workbook holds: the options over its Outputs sheet."""
     p.add_argument("--host", choices=HOSTS, default="excel",
                    help="whose Offset rounding the filtered column reproduces when 1/(E2*E34) "
                         "is fractional (default: excel)")
@@ -41,6 +50,10 @@ def add_parser(sub):
     p.add_argument("--sidecar", choices=SIDECAR_MODES,
                    help="full time history beside the output: auto (when rows are left out), "
                         "always or never")
+
+
+def _add_run(p):
+    """How the shot runs, and where it is archived."""
     add_integrator(p)
     p.add_argument("--allow-unstable", action="store_true",
                    help="run even when the time step is above the critical step (a diverging "
@@ -61,9 +74,6 @@ def add_parser(sub):
                                   "label in the sheet, else SHOT's file name)")
     p.add_argument("--reproducible", action="store_true",
                    help="leave run times out of the Summary, so equal inputs give equal bytes")
-    add_spec_options(p)
-    add_json(p, "the filled shot (a campaign's rows)")
-    p.set_defaults(run=run)
 
 
 def print_summary(output, filled):

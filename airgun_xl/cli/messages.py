@@ -55,3 +55,13 @@ def warn(messages):
         if line not in _WARNED:
             _WARNED.add(line)
             _say(line)
+
+
+def report(outcome, lines, as_json=False, code=0):
+    """Print a command's outcome (its JSON document with ``--json``, else ``lines``, each
+    made printable), then its warnings on stderr; return ``code``, the exit status."""
+    from ..untrusted_json import printable
+
+    print(outcome.to_json() if as_json else "\n".join(printable(line) for line in lines))
+    warn(list(outcome.warnings))
+    return code

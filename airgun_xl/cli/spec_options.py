@@ -39,6 +39,19 @@ def add_spec_options(p, cfc=True):
                         "20%%")
     g.add_argument("--time-slack", action=Once, metavar="PCT",
                    help="time slack of the corridor, %% of the duration: 10%% (default 0%%)")
+    _add_windows(g)
+    if cfc:
+        g.add_argument("--cfc", type=cfc_value, default=None, metavar="N|none",
+                       action=CfcOption, help=RECORD_HELP)
+    g.add_argument("--record", type=record_value, metavar="unfiltered|cfcN", dest="cfc",
+                   action=RecordAlias)
+    _add_srs(g)
+
+
+def _add_windows(g):
+    """Where the velocity change and the corridor are judged, and how the pulse is read."""
+    from .vocabulary import Once
+
     g.add_argument("--dv-window", action=Once, metavar="BEFORE,AFTER",
                    help="the velocity change's window before and after the pulse, in time or"
                         " in nominal durations: 0.4D,0.1D or 1ms,0.5ms (default 0.5D,0.5D)")
@@ -55,11 +68,12 @@ def add_spec_options(p, cfc=True):
                         "10%% (the default)")
     g.add_argument("--placement", action=Once, metavar="|".join(PLACEMENTS),
                    help="where the ideal pulse sits: least squares (default) or on the peak")
-    if cfc:
-        g.add_argument("--cfc", type=cfc_value, default=None, metavar="N|none",
-                       action=CfcOption, help=RECORD_HELP)
-    g.add_argument("--record", type=record_value, metavar="unfiltered|cfcN", dest="cfc",
-                   action=RecordAlias)
+
+
+def _add_srs(g):
+    """An SRS requirement and its tolerance."""
+    from .vocabulary import Once
+
     g.add_argument("--srs", action=Once, metavar="REQ.csv",
                    help="an SRS requirement (CSV: 'frequency [Hz],srs [g]')")
     g.add_argument("--srs-tol", action=Once, metavar="LO,HI", help="its tolerance in dB: -3dB,+6dB "

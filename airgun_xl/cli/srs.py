@@ -40,23 +40,15 @@ def add_parser(sub):
 
 
 def run(args):
-    from ..app.srs import SrsRequest
+    from ..app.srs import SrsRequest, lines
     from ..app.srs import run as spectrum
-    from .messages import warn
+    from .messages import report
 
     shot_path = Path(args.shot)
     output = Path(args.output) if args.output else shot_path.with_name(
         shot_path.stem + ".srs.xlsx")
-    outcome = spectrum(SrsRequest(shot_path, args.srs_q, args.cfc, args.lo, args.hi,
-                                  args.integrator, args.model, output, args.force,
-                                  args.crush_law,
-                                  Path(args.archive) if args.archive else None))
-    if args.json:
-        print(outcome.to_json())
-        warn(list(outcome.warnings))
-        return 0
-    level, frequency = outcome.largest
-    print(f"wrote {output}: SRS at {len(outcome.frequencies)} frequencies, {args.lo:g}-"
-          f"{args.hi:g} Hz, Q = {outcome.q:g}; largest {level:.4f} kG at {frequency:,.0f} Hz")
-    warn(list(outcome.warnings))
-    return 0
+    request = SrsRequest(shot_path, args.srs_q, args.cfc, args.lo, args.hi, args.integrator,
+                         args.model, output, args.force, args.crush_law,
+                         Path(args.archive) if args.archive else None)
+    outcome = spectrum(request)
+    return report(outcome, lines(request, outcome), args.json)

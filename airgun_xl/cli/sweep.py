@@ -50,32 +50,11 @@ def request_of(args):
 
 
 def run(args):
+    from ..app.sweep import lines
     from ..app.sweep import run as sweep
-    from .messages import warn
+    from .messages import report
     from .progress import count_bar
 
-    outcome = sweep(request_of(args), None if args.json else count_bar)
-    if args.json:
-        print(outcome.to_json())
-        warn(list(outcome.warnings))
-        return 0
-    result, stats = outcome.result, outcome.stats
-    print(f"wrote {outcome.output}: {outcome.shots:,} shots in {outcome.seconds:.2f} s "
-          f"({outcome.steps_per_second:.3g} shot-steps/s); {int(result.diverged.sum())} "
-          f"diverged, {int(result.invalid.sum())} invalid")
-    if result.kind == "grid":  # every combination, not a distribution: its extremes
-        import numpy as np
-
-        peaks = result.figures[:, 0][np.isfinite(result.figures[:, 0])]
-        if len(peaks):
-            print(f"  peak from {peaks.min():.4f} to {peaks.max():.4f} kG over the grid")
-    else:
-        print(f"  peak {stats['mean']:.4f} kG mean, sd {stats['sd']:.4f}, 5-95% "
-              f"{stats['p5']:.4f}-{stats['p95']:.4f} kG (seed {args.seed})")
-    warn(list(outcome.warnings))
-    if outcome.sensitivity is not None:
-        found = outcome.sensitivity.indices["peak_kg"]
-        print("  Sobol indices of the peak: " + ", ".join(
-            f"{cell} S1 {s1:.3f} ST {st:.3f}" for cell, s1, st in
-            zip(outcome.sensitivity.cells, found["S1"], found["ST"], strict=True)))
-    return 0
+    request = request_of(args)
+    outcome = sweep(request, None if args.json else count_bar)
+    return report(outcome, lines(request, outcome), args.json)
