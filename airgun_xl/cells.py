@@ -113,6 +113,13 @@ BY_ADDRESS = {c.address: c for c in CELLS}
 BY_ADDRESS[UNUSED_K1] = Cell(UNUSED_K1, "k1", "K1", "N/m", "not read by the macro", "any", 0.0)
 BY_NAME = {c.name: c for c in CELLS}
 
+
+def address(name: str) -> str:
+    """The cell that holds the shot's field ``name``: ``address("delta") == "E2"``. Code names
+    a parameter cell through this (or :data:`BY_NAME`), never by a literal address, so the
+    table stays the one place that knows the layout (tests/test_cell_table.py)."""
+    return BY_NAME[name].address
+
 #: Most steps a run may take: ~100 bytes a step keep 5e7 steps within a few GB of memory.
 MAX_STEPS = 50_000_000
 

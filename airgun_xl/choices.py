@@ -4,6 +4,7 @@ The CLI builds its parser from these before anything heavy loads, so ``airgun-xl
 or ``--help`` starts without the engine and the workbook libraries. The modules that implement
 each choice import their names from here (and a test checks that they implement all of them).
 """
+from .cells import address
 
 #: Integrators (``airgun_xl.engine.integrators.INTEGRATORS``).
 INTEGRATORS = ("legacy", "newmark")
@@ -25,8 +26,10 @@ TRACKED = ("crush_factor", "m31", "deflection", "x_plastic", "force", "m1", "v1"
 #: When a fill writes the full history beside the workbook.
 SIDECAR_MODES = ("auto", "always", "never")
 
-#: Parameters ``design`` can solve for (``airgun_xl.studies.design.VARIABLES``).
-DESIGN_VARIABLES = ("A28", "E13", "E16", "E40", "A2")
+#: Parameters ``design`` can solve for (``airgun_xl.studies.design.VARIABLES``): the bird's
+#: velocity (A28, A29 and A30 together), the mitigator's radius and wedge, the lot's crush
+#: stress, the MEM's mass.
+DESIGN_VARIABLES = tuple(address(name) for name in ("v31", "rcone", "hcone", "sigmay", "m1"))
 
 #: The environment variable that names the default archive folder.
 ARCHIVE_ENV = "AIRGUN_XL_ARCHIVE"

@@ -11,7 +11,7 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields, replace
 from typing import Any
 
-from .cells import BY_NAME, CELLS, MAX_STEPS, expectation
+from .cells import BY_NAME, CELLS, MAX_STEPS, address, expectation
 from .choices import UNLOADINGS
 from .crush_law import LEGACY_LAW, CrushLaw
 from .errors import CellError, OptionError
@@ -87,8 +87,8 @@ def _blank(value):
 
 def bird_masses(raw):
     """The bird model a sheet's raw cells describe: 3, 2 or 1 masses (see ShotParams)."""
-    if _absent(raw.get("D2")) and _blank(raw.get("C6")):
-        if _absent(raw.get("C2")) and _blank(raw.get("B6")):
+    if _absent(raw.get(address("m33"))) and _blank(raw.get(address("k3"))):
+        if _absent(raw.get(address("m32"))) and _blank(raw.get(address("k2"))):
             return 1
         return 2
     return 3
@@ -179,10 +179,12 @@ class ShotParams:
         """
         raw = dict(raw_by_address)
         masses = bird_masses(raw)
-        reduced = {3: (), 2: ("D2", "C6"), 1: ("C2", "D2", "B6", "C6")}[masses]
-        for address in reduced:
-            raw[address] = 0.0  # the model leaves these masses and springs out
-        for mass, velocity, previous in (("C2", "A29", "A28"), ("D2", "A30", "A29")):
+        left_out = {3: (), 2: ("m33", "k3"), 1: ("m32", "m33", "k2", "k3")}[masses]
+        reduced = tuple(address(name) for name in left_out)
+        for cell in reduced:
+            raw[cell] = 0.0  # the model leaves these masses and springs out
+        for mass, velocity, previous in ((address(m), address(v), address(w)) for m, v, w in
+                                         (("m32", "v32", "v31"), ("m33", "v33", "v32"))):
             if mass in reduced and raw.get(velocity) is None:
                 raw[velocity] = raw.get(previous)  # a left-out mass moves with its neighbour
         values: dict[str, Any] = {

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ..cells import address
 from ..errors import OptionError
 from ..specification import parse_target
 from .running import cluster_runner, shots_progress
@@ -123,7 +124,7 @@ def _range(text: str) -> tuple[float, float]:
 
 
 def _label(var: Any) -> str:
-    return f"{var.cell}{'..A30' if var.cell == 'A28' else ''}"
+    return var.cell if len(var.cells) == 1 else f"{var.cells[0]}..{var.cells[-1]}"
 
 
 def run(request: DesignRequest, warn: Say | None = None, note: Say | None = None,
@@ -167,7 +168,7 @@ def _solve_target(request: DesignRequest) -> tuple[Shot, Design, list[str], dict
     target = parse_target("peak", request.target_peak, "--target-peak")
     duration = parse_target("duration", request.target_duration, "--target-duration") \
         if request.target_duration else None
-    variables = [variable(n) for n in request.vary or ("A28",)]
+    variables = [variable(n) for n in request.vary or (address("v31"),)]
     if duration is not None and len(variables) != 2:
         raise OptionError("--target-duration: found one --vary, expected two (the first meets "
                           "the peak, the second the duration)")
@@ -211,7 +212,7 @@ def _solve_srs(request: DesignRequest) -> tuple[Shot, Design, list[str], dict[st
                           "the spectrum, or a peak and a duration")
     if len(request.vary) > 1:
         raise OptionError("--vary: found two parameters, expected one with --target-srs")
-    var = variable((request.vary or ("A28",))[0])
+    var = variable((request.vary or (address("v31"),))[0])
     # the SRS's quality factor (default 10) [-], by the grammar every command reads it with
     q = 10.0 if request.spec.srs_q is None else parse_q(request.spec.srs_q, "--srs-q")
     bounds = _range(request.range) if request.range else None
@@ -262,7 +263,7 @@ def _solve_spec(request: DesignRequest, shots_progress_for: Callable[[int], Any]
     if len(request.vary) > 1:
         raise OptionError("--vary: found two parameters, expected one for a design by the "
                           "specification")
-    var = variable((request.vary or ("A28",))[0])
+    var = variable((request.vary or (address("v31"),))[0])
     bounds = _range(request.range) if request.range else None
     sds = _check_spec_options(request)
     if request.output is not None:  # before the study
@@ -387,7 +388,7 @@ def with_cells(shot: Shot, design: Design) -> Shot:
     assert isinstance(design.params, ShotParams)
     block = dict(shot.source.block)
     for var, value in zip(design.variables, design.values, strict=True):
-        for address in var.cells:
-            block[coordinate_to_tuple(address)] = (float(value), None)
+        for cell in var.cells:
+            block[coordinate_to_tuple(cell)] = (float(value), None)
     source = dataclasses.replace(shot.source, block=block)
     return dataclasses.replace(shot, params=design.params, source=source)

@@ -151,9 +151,9 @@ def displacement_bound(p):
 def no_wedge_error(p, row):
     """E16 = 0 and a loading step before the plastic front has moved: the wedge's area is
     0/0 there. The macro stops with "Division by zero"; the kernel gets NaN and stops."""
-    from ..cells import BY_ADDRESS
+    from ..cells import BY_NAME
 
-    c = BY_ADDRESS["E16"]
+    c = BY_NAME["hcone"]
     return CellError(c.address, c.label,
                      f"0 with the plastic front not yet moved on a loading step (row "
                      f"{row + 2}, t = {(row - 1) * p.delta:.4g} s), where the macro divides 0/0 "

@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 
+from ..cells import address
 from ..crush_law import LEGACY_LAW
 from ..studies.calibrate import AT_BOUND
 from ..transaction import display
@@ -34,10 +35,10 @@ from ..xlsx.shot_sheets import (
 )
 
 #: Fitted name -> (parameter cell (row, col), ShotParams field).
-CELLS = {"E40": ((40, 5), "sigmay"), "E43": ((43, 5), "zeta")}
+CELLS = {address("sigmay"): ((40, 5), "sigmay"), address("zeta"): ((43, 5), "zeta")}
 
 #: How the Fitted table shows each fitted value: a quantity code of the report layer.
-FITTED_CODES = {"E40": "Pa", "E43": "fraction", "scale": "ratio"}
+FITTED_CODES = {address("sigmay"): "Pa", address("zeta"): "fraction", "scale": "ratio"}
 
 #: Default columns and rows of each chart, right of the tables.
 CHART_COLS, CHART_ROWS = 10, 22

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..cells import address
 from ..crush_law import DEGREE, CrushLaw
 from ..errors import OptionError
 from .measured import KG_MS2, on_measured_grid, threshold_shift
@@ -43,7 +44,7 @@ FORCE_FLOOR = 0.2
 
 #: Fit names (cells, or the law's scale): the field they move, and their bounds relative to the
 #: start (None: zeta's absolute 0..0.5).
-FIT_PARAMETERS = {"E40": ("sigmay", 0.25, 4.0), "E43": ("zeta", None, None),
+FIT_PARAMETERS = {address("sigmay"): ("sigmay", 0.25, 4.0), address("zeta"): ("zeta", None, None),
                   "scale": ("scale", 0.25, 4.0)}
 OBJECTIVES = ("l2", "iso18571")
 
@@ -605,7 +606,7 @@ def check_fit(names, objective="l2"):
     if unknown or not names:
         raise OptionError(f"--fit: found {','.join(unknown) or 'nothing'}, expected names "
                           f"from {', '.join(FIT_PARAMETERS)}")
-    if "E40" in names and "scale" in names:
+    if address("sigmay") in names and "scale" in names:
         raise OptionError("--fit: found both E40 and scale, expected one of them: the yield "
                           "stress and the law's scale multiply the same crush force, so no "
                           "pulse can tell them apart")
@@ -640,7 +641,7 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
 
     names = check_fit(names, objective)
     p0 = pairs[0][0]
-    start = {"E40": p0.sigmay, "E43": p0.zeta, "scale": 1.0}
+    start = {address("sigmay"): p0.sigmay, address("zeta"): p0.zeta, "scale": 1.0}
     x0, lo, hi = [], [], []
     for n in names:
         _, low, high = FIT_PARAMETERS[n]
@@ -654,10 +655,10 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
         out = []
         for p, _ in pairs:
             changes = {}
-            if "E40" in values:
-                changes["sigmay"] = values["E40"]
-            if "E43" in values:
-                changes["zeta"] = values["E43"]
+            if address("sigmay") in values:
+                changes["sigmay"] = values[address("sigmay")]
+            if address("zeta") in values:
+                changes["zeta"] = values[address("zeta")]
             if "scale" in values:
                 changes["crush_law"] = p.crush_law.scaled(values["scale"])
             out.append(p.replace(**changes))
@@ -801,7 +802,7 @@ def verdict(cal, cfc, objective, p0):
         elif not error <= UNIDENTIFIED * abs(value):
             found.append(f"--fit {name}: {value:.6g} +/- {error:.3g} (1 standard error): the "
                          "pulses do not pin it down (not identified)")
-    if "E43" in cal.fitted and cfc:
+    if address("zeta") in cal.fitted and cfc:
         chain = (p0.m31, p0.m32, p0.m33)[:p0.bird_masses]
         springs = (-p0.k2, -p0.k3)[:p0.bird_masses - 1]
         lowest = min(natural_frequencies(chain, springs), default=np.inf)

@@ -3,7 +3,7 @@ stretched past what it was built for. Each finding names the cell that causes it
 import math
 from dataclasses import dataclass
 
-from ..cells import BY_ADDRESS, CELLS
+from ..cells import BY_ADDRESS, CELLS, address
 from ..engine.filtered import fractional_rows
 from ..engine.stability import WARN_RATIO, critical_time_step, full_length
 
@@ -18,6 +18,11 @@ class Finding:
     level: str
     cell: str
     message: str
+
+    @classmethod
+    def on(cls, level, field, message):
+        """A finding on the cell of the shot's field ``field`` (``"delta"``: E2)."""
+        return cls(level, address(field), message)
 
     def __str__(self):
         label = BY_ADDRESS[self.cell].label if self.cell in BY_ADDRESS else ""
@@ -38,15 +43,15 @@ def stability(p, integrator="legacy"):
     """
     crit = critical_time_step(p, chain=integrator == "legacy")
     if crit.ratio > 1:
-        return crit, Finding("error", "E2", f"{_fmt(p.delta)} is {crit.ratio:.3g} x the "
+        return crit, Finding.on("error", "delta", f"{_fmt(p.delta)} is {crit.ratio:.3g} x the "
                                             f"critical time step of the {integrator} scheme, "
                                             f"set by {crit.limiting}; the largest safe time "
                                             f"step is {_fmt(crit.dt_crit)}")
     if crit.unstable_length is not None:
-        return crit, Finding("warning", "E2", unloading_limit(p, crit, integrator)
+        return crit, Finding.on("warning", "delta", unloading_limit(p, crit, integrator)
                              + "; the run is watched and stops where it diverges")
     if crit.ratio > WARN_RATIO:
-        return crit, Finding("warning", "E2", f"{_fmt(p.delta)} is {crit.ratio:.2f} x the "
+        return crit, Finding.on("warning", "delta", f"{_fmt(p.delta)} is {crit.ratio:.2f} x the "
                                               f"critical time step ({_fmt(crit.dt_crit)}) of "
                                               f"the {integrator} scheme: close to unstable")
     return crit, None
@@ -73,7 +78,7 @@ def unloading_diverged(result, crit, integrator="legacy"):
     k = unloading_divergence(result.history)
     if k is None:
         return None
-    return Finding("error", "E2", f"the run diverges at row {k + 2:,} (t = "
+    return Finding.on("error", "delta", f"the run diverges at row {k + 2:,} (t = "
                    f"{result.history.time[k] * 1e3:.4g} ms): while the mitigator unloads, its "
                    f"deflection has oscillated with growing amplitude, alternating every step, "
                    f"for {DIVERGING_STEPS} steps; "
@@ -88,7 +93,7 @@ def impact_speed_finding(p):
     v_rel = p.v31 - p.v1
     if v_rel <= hi:
         return None
-    return Finding("warning", "A28", f"the bird meets the MEM at {v_rel:.4g} m/s, outside "
+    return Finding.on("warning", "v31", f"the bird meets the MEM at {v_rel:.4g} m/s, outside "
                    f"{lo:g}..{hi:g} m/s where {_law_words(p)} holds: it is "
                    f"extrapolated there (crush factor {p.crush_law(v_rel):.3g})")
 
@@ -107,26 +112,30 @@ def before_run(p, integrator="legacy"):
     if speed is not None:
         found.append(speed)
     if p.v1 == p.v31 == p.v32 == p.v33:
-        found.append(Finding("note", "A28", f"all masses start at {p.v31:g} m/s: nothing "
+        found.append(Finding.on("note", "v31", f"all masses start at {p.v31:g} m/s: nothing "
                              "crushes the mitigator, the response is free flight"))
     steps = p.max_time / p.delta
     if abs(steps - round(steps)) > 1e-9 * steps:
-        found.append(Finding("warning", "E6", f"E6/E2 = {steps!r} is not a whole number of "
+        found.append(Finding.on("warning", "max_time",
+                                f"E6/E2 = {steps!r} is not a whole number of "
                              f"steps; the macro's row count floor(E6/E2 + 2) gives {p.rows:,} "
                              "rows, ending before E6"))
     elif steps != round(steps):
-        found.append(Finding("note", "E6", f"E6/E2 = {steps!r} rounds below {round(steps)}: "
+        found.append(Finding.on("note", "max_time",
+                                f"E6/E2 = {steps!r} rounds below {round(steps)}: "
                              f"the macro's row count gives {p.rows:,} rows, not "
                              f"{round(steps) + 2:,}"))
     s = p.samplerate
     # below one row (s < 1) is the sub-row filter quirk, named by the run (engine.filtered)
     if 1 <= s and 2 * s >= p.rows - 2:
-        found.append(Finding("warning", "E34", f"1/(E2*E34) = {s:.6g} rows: the filter needs "
+        found.append(Finding.on("warning", "filter_frequency",
+                                f"1/(E2*E34) = {s:.6g} rows: the filter needs "
                              f"2 x that within the run's {p.rows:,} rows, so there is no "
                              "filtered column"))
     elif 1 <= s and not float(s).is_integer():
-        found.append(Finding("warning", "E34", fractional_rows(s)))
-    masses = {c: m for c, m in (("B2", p.m31), ("C2", p.m32), ("D2", p.m33)) if m > 0}
+        found.append(Finding.on("warning", "filter_frequency", fractional_rows(s)))
+    masses = {address(name): getattr(p, name) for name in ("m31", "m32", "m33")
+              if getattr(p, name) > 0}
     light = min(masses, key=lambda cell: masses[cell])
     heavy = max(list(masses.values()) + [p.m1 + p.mmitigator])
     if heavy / masses[light] >= MASS_RATIO_WARNING:
@@ -134,11 +143,11 @@ def before_run(p, integrator="legacy"):
                              f"{heavy / masses[light]:.2g} times lighter than the heaviest "
                              "mass: a stiff, badly scaled system (see the critical time step)"))
     if p.zeta == 0:
-        found.append(Finding("note", "E43", "zeta = 0: the OBR chain is undamped"))
+        found.append(Finding.on("note", "zeta", "zeta = 0: the OBR chain is undamped"))
     found += plausibility(p)
     if p.bird_masses < 3:
         cells = "D2 and C6 are" if p.bird_masses == 2 else "C2, D2, B6 and C6 are"
-        found.append(Finding("warning", "D2" if p.bird_masses == 2 else "C2",
+        found.append(Finding("warning", address("m33") if p.bird_masses == 2 else address("m32"),
                              f"{cells} blank: airgun-xl runs the {p.model.split(' (')[0]} "
                              "model, where the macro itself stops with 'Division by zero', so "
                              "there is no legacy output to compare with"))
@@ -171,7 +180,8 @@ def after_run(result):
         return []
     found = stats_findings(p, stats, quirk=False)
     if not math.isfinite(result.peak_kg):
-        found.append(Finding("warning", "E6", "no acceleration rows: the run is too short"))
+        found.append(Finding.on("warning", "max_time",
+                                "no acceleration rows: the run is too short"))
     return found + quirk_findings(result)
 
 
@@ -186,26 +196,28 @@ def stats_findings(p, stats, quirk=True):
     if not said and (stats.max_relative_velocity > hi or stats.min_relative_velocity < lo):
         worst = (stats.max_relative_velocity if stats.max_relative_velocity > hi
                  else stats.min_relative_velocity)
-        found.append(Finding("warning", "A28", f"while crushing, the relative velocity reached "
+        found.append(Finding.on("warning", "v31", f"while crushing, the relative velocity reached "
                              f"{worst:.4g} m/s, outside {lo:g}..{hi:g} m/s where "
                              f"{_law_words(p)} holds (crush factor "
                              f"{p.crush_law(worst):.3g} there)"))
     length = p.hcone + p.hcylinder
     if stats.x_plastic > length:
-        found.append(Finding("warning", "E19", f"the plastic front reached {stats.x_plastic:.4g}"
+        found.append(Finding.on("warning", "hcylinder",
+                                f"the plastic front reached {stats.x_plastic:.4g}"
                              f" m, past the end of the mitigator (E16 + E19 = {length:.4g} m): "
                              "it bottoms out, where the model no longer holds"))
     if stats.max_crushed_mass > p.mmitigator:
-        found.append(Finding("warning", "E25", f"the crushed honeycomb joining m31 reached "
+        found.append(Finding.on("warning", "mmitigator",
+                                f"the crushed honeycomb joining m31 reached "
                              f"{stats.max_crushed_mass:.4g} kg, more than the mitigator's "
                              f"{p.mmitigator:.4g} kg: more mass than the MEM can give"))
     if stats.max_crush > length:
-        found.append(Finding("warning", "E19", f"the mitigator is crushed by "
+        found.append(Finding.on("warning", "hcylinder", f"the mitigator is crushed by "
                              f"{stats.max_crush:.4g} m, more than its length E16 + E19 = "
                              f"{length:.4g} m: the final length {length - stats.max_crush:.4g} m "
                              "is negative, which no real mitigator reaches"))
     if quirk and p.unloading == "macro" and stats.second_onset >= 0:
-        found.append(Finding("warning", "E31", f"the macro's unloading-force quirk: the "
+        found.append(Finding.on("warning", "E", f"the macro's unloading-force quirk: the "
                              f"mitigator unloads again after reloading at row "
                              f"{stats.second_onset + 2:,}, where its force jumps; the figures "
                              "follow the quirk, not the physics"))
@@ -236,9 +248,9 @@ def quirk_findings(result):
     p, stats, found = result.params, result.history.stats, []
     quirk = unloading_quirk(result.history) if p.unloading == "macro" else None
     if quirk is not None:
-        found.append(Finding("warning", "E31", str(quirk)))
+        found.append(Finding.on("warning", "E", str(quirk)))
     if stats is not None and stats.past_bound is not None:
-        found.append(Finding("warning", "E2", f"from row {stats.past_bound + 2:,} the "
+        found.append(Finding.on("warning", "delta", f"from row {stats.past_bound + 2:,} the "
                              "displacements pass what any physical run reaches (the unloading "
                              "quirk's force): the run goes on as the macro's does, and its "
                              "figures are not to be trusted"))

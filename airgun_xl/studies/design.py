@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..cells import BY_NAME, address
 from ..engine.batch import run_batch
 from ..errors import DesignError, OptionError
 from ..models import apply_model
@@ -42,14 +43,20 @@ class Variable:
         return p.replace(**{f: float(x) for f in self.fields})
 
 
-VARIABLES = {
-    "A28": Variable("A28", "v0", "m/s", ("v31", "v32", "v33"), ("A28", "A29", "A30"),
-                    (10.0, 260.0)),
-    "E13": Variable("E13", "E13", "m", ("rcone",), ("E13",), (0.5, 2.0), True),
-    "E16": Variable("E16", "E16", "m", ("hcone",), ("E16",), (0.2, 3.0), True),
-    "E40": Variable("E40", "E40", "Pa", ("sigmay",), ("E40",), (0.5, 2.0), True),
-    "A2": Variable("A2", "A2", "kg", ("m1",), ("A2",), (0.25, 4.0), True),
-}
+def _variable(fields, search, relative=False, label=None):
+    """A variable over the cells of ``fields`` (the first names it, and gives its unit)."""
+    first = BY_NAME[fields[0]]
+    return Variable(first.address, label or first.address, first.unit, fields,
+                    tuple(address(f) for f in fields), search, relative)
+
+
+VARIABLES = {v.cell: v for v in (
+    _variable(("v31", "v32", "v33"), (10.0, 260.0), label="v0"),  # the bird, all three
+    _variable(("rcone",), (0.5, 2.0), True),
+    _variable(("hcone",), (0.2, 3.0), True),
+    _variable(("sigmay",), (0.5, 2.0), True),
+    _variable(("m1",), (0.25, 4.0), True),
+)}
 
 #: Points of the first scan over a parameter's range.
 SCAN_POINTS = 25
@@ -57,8 +64,8 @@ SCAN_POINTS = 25
 
 def variable(name):
     key = name.strip().upper()
-    if key in ("A29", "A30", "V0"):
-        key = "A28"
+    if key in (address("v32"), address("v33"), "V0"):
+        key = address("v31")
     if key not in VARIABLES:
         raise OptionError(f"--vary: found {name!r}, expected one of {', '.join(VARIABLES)}")
     return VARIABLES[key]
@@ -109,7 +116,7 @@ def _bracket(xs, ys, target):
 def _span_message(var, p, xs, ys, what):
     finite = ys[np.isfinite(ys)]
     lo, hi = var.bounds(p)
-    held = "" if var.cell == "E13" else f"with E13 = {p.rcone:.3g} m "
+    held = "" if var.cell == address("rcone") else f"with E13 = {p.rcone:.3g} m "
     if not len(finite):
         return f"{held}every shot diverged for {var.label} in {lo:.4g}-{hi:.4g} {var.unit}"
     return (f"{held}the {what} spans {finite.min():.3g}-{finite.max():.3g} kG for {var.label} "

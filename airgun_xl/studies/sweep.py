@@ -7,14 +7,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import limits
-from ..cells import BY_ADDRESS, CELLS
+from ..cells import BY_ADDRESS, CELLS, address
 from ..engine.batch import FIGURES, run_batch
 from ..errors import AirgunXlError, OptionError
 from ..models import apply_model
 from .check import shot_findings
 
 #: Cells whose value moves several fields: the bird's velocity goes to A28..A30 together.
-GROUPED = {"A28": ("v31", "v32", "v33")}
+GROUPED = {address("v31"): ("v31", "v32", "v33")}
 
 
 def fields_of(cell, option):

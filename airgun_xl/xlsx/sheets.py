@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..cells import address
 from ..engine.decimate import minmax_indices
 from ..engine.summary import PULSE_FRACTION, SPECTRUM_MAX_HZ
 from ..errors import OutputError
@@ -248,7 +249,7 @@ def _summary_rows(result, summary, prov):
          "", "" if p.crush_law.is_legacy else
          f"the archive's law {p.crush_law.source} (calibrate --archive --name)"
          if p.crush_law.source else "the Crush law sheet (airgun-xl calibrate)"),
-        ("Time step", p.delta, "step", "E2"),
+        ("Time step", p.delta, "step", address("delta")),
         ("Critical time step", prov.dt_crit
          if prov.dt_crit != float("inf") else "none: implicit in the OBR chain",
          "step", "largest step stable for the OBR chain, the springs that always act "
@@ -358,8 +359,8 @@ def write_summary(wb, result, summary, prov, name="Summary"):
 _CRUSH_FIGURES = ("Maximum crush", "Final mitigator length", "Final M1", "Final m31")
 _PULSE_FIGURES = ("Peak acceleration (raw)", "Time of peak", "Peak acceleration (filtered)",
                   "Time of filtered peak", "Pulse duration", "Pulse start", "Pulse end")
-_DOUBTED = {"E19": _CRUSH_FIGURES, "E25": _CRUSH_FIGURES[2:],
-            "E34": ("Peak acceleration (filtered)", "Time of filtered peak")}
+_DOUBTED = {address("hcylinder"): _CRUSH_FIGURES, address("mmitigator"): _CRUSH_FIGURES[2:],
+            address("filter_frequency"): ("Peak acceleration (filtered)", "Time of filtered peak")}
 
 
 def flagged_figures(warnings):
