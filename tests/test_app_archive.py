@@ -69,3 +69,10 @@ def test_init_and_verify(tmp_path, filled):
     summary.write_text(summary.read_text().replace("peak_kg", "peak_kG"))
     broken = archive.verify(str(root))
     assert len(broken.problems) == 1 and "summary.json" in broken.problems[0]
+
+
+def test_archive_verify_json_lists_the_problems(filled, capsys):
+    root, _ = filled
+    assert main(["archive", "verify", str(root), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["entries"] == 2 and doc["problems"] == [] and doc["archive"] == str(root)

@@ -12,6 +12,8 @@ from airgun_xl import units
 from airgun_xl.cli.spec_options import options_spec
 from airgun_xl.errors import AirgunXlError
 from airgun_xl.readers.recording import read_trace
+from airgun_xl.readers.spec_sheet import FIRST_ROW, ROWS
+from airgun_xl.readers.spec_sheet import spec_from_cells as sheet_spec
 from airgun_xl.specification import load_profile, parse_target
 
 
@@ -63,6 +65,17 @@ def _profile(text, folder):
         return str(exc).partition(": peak: ")[2]
 
 
+PEAK_ROW = FIRST_ROW + [name for name, _, _ in ROWS].index("peak")
+
+
+def _sheet(text):
+    """The Specification sheet's Peak cell holding ``text`` (as typed: a text cell)."""
+    try:
+        return sheet_spec({(PEAK_ROW, 2): (text, None)}).peak.nominal
+    except AirgunXlError as exc:
+        return str(exc).removeprefix(f"'Specification'!B{PEAK_ROW} (Peak): ")
+
+
 TEXT = st.one_of(st.text(max_size=14).filter(lambda t: ":" not in t and t.strip()),
                  st.sampled_from(["12kG", "12KG", "12kg", "11750g", "1.2e5m/s^2", "1.2e5m/s²",
                                   "9800m/s2", "12 kG", "-1kG", "+1kG", "0kG", "1e999kG",
@@ -72,8 +85,10 @@ TEXT = st.one_of(st.text(max_size=14).filter(lambda t: ":" not in t and t.strip(
 @settings(max_examples=200, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(text=TEXT)
-def test_an_option_a_profile_and_a_design_target_read_a_peak_alike(text, tmp_path):
-    """``--peak X``, a profile's ``"peak": X`` and ``design --target-peak X`` (a peak
-    without a tolerance): the same value, or the same refusal after the place's name."""
+def test_an_option_a_profile_a_sheet_and_a_design_target_read_a_peak_alike(text, tmp_path):
+    """``--peak X``, a profile's ``"peak": X``, the Specification sheet's Peak cell holding
+    the text X, and ``design --target-peak X`` (a peak without a tolerance): the same value,
+    or the same refusal after the place's name."""
     option, target, profile = _option(text), _target(text), _profile(text, tmp_path)
-    assert option == target == profile, (text, option, target, profile)
+    sheet = _sheet(text)
+    assert option == target == profile == sheet, (text, option, target, profile, sheet)

@@ -395,6 +395,15 @@ class MaintenanceOutcome:
 
     lines: tuple[str, ...]
     problems: tuple[str, ...] = ()
+    archive: str = ""  # the folder, as shown
+    entries: int | None = None  # verify: the entries checked
+
+    def to_json(self) -> str:
+        """``archive ... --json``: the archive, what was done, and verify's problems."""
+        from .documents import dumps
+
+        return dumps({"archive": self.archive, "entries": self.entries,
+                      "problems": self.problems, "lines": self.lines})
 
 
 def init(folder: str | None, index: str | None = None,
@@ -409,7 +418,8 @@ def init(folder: str | None, index: str | None = None,
     archive = Archive.init(root, index, server=server, writers=list(writers))
     where = (f"its index on {archive.index.shown}" if archive.index.kind == "server"
              else "its index in the folder")
-    return MaintenanceOutcome((f"made the archive {display(archive.root)}, {where}",))
+    return MaintenanceOutcome((f"made the archive {display(archive.root)}, {where}",),
+                              archive=display(archive.root))
 
 
 def migrate(folder: str | None, index: str | None,
@@ -420,7 +430,8 @@ def migrate(folder: str | None, index: str | None,
     backup = archive.migrate(index, list(writers))
     return MaintenanceOutcome((
         f"moved the index of {display(archive.root)} ({_count(before, 'entry', 'entries')}) "
-        f"to {archive.index.shown}; the SQLite index is kept as {backup.name}",))
+        f"to {archive.index.shown}; the SQLite index is kept as {backup.name}",),
+        archive=display(archive.root), entries=before)
 
 
 def verify(folder: str | None, index: str | None = None) -> MaintenanceOutcome:
@@ -432,4 +443,5 @@ def verify(folder: str | None, index: str | None = None) -> MaintenanceOutcome:
     lines = [f"problem: {p}" for p in problems]
     lines.append(f"{_count(len(entries), 'entry', 'entries')}, "
                  f"{_count(len(problems), 'problem', 'problems')} in {display(archive.root)}")
-    return MaintenanceOutcome(tuple(lines), tuple(problems))
+    return MaintenanceOutcome(tuple(lines), tuple(problems), display(archive.root),
+                              len(entries))

@@ -7,7 +7,7 @@ from ..app.archive import is_role
 from ..choices import ARCHIVE_ENV as ENV
 from ..choices import INDEX_ENV
 from ..untrusted_json import printable
-from .run_options import ATOL_HELP, RTOL_HELP, add_force, tolerance
+from .run_options import ATOL_HELP, RTOL_HELP, add_force, add_json, tolerance
 from .vocabulary import One
 
 WHERE = f"DIR defaults to ${ENV}."
@@ -97,6 +97,7 @@ def _add_archive(sub):
                    help="init and migrate on a server, run by the schema's owner: grant the "
                         "engineers' role what a writer needs and no more (read, add entries; "
                         "no update, delete or schema change); may be repeated")
+    add_json(a, "what was done (verify: every problem)")
     a.set_defaults(run=run_archive)
 
 
@@ -178,5 +179,8 @@ def run_archive(args):
         outcome = archive.migrate(args.dir, args.index, args.writers)
     else:
         outcome = archive.verify(args.dir, args.index)
-    _print(outcome.lines)
+    if args.json:
+        print(outcome.to_json())
+    else:
+        _print(outcome.lines)
     return 1 if outcome.problems else 0
