@@ -41,6 +41,7 @@ if TYPE_CHECKING:
     from .app.design import DesignOutcome
     from .app.diff import DiffOutcome
     from .app.fill import FillOutcome
+    from .app.next_shot import NextOutcome
     from .app.settings import FillSettings
     from .app.specifying import SpecKeywords
     from .app.srs import SrsOutcome
@@ -578,6 +579,44 @@ def compare(entry1: str, entry2: str, archive: str | os.PathLike[str] | None = N
         os.fspath(report) if report is not None else None, force))
 
 
+def next_shot(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
+              archive: str | os.PathLike[str], lot: str, new_lot: bool = False,
+              sd: str | Sequence[str] = (), confidence: float = 0.9, shots: int = 2000,
+              seed: int = 1, output: str | os.PathLike[str] | None = None, force: bool = False,
+              channel: str | None = None, sign: float = 1.0, time_unit: str | None = None,
+              accel_unit: str | None = None, integrator: str = "legacy",
+              **spec: Unpack[SpecKeywords]) -> NextOutcome:
+    """The closed loop, as ``airgun-xl next`` runs it: judge the fired ``shot``'s
+    ``recording``, update ``lot``'s law in ``archive`` on every shot of the lot, choose the
+    A28 most likely to pass with the gun's scatter (``sd=["A28=1.5%"]``) and the law drawn
+    from its update, write the next shot's workbook (``output``, else SHOT.next.xlsx) and keep
+    the verdict, the law's version and the proposal in the archive.
+
+    Returns
+    -------
+    airgun_xl.app.next_shot.NextOutcome
+        ``verdict`` (the fired shot's), ``update`` (the law's scale and its standard error),
+        ``law`` (its new version), ``setting`` [m/s], ``best`` (P(PASS) with its interval),
+        ``reached``, ``files``, ``warnings``.
+
+    Raises
+    ------
+    AirgunXlError
+        Bad input, named; nothing is written or recorded.
+    """
+    from pathlib import Path
+
+    from .app.next_shot import NextRequest, run
+    from .app.specifying import keyword_fields
+
+    fields = keyword_fields("next", dict(spec), accel_unit)
+    return run(NextRequest(
+        Path(shot), os.fspath(recording), Path(archive), lot, fields, new_lot, _texts(sd),
+        _number("--confidence", confidence), _whole("--shots", shots), _whole("--seed", seed),
+        channel, _number("--sign", sign), time_unit, accel_unit, integrator,
+        Path(output) if output is not None else None, force, ("next",)))
+
+
 __all__ = [
     "AirgunXlError",
     "ArchiveError",
@@ -606,6 +645,7 @@ __all__ = [
     "fill",
     "history",
     "load",
+    "next_shot",
     "show",
     "srs",
     "sweep",

@@ -28,7 +28,8 @@ from .errors import AirgunXlError
 
 #: The largest file read, by kind [bytes]: each is a few kilobytes when the tool writes it.
 MAX_BYTES = {"profile": 65_536, "law": 1 << 20, "verdict": 1 << 20, "summary": 4 << 20,
-             "params": 1 << 20, "provenance": 1 << 20, "manifest": 1 << 20, "marker": 4096}
+             "params": 1 << 20, "provenance": 1 << 20, "manifest": 1 << 20, "marker": 4096,
+             "proposal": 4 << 20}
 
 #: The deepest nesting of arrays and objects read (the tool writes 4 at most).
 MAX_DEPTH = 32
@@ -81,6 +82,33 @@ SCHEMAS: dict[str, dict] = {
                                           "description": "what the recording said of "
                                                          "itself, text by label"},
                        "created": _TEXT, "command": _TEXTS}},
+    "proposal": {
+        "type": "object", "description": "a lot's proposal (next)",
+        "required": ["lot", "shot", "verdict", "law", "setting_A28", "p_pass", "interval",
+                     "shots", "next_sha256"],
+        "properties": {
+            "lot": _TEXT, "shot": _TEXT, "recording": _TEXT,
+            "verdict": {"enum": ["PASS", "FAIL"]}, "law": _TEXT, "scale": _NUMBER,
+            "scale_error": _NUMBER_OR_NULL, "setting_A28": _NUMBER,
+            "p_pass": {"type": "number", "minimum": 0, "maximum": 1},
+            "interval": {"type": "array", "items": _NUMBER, "minItems": 2, "maxItems": 2},
+            "draws": {"type": "integer"}, "most_likely_to_fail": {"type": ["string", "null"]},
+            "confidence": _NUMBER, "reached": {"type": "boolean"}, "sd": _TEXTS,
+            "seed": {"type": "integer"}, "next_workbook": _TEXT,
+            "next_sha256": {"type": "string", "pattern": "^[0-9a-f]{64}$"},
+            "shots": {"type": "array", "items": {
+                "type": "object",
+                "required": ["shot", "shot_sha256", "recording", "recording_sha256"],
+                "properties": {"shot": _TEXT, "recording": _TEXT,
+                               "shot_sha256": {"type": "string", "pattern": "^[0-9a-f]{64}$"},
+                               "recording_sha256": {"type": "string",
+                                                    "pattern": "^[0-9a-f]{64}$"},
+                               "sign": {"enum": [1, -1, 1.0, -1.0]},
+                               "time_unit": {"type": ["string", "null"]},
+                               "accel_unit": {"type": ["string", "null"]},
+                               "channel": {"type": ["string", "null"]}}},
+                "description": "the lot's shots: each workbook and recording, with hashes"},
+            "warnings": _TEXTS, "created": _TEXT, "command": _TEXTS}},
     "summary": {
         "type": "object", "description": "an entry's figures",
         "properties": {

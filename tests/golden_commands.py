@@ -45,7 +45,8 @@ GOLDEN = ROOT / "tests" / "golden" / "commands.json"
 #: Lines for what the documents do not show: each command's help, the commands no block
 #: runs, and a refusal of each kind (run after the documents' blocks, in the same copy).
 COMMANDS = ("fill", "diff", "history", "show", "compare", "archive", "check", "convergence",
-            "design", "sweep", "srs", "compare-measured", "calibrate", "accept", "template")
+            "design", "sweep", "srs", "compare-measured", "calibrate", "accept", "next",
+            "template")
 EXTRA = (
     "airgun-xl --help",
     *(f"airgun-xl {command} --help" for command in COMMANDS),

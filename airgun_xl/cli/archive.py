@@ -30,6 +30,10 @@ def _add_history(sub):
     h.add_argument("dir", nargs="?", metavar="DIR",
                    help="old spelling of --archive DIR, kept one release")
     h.add_argument("--shot", metavar="NAME", help="only this shot's runs")
+    h.add_argument("--lot", metavar="NAME",
+                   help="a lot's chain instead (airgun-xl next): each shot fired, its "
+                        "verdict, the P(PASS) predicted for it, the law version, the next "
+                        "setting")
     h.add_argument("--since", metavar="DATE", help="only runs from this ISO date on, e.g. "
                                                    "2026-11-01")
     h.add_argument("--where", action="append", default=[], metavar="CELL=VALUE",
@@ -119,6 +123,8 @@ def _print(lines):
 def run_history(args):
     from ..app.archive import HistoryRequest, history
 
+    if args.lot is not None:
+        return _run_chain(args)
     outcome = history(HistoryRequest(_history_archive(args), args.shot, args.since,
                                      tuple(args.where), args.output, args.force))
     if args.json:  # the index row of each entry, with its figures and its law
@@ -127,6 +133,15 @@ def run_history(args):
         _print(outcome.lines)
     if outcome.wrote:
         print(outcome.wrote, file=sys.stderr if args.json else sys.stdout)
+    return 0
+
+
+def _run_chain(args):
+    from ..app.next_shot import chain, chain_lines
+
+    rows = chain(_history_archive(args), args.lot)
+    print(json.dumps(rows, indent=1) if args.json else "\n".join(
+        printable(line) for line in chain_lines(args.lot, rows)))
     return 0
 
 

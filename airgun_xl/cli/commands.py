@@ -15,6 +15,7 @@ from . import (
     design,
     diff,
     fill,
+    next_shot,
     srs,
     sweep,
     template,
@@ -22,7 +23,7 @@ from . import (
 from .spec_options import PLAIN_OPTIONS, QUANTITY_OPTIONS
 
 COMMANDS = (fill, diff, archive, check, convergence, design, sweep, srs, compare_measured,
-            calibrate, accept, template)
+            calibrate, accept, next_shot, template)
 
 
 class _Parser(argparse.ArgumentParser):

@@ -970,11 +970,15 @@ class BlockJudge:
 
     spec: Specification
     width: int = len(BLOCK_VALUES)
+    #: The noise at rest [kG, 1 sigma] of the recording the shots will be judged on: 0 judges
+    #: a prediction as it is; a fired shot's noise (the closed loop) judges the default
+    #: record as that shot's was judged (through the low-pass where the noise asks for it).
+    noise: float = 0.0
 
     def __call__(self, t: np.ndarray, kg: np.ndarray) -> np.ndarray:
         spec = self.spec.resolved()
         last = float(t[-1])  # a prediction: at rest before its first sample, known
-        t, kg, _ = judged_record(t, kg, spec)
+        t, kg, _ = judged_record(t, kg, spec, self.noise)
         values = judge_rows(t, kg, spec, recorded=(-math.inf, last))
         return np.column_stack([values.get(name, np.full(len(kg), np.nan))
                                 for name in BLOCK_VALUES])

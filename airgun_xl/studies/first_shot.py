@@ -81,13 +81,14 @@ class MiddleDesign:
                                                                      np.zeros(0)))
 
 
-def _run(p, var, xs, spec, integrator, model, runner):
+def _run(p, var, xs, spec, integrator, model, runner, noise=0.0):
     params = [apply_model(var.apply(p, x), model) for x in xs]
-    batch = (runner or run_batch)(params, integrator, extra=BlockJudge(spec))
+    batch = (runner or run_batch)(params, integrator, extra=BlockJudge(spec, noise=noise))
     return batch.extras
 
 
-def solve_middle(p, spec, var, bounds=None, integrator="legacy", model="4-mass", runner=None):
+def solve_middle(p, spec, var, bounds=None, integrator="legacy", model="4-mass", runner=None,
+                 noise=0.0):
     """The value of ``var`` with the largest smallest margin: a scan of :data:`SCAN_POINTS`,
     then a bounded search (scipy) between the best point's neighbours.
 
@@ -100,7 +101,7 @@ def solve_middle(p, spec, var, bounds=None, integrator="legacy", model="4-mass",
 
     lo, hi = bounds or var.bounds(p)
     xs = np.linspace(lo, hi, SCAN_POINTS)
-    ys = margins(_run(p, var, xs, spec, integrator, model, runner), spec)
+    ys = margins(_run(p, var, xs, spec, integrator, model, runner, noise), spec)
     if not np.isfinite(ys).any():
         raise DesignError(f"no {var.label} in {lo:.4g}-{hi:.4g} {var.unit} gives a pulse that "
                           "can be judged (every shot diverged)")
@@ -110,7 +111,8 @@ def solve_middle(p, spec, var, bounds=None, integrator="legacy", model="4-mass",
 
     def negative(x):
         count[0] += 1
-        return -float(margins(_run(p, var, [x], spec, integrator, model, runner), spec)[0])
+        return -float(margins(_run(p, var, [x], spec, integrator, model, runner, noise),
+                              spec)[0])
 
     found = minimize_scalar(negative, bounds=(a, b), method="bounded",
                             options={"xatol": 1e-6 * max(abs(a), abs(b), 1e-12)})
@@ -147,22 +149,33 @@ class PassProbability:
         return name, self.failures[name]
 
 
+#: The crush law's scale as a scattered quantity (issue 45): an ``sds`` entry
+#: ``(LAW_SCALE, LAW_FIELDS, sd, True)`` draws a factor around 1 that multiplies the whole law
+#: of each shot (a lot's law known to a standard error; see
+#: :mod:`airgun_xl.studies.closed_loop`).
+LAW_SCALE, LAW_FIELDS = "scale", ("crush_law",)
+
+
+def _mean(p, fields):
+    return 1.0 if fields == LAW_FIELDS else getattr(p, fields[0])
+
+
 def draws(p, sds, n, seed):
     """``n`` draws of the scattered cells: a (n, cells) array of values, and the cells'
-    fields (as :func:`airgun_xl.studies.sweep.monte_carlo` draws them)."""
+    fields (as :func:`airgun_xl.studies.sweep.monte_carlo` draws them; the law's scale, see
+    :data:`LAW_SCALE`, around 1)."""
     from .sweep import check_spreads
 
-    check_spreads(p, sds)
+    check_spreads(p, [sd for sd in sds if sd[1] != LAW_FIELDS])
     rng = np.random.default_rng(seed)
-    columns = [rng.normal(getattr(p, fields[0]),
-                          sd * abs(getattr(p, fields[0])) if relative else sd, n)
+    columns = [rng.normal(_mean(p, fields), sd * abs(_mean(p, fields)) if relative else sd, n)
                for _cell, fields, sd, relative in sds]
     return (np.column_stack(columns) if columns else np.zeros((n, 0)),
             [fields for _cell, fields, _sd, _rel in sds])
 
 
 def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator="legacy",
-                     model="4-mass", runner=None, progress=None, drawn=None):
+                     model="4-mass", runner=None, progress=None, drawn=None, noise=0.0):
     """The fraction of ``n`` shots that pass ``spec``, with ``var`` at ``setting`` (None: the
     sheet's) and the ``sds`` cells scattered (:func:`airgun_xl.studies.sweep.parse_sd`).
 
@@ -179,17 +192,23 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
     values, fields_list = drawn if drawn is not None else draws(p, sds, n, seed)
     base = var.apply(p, setting) if var is not None and setting is not None else p
     params, invalid = [], np.zeros(n, dtype=bool)
-    offsets = [(fields, getattr(base, fields[0]) - getattr(p, fields[0]))
-               for fields in fields_list]
+    offsets = [(fields, 0.0 if fields == LAW_FIELDS else
+                getattr(base, fields[0]) - getattr(p, fields[0])) for fields in fields_list]
     for i in range(n):
         try:
-            q = base.replace(**{f: float(value + shift) for (fields, shift), value
-                                in zip(offsets, values[i], strict=True) for f in fields})
-            params.append(apply_model(q, model))
+            changes = {f: float(value + shift) for (fields, shift), value
+                       in zip(offsets, values[i], strict=True) for f in fields
+                       if fields != LAW_FIELDS}
+            for (fields, _), value in zip(offsets, values[i], strict=True):
+                if fields == LAW_FIELDS:  # a scale at or below 0 is no law: not a shot
+                    if not value > 0:
+                        raise DesignError(f"a drawn law scale of {value:.3g}")
+                    changes["crush_law"] = base.crush_law.scaled(float(value))
+            params.append(apply_model(base.replace(**changes), model))
         except AirgunXlError:
             invalid[i] = True
     batch = (runner or run_batch)(params, integrator, progress=progress,
-                                  extra=BlockJudge(spec))
+                                  extra=BlockJudge(spec, noise=noise))
     flags = flags_of(batch.extras, spec)
     ok = np.ones(len(params), dtype=bool)
     for f in flags.values():
@@ -213,9 +232,10 @@ class ConfidenceDesign:
 
 
 def solve_confidence(p, spec, var, sds, n, seed=1, bounds=None, integrator="legacy",
-                     model="4-mass", runner=None, progress=None):
-    """The setting of ``var`` most likely to pass (see the module's notes)."""
-    middle = solve_middle(p, spec, var, bounds, integrator, model, runner)
+                     model="4-mass", runner=None, progress=None, noise=0.0):
+    """The setting of ``var`` most likely to pass (see the module's notes); ``noise`` [kG]:
+    the rest noise of the recordings the shots will be judged on (:class:`BlockJudge`)."""
+    middle = solve_middle(p, spec, var, bounds, integrator, model, runner, noise)
     xs, ys = middle.scan
     step = xs[1] - xs[0] if len(xs) > 1 else 0.0
     if middle.passing is not None:
@@ -227,12 +247,12 @@ def solve_confidence(p, spec, var, sds, n, seed=1, bounds=None, integrator="lega
     first_n = max(200, int(round(n * FIRST_ROUND)))
     drawn_first = draws(p, sds, first_n, seed)
     first = [pass_probability(p, spec, sds, first_n, seed, var, x, integrator, model, runner,
-                              progress, drawn_first) for x in candidates]
+                              progress, drawn_first, noise) for x in candidates]
     ranked = sorted(first, key=lambda r: -r.probability)
     finalists = sorted({r.setting for r in ranked[:FINALISTS]} | {middle.value})
     drawn = draws(p, sds, n, seed + 1)  # fresh draws: the first round's luck does not carry
     final = [pass_probability(p, spec, sds, n, seed + 1, var, x, integrator, model, runner,
-                              progress, drawn) for x in finalists]
+                              progress, drawn, noise) for x in finalists]
     best = max(final, key=lambda r: r.probability)
     mid = next(r for r in final if r.setting == middle.value)
     warnings = []

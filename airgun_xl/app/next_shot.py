@@ -1,0 +1,436 @@
+"""``next``: the closed loop (issue 45). A fired shot of a honeycomb lot is judged, the lot's
+law is updated by every shot of the lot, and the next shot's setting is chosen for the
+highest P(PASS) on what the lot is now known to be; the next shot's workbook is written, and
+the verdict, the law's new version and the proposal are kept in the archive.
+
+Everything that can be refused is refused before anything is written or recorded: the
+options, the lot (unknown without ``new_lot``), the specification (it needs tolerances), the
+gun's scatter, the lot's earlier shots (each file unchanged since it was recorded), the
+recording and the output.
+
+This first part updates the law's scale (a scale is what one shot, or shots at one speed,
+pins); the gun's scatter is the one given (``--sd A28=...``).
+"""
+from __future__ import annotations
+
+import dataclasses
+import datetime
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from ..cells import address
+from ..errors import OptionError
+from .specifying import SpecFields, require, resolve
+
+if TYPE_CHECKING:
+    from ..shot import Shot
+    from ..studies.acceptance import Verdict
+    from ..studies.closed_loop import LawUpdate
+    from ..studies.first_shot import PassProbability
+
+
+@dataclass(frozen=True)
+class NextRequest:
+    """The fired shot and its recording, the lot and its archive, the specification's
+    fields (over the shot's sheet and ``profile``), the gun's and zeta's scatter (``sd``:
+    ``A28=1.5%``, ``E43=10%``), the confidence asked, the Monte Carlo's size and seed, how the
+    recording is read, and where the next shot's workbook goes."""
+
+    shot: Path
+    recording: str
+    archive: Path
+    lot: str
+    spec: SpecFields = field(default_factory=SpecFields)
+    new_lot: bool = False
+    sd: tuple[str, ...] = ()
+    confidence: float = 0.9
+    shots: int = 2000
+    seed: int = 1
+    channel: str | None = None
+    sign: float = 1.0
+    time_unit: str | None = None
+    accel_unit: str | None = None
+    integrator: str = "legacy"
+    output: Path | None = None  # default SHOT.next.xlsx beside the shot
+    force: bool = False
+    argv: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class NextOutcome:
+    """The fired shot's verdict, the law's update and its new version, the setting chosen with
+    its P(PASS), whether it reaches the confidence asked, and every file and warning."""
+
+    verdict: Verdict
+    update: LawUpdate
+    law: str  # the law's new version, NAME@N
+    setting: float  # [m/s] A28..A30 of the next shot
+    best: PassProbability
+    confidence: float
+    reached: bool
+    counted_once: bool  # this shot was recorded in the lot before
+    output: Path
+    proposal: str  # the proposal's version, LOT@N
+    files: tuple[Path, ...]
+    warnings: tuple[str, ...]
+
+    def to_json(self) -> str:
+        """``next --json``: the verdict, the law's update, the setting and its P(PASS)."""
+        from .documents import dumps
+
+        lo, hi = self.best.interval
+        worst = self.best.most_failing()
+        return dumps({
+            "verdict": self.verdict.word,
+            "criteria": [dataclasses.asdict(c) for c in self.verdict.criteria],
+            "law": {"version": self.law, "scale": self.update.scale,
+                    "scale_standard_error": self.update.error, "shots": self.update.shots,
+                    "note": self.update.note},
+            "next": {"A28_m_s": self.setting, "p_pass": self.best.probability,
+                     "interval": [lo, hi], "draws": self.best.shots,
+                     "most_likely_to_fail": worst[0] if worst else None},
+            "confidence": self.confidence, "reached": self.reached,
+            "proposal": self.proposal, "files": self.files, "warnings": self.warnings})
+
+
+def default_output(shot: Path) -> Path:
+    return shot.with_name(shot.stem + ".next.xlsx")
+
+
+def run(request: NextRequest) -> NextOutcome:
+    """Judge, update, choose, write and record (see the module).
+
+    Raises
+    ------
+    airgun_xl.errors.AirgunXlError
+        Bad input, named; nothing is written or recorded.
+    """
+    from ..archive.lots import file_sha256
+    from ..readers.recording import input_file
+    from ..shot import Shot
+    from ..studies.closed_loop import law_scatter, update_scale
+
+    output = _checked(request)
+    shot = Shot.from_workbook(request.shot)
+    spec = require(resolve(shot, request.spec), request.shot)
+    _tolerances(spec)
+    sds = _scatter(request, shot)
+    prior, earlier = _lot(request)
+    this = {"shot": str(request.shot), "shot_sha256": file_sha256(request.shot),
+            "recording": str(request.recording),
+            "recording_sha256": file_sha256(input_file(request.recording)),
+            **_reading(request)}
+    counted_once = any((s["shot_sha256"], s["recording_sha256"]) ==
+                       (this["shot_sha256"], this["recording_sha256"]) for s in earlier)
+    lot_shots = earlier if counted_once else [*earlier, this]
+    verdict = _judge(request, spec)
+    params, traces = _read_lot(lot_shots)
+    update = update_scale(params, traces, prior, spec.judged.cfc, request.integrator)
+    p_next = shot.params.replace(crush_law=update.law)
+    best, conf_warnings = _choose(request, spec, p_next, [*sds, law_scatter(update)],
+                                  _noise(verdict))
+    reached = best.probability >= request.confidence and best.interval[1] >= request.confidence
+    warnings = list(dict.fromkeys([*map(str, shot.warnings), *verdict.warnings,
+                                   *update.warnings, *conf_warnings]))
+    if not reached:
+        warnings.append(f"next: no A28 in range reaches P(PASS) = {request.confidence:g}; the "
+                        f"best found is {best.probability:.4f} at {best.setting:.6g} m/s")
+    return _publish(request, output, shot, spec, verdict, update, best, reached, lot_shots,
+                    counted_once, warnings)
+
+
+def _checked(request: NextRequest) -> Path:
+    """The options refused before any work; the output's path."""
+    from ..archive import Archive
+    from ..archive.store import safe_name
+    from ..readers.recording import input_file
+    from ..transaction import check_output
+
+    if request.sign not in (1.0, -1.0):
+        raise OptionError(f"--sign: found {request.sign!r}, expected 1 or -1")
+    if not 0 < request.confidence < 1:
+        raise OptionError(f"--confidence: found {request.confidence!r}, expected a probability "
+                          "above 0 and below 1, such as 0.9")
+    if request.shots < 100:
+        raise OptionError(f"--shots: found {request.shots}, expected at least 100 Monte Carlo "
+                          "shots a setting")
+    if not request.lot or safe_name(request.lot) != request.lot:
+        raise OptionError(f"--lot: found {request.lot!r}, expected a lot name of letters, "
+                          "digits, '-', '_' and '.' (such as LOT-2026-07)")
+    output = request.output if request.output is not None else default_output(request.shot)
+    check_output(output, request.force, inputs=[request.shot, input_file(request.recording)])
+    Archive(request.archive, create=True, dry_run=True)  # a folder that is not one: refused
+    return output
+
+
+def _tolerances(spec: Any) -> None:
+    """A specification the loop can aim at: a peak or a duration with a tolerance."""
+    judged = [f for f in (spec.peak, spec.duration) if f is not None]
+    if not judged:
+        raise OptionError("next: found a specification without a peak or a duration, "
+                          "expected --peak and/or --duration with their tolerances (the loop "
+                          "aims A28 at them)")
+
+
+def _scatter(request: NextRequest, shot: Shot) -> list[Any]:
+    """The gun's scatter and zeta's, as given; the gun's is needed."""
+    from ..studies.sweep import parse_sds
+
+    sds = parse_sds(request.sd)
+    if not any(cell == address("v31") for cell, *_ in sds):
+        raise OptionError("--sd: found no A28 scatter, expected the gun's shot-to-shot "
+                          "scatter such as --sd A28=1.5% (and E43=10% for zeta's)")
+    if any(cell == address("sigmay") for cell, *_ in sds):
+        raise OptionError("--sd: found E40, expected the gun's (A28) and zeta's (E43) only: "
+                          "the lot's crush strength is the law's, drawn from its update")
+    return list(sds)
+
+
+def _lot(request: NextRequest) -> tuple[Any, list[dict[str, Any]]]:
+    """The lot's prior law (its latest version, or the report's law for a new lot) and its
+    shots so far (each file checked unchanged)."""
+    from ..archive.laws import load_law
+    from ..archive.lots import file_sha256, proposals
+    from ..archive.records import versions
+    from ..crush_law import LEGACY_LAW
+    from ..errors import ArchiveError
+
+    has_law = bool(versions(Path(request.archive) / ".laws" / request.lot))
+    chain = proposals(request.archive, request.lot)
+    if not has_law and not chain:
+        if not request.new_lot:
+            raise OptionError(f"--lot: found {request.lot!r}, which the archive "
+                              f"{request.archive} does not know, expected a lot it holds or "
+                              "--new-lot to start one from the report's law")
+        return LEGACY_LAW, []
+    if request.new_lot:
+        raise OptionError(f"--new-lot: found the lot {request.lot!r} in the archive already, "
+                          "expected a new lot's name (or no --new-lot to go on with it)")
+    prior, _record = load_law(request.archive, request.lot)
+    earlier = list(chain[-1][1]["shots"]) if chain else []
+    for s in earlier:
+        for key, what in (("shot", "workbook"), ("recording", "recording")):
+            try:
+                path = s[key] if key == "shot" else _recording_file(s[key])
+                same = file_sha256(path) == s[f"{key}_sha256"]
+            except (OSError, KeyError, TypeError):
+                same = False
+            if not same:
+                raise ArchiveError(f"{s.get(key, '?')}: the lot {request.lot}'s {what} "
+                                   "differs from the one recorded (or is gone), expected it "
+                                   "unchanged: the lot's law is fitted on the shots as fired")
+    return prior, earlier
+
+
+def _recording_file(text: str) -> str:
+    from ..readers.recording import input_file
+
+    return str(input_file(text))
+
+
+def _reading(request: NextRequest) -> dict[str, Any]:
+    return {"sign": request.sign, "time_unit": request.time_unit,
+            "accel_unit": request.accel_unit, "channel": request.channel}
+
+
+def _judge(request: NextRequest, spec: Any) -> Verdict:
+    """The fired shot judged as ``accept`` judges it (nothing written)."""
+    from .accept import AcceptRequest
+    from .accept import run as accept
+
+    outcome = accept(AcceptRequest(request.shot, request.recording, request.spec,
+                                   channel=request.channel, sign=request.sign,
+                                   time_unit=request.time_unit,
+                                   accel_unit=request.accel_unit, argv=request.argv))
+    return outcome.verdict
+
+
+def _read_lot(lot_shots: list[dict[str, Any]]) -> tuple[list[Any], list[Any]]:
+    """Each shot's parameters as set, and its recording as read."""
+    from ..readers.recording import read_trace
+    from ..shot import Shot
+
+    params = [Shot.from_workbook(s["shot"]).params for s in lot_shots]
+    traces = [read_trace(s["recording"], s.get("time_unit"), s.get("accel_unit"),
+                         float(s.get("sign", 1.0)), s.get("channel")) for s in lot_shots]
+    return params, traces
+
+
+def _noise(verdict: Verdict) -> float:
+    """The fired recording's noise at rest [kG, 1 sigma]: the next shot's recording is
+    expected as noisy, and its predictions are judged as it will be (through the default
+    record's low-pass where that noise asks for it, as this shot's was)."""
+    quality = verdict.quality
+    noise = float(quality.base.noise) if quality is not None else 0.0
+    return noise if math.isfinite(noise) and noise > 0 else 0.0
+
+
+def _choose(request: NextRequest, spec: Any, p: Any, sds: list[Any],
+            noise: float) -> tuple[PassProbability, list[str]]:
+    """The A28 most likely to pass, drawing the gun, zeta and the law, each prediction judged
+    as a recording of the fired shot's noise would be."""
+    from ..studies.design import variable
+    from ..studies.first_shot import solve_confidence
+
+    found = solve_confidence(p, spec, variable(address("v31")), sds, request.shots, request.seed,
+                             integrator=request.integrator, noise=noise)
+    return found.best, list(found.warnings)
+
+
+def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: Verdict,
+             update: LawUpdate, best: PassProbability, reached: bool,
+             lot_shots: list[dict[str, Any]], counted_once: bool,
+             warnings: list[str]) -> NextOutcome:
+    """Store the law's new version, write the next shot's workbook, keep the verdict and the
+    proposal; a failure takes back what was done."""
+    from ..archive import Archive
+    from ..archive.laws import store_law
+    from ..archive.lots import file_sha256, store_proposal
+    from ..archive.verdicts import StoredVerdict, store_verdict
+    from ..crush_law import CrushLaw
+    from ..transaction import signals_held
+
+    done: list[Any] = []
+    try:
+        with signals_held():
+            ref = store_law(request.archive, request.lot, update.law, lot_shots,
+                            [{"shot": s["shot"]} for s in lot_shots], request.argv)
+            version = int(ref.rpartition("@")[2])
+            done.append(StoredVerdict(Path(request.archive) / ".laws" / request.lot /
+                                      f"v{version:04d}.json", Archive(request.archive)))
+        law = CrushLaw(update.law.coefficients, update.law.v_range, "fitted", source=ref)
+        _write(request, output, shot, spec, verdict, update, best, law, ref, warnings)
+        done.append(output)
+        with signals_held():
+            done.append(store_verdict(request.archive, shot, verdict, request.recording,
+                                      output, request.argv))
+        lo, hi = best.interval
+        worst = best.most_failing()
+        record = {"lot": request.lot, "shot": str(request.shot),
+                  "recording": str(request.recording), "verdict": verdict.word,
+                  "law": ref, "scale": update.scale, "scale_error": update.error,
+                  "setting_A28": best.setting, "p_pass": best.probability,
+                  "interval": [lo, hi], "draws": best.shots,
+                  "most_likely_to_fail": worst[0] if worst else None,
+                  "confidence": request.confidence, "reached": reached,
+                  "sd": list(request.sd), "seed": request.seed,
+                  "next_workbook": str(output), "next_sha256": file_sha256(output),
+                  "shots": lot_shots, "warnings": warnings,
+                  "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+                  "command": list(request.argv)}
+        stored = store_proposal(request.archive, request.lot, record)
+        done.append(stored)
+    except BaseException:
+        for thing in reversed(done):
+            if isinstance(thing, Path):
+                thing.unlink(missing_ok=True)
+            else:
+                thing.take_back()
+        raise
+    proposal = f"{request.lot}@{int(stored.path.stem[1:])}"
+    return NextOutcome(verdict, update, ref, best.setting, best, request.confidence, reached,
+                       counted_once, output, proposal, (output,), tuple(warnings))
+
+
+def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: Verdict,
+           update: LawUpdate, best: PassProbability, law: Any, ref: str,
+           warnings: list[str]) -> None:
+    """The next shot's workbook: the chosen A28..A30, the lot's law (its Crush law sheet),
+    and on its Summary the prediction of P(PASS) and where it came from."""
+    from ..outputs import from_sheet
+    from ..studies.design import Design, variable
+    from .design import with_cells
+    from .fill import Options, fill_workbook
+
+    var = variable(address("v31"))
+    params = var.apply(shot.params.replace(crush_law=law), best.setting)
+    designed = with_cells(shot, Design([var], [best.setting], params, math.nan, math.nan,
+                                       best.shots))
+    designed = dataclasses.replace(designed, warnings=[])  # the fired shot's are its verdict's
+    lo, hi = best.interval
+    worst = best.most_failing()
+    notes = (f"next shot of lot {request.lot}: A28 = {best.setting:.6g} m/s, P(PASS) = "
+             f"{best.probability:.4f} (95 % interval {lo:.4f}-{hi:.4f}, {best.shots:,} draws "
+             f"of the gun ({', '.join(request.sd)}) and the law), seed {request.seed}",
+             f"most likely to fail: {worst[0] if worst else 'none'}",
+             f"the lot's law {ref}: the prior scaled by {update.scale:.4f} +/- "
+             f"{update.error:.4f} on {update.shots} shot{'s' * (update.shots > 1)}; "
+             f"{update.note}",
+             f"from {request.shot} ({verdict.word}), recording {request.recording}")
+    assert designed.source is not None
+    options = Options(request.integrator, force=request.force, command=request.argv,
+                      spec=spec, study_notes=notes)
+    said: list[str] = []
+    fill_workbook(designed, output, from_sheet(designed.source.outputs_block), options,
+                  said.extend)
+    warnings.extend(w for w in said if w not in warnings)
+
+
+def lines(request: NextRequest, outcome: NextOutcome) -> list[str]:
+    """What ``next`` prints: the fired shot's verdict, the law's update, the next setting
+    with its P(PASS), the files and the archive's records."""
+    from .accept import verdict_lines
+
+    u, b = outcome.update, outcome.best
+    lo, hi = b.interval
+    worst = b.most_failing()
+    said = verdict_lines(outcome.verdict, f"{request.recording} against {request.shot}")
+    if outcome.counted_once:
+        said.append("  this shot was recorded in the lot before: counted once")
+    said += [f"lot {request.lot}: the law {outcome.law}, the prior scaled by {u.scale:.4f} "
+             f"+/- {u.error:.4f} (1 standard error) on {u.shots} shot"
+             f"{'s' * (u.shots > 1)}", f"  {u.note}",
+             f"next: A28 = {outcome.setting:.6g} m/s, P(PASS) = {b.probability:.4f} "
+             f"[{lo:.4f}, {hi:.4f}] over {b.shots:,} draws"
+             + (f"; most likely to fail: {worst[0]}" if worst else ""),
+             f"  {'reaches' if outcome.reached else 'does NOT reach'} --confidence "
+             f"{outcome.confidence:g}",
+             f"wrote {outcome.output}; kept the verdict, the law {outcome.law} and the "
+             f"proposal {outcome.proposal} in {request.archive}"]
+    return said
+
+
+def chain(root: str | Path | None, lot: str) -> list[dict[str, Any]]:
+    """``history --lot``: a row a proposal (the shot fired, its verdict, the P(PASS) predicted
+    for it before it was fired when it was fired from a proposal's workbook, the law version
+    made, the next setting and its P(PASS))."""
+    from ..archive import Archive, archive_dir
+    from ..archive.lots import proposals
+
+    found = Archive(archive_dir(root))
+    rows: list[dict[str, Any]] = []
+    predicted: dict[str, Any] = {}
+    chained = proposals(found.root, lot)
+    if not chained:
+        raise OptionError(f"--lot: found {lot!r}, which has no chain in {found.root}, "
+                          "expected a lot airgun-xl next has kept there")
+    for version, record in chained:
+        shots = record.get("shots") or []
+        fired = shots[-1].get("shot_sha256") if shots else None
+        before = predicted.get(fired) if isinstance(fired, str) else None
+        rows.append({"proposal": f"{lot}@{version}", "shot": record.get("shot"),
+                     "verdict": record.get("verdict"),
+                     "predicted_before": before, "law": record.get("law"),
+                     "next_A28": record.get("setting_A28"), "next_p_pass": record.get("p_pass"),
+                     "created": record.get("created", "")})
+        if isinstance(record.get("next_sha256"), str):
+            predicted[record["next_sha256"]] = record.get("p_pass")
+    return rows
+
+
+def chain_lines(lot: str, rows: list[dict[str, Any]]) -> list[str]:
+    """``history --lot``: a line a shot of the chain."""
+    def p(value: Any) -> str:
+        return f"{value:.3f}" if isinstance(value, (int, float)) else "n/a"
+
+    lines = [f"lot {lot}: {'proposal':<16} {'verdict':<7} {'P before':>8}  {'law':<16} "
+             f"{'next A28 m/s':>12} {'P(PASS)':>8}  shot"]
+    for r in rows:
+        nxt = r["next_A28"]
+        lines.append(f"       {r['proposal']:<16} {r['verdict']!s:<7} "
+                     f"{p(r['predicted_before']):>8}  {r['law']!s:<16} "
+                     f"{nxt if not isinstance(nxt, (int, float)) else f'{nxt:.3f}':>12} "
+                     f"{p(r['next_p_pass']):>8}  {r['shot']}")
+    return lines

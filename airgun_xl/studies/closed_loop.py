@@ -1,0 +1,121 @@
+"""The closed loop (issue 45): a lot's crush law updated by every shot fired from it, and the
+next setting chosen on what the lot is now known to be.
+
+- :func:`update_scale`: the lot's prior law (its previous version, or the report's law for a
+  new lot) scaled to every shot of the lot by least squares (:func:`~.calibrate.calibrate`
+  with ``fit=("scale",)``), with the scale's standard error. A scale is what one shot, or
+  shots at one speed, can pin; the law's shape over speed needs shots spread over it, and is
+  the prior's until then (said in :attr:`LawUpdate.note`).
+- :func:`law_scatter`: the scale's standard error as a scatter of the law (relative, around
+  1), drawn with the gun's and zeta's by :func:`~.first_shot.pass_probability` (the law known
+  to its standard error: a posterior, not a shot-to-shot scatter).
+- :func:`brier` and :func:`reliability`: how honest the predictions were, once shots were
+  fired at the settings proposed: the Brier score, and the observed pass rate in each band of
+  predicted P(PASS) with its Wilson 95 % interval.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .acceptance import wilson_interval
+from .first_shot import LAW_FIELDS, LAW_SCALE
+
+
+@dataclass(frozen=True)
+class LawUpdate:
+    """The lot's law after this shot: the prior scaled by ``scale`` (± ``error``, one
+    standard error) on ``shots`` shots; the calibration behind it; what it pins."""
+
+    law: Any  # CrushLaw
+    prior: Any  # CrushLaw
+    scale: float
+    error: float
+    shots: int
+    speeds: tuple[float, float]  # [m/s] the lowest and highest impact speed of the shots
+    calibration: Any  # studies.calibrate.Calibration
+    note: str
+
+    @property
+    def warnings(self) -> list[str]:
+        said = list(self.calibration.warnings) if self.calibration is not None else []
+        if not (math.isfinite(self.error) and self.error >= 0):
+            said.append("the law's scale has no standard error (the fit could not estimate "
+                        "one): P(PASS) draws the law as if it were known exactly, and is "
+                        "optimistic")
+        return said
+
+
+def update_scale(params, traces, prior, cfc=None, integrator="legacy"):
+    """The prior law scaled to the shots (``params`` each with its set values, ``traces``
+    each its recording), by least squares on the filtered pulses.
+
+    Returns
+    -------
+    LawUpdate
+    """
+    from .calibrate import calibrate
+
+    start = [p.replace(crush_law=prior) for p in params]
+    cal = calibrate(start, traces, law=False, fit=("scale",), cfc=cfc, integrator=integrator)
+    scale, error = float(cal.fitted["scale"]), float(cal.errors.get("scale", math.nan))
+    speeds = [p.v31 - p.v1 for p in params]
+    lo, hi = min(speeds), max(speeds)
+    n = len(params)
+    note = (f"{n} shot{'s' * (n > 1)} at {lo:.4g}" + (f" to {hi:.4g}" if hi > lo else "")
+            + " m/s pin the law's scale only; its shape over speed stays the prior's")
+    return LawUpdate(prior.scaled(scale), prior, scale, error, n, (lo, hi), cal, note)
+
+
+def law_scatter(update):
+    """The ``sds`` entry that draws the law from its posterior: its scale around 1, with the
+    standard error relative to the scale fitted."""
+    relative = update.error / update.scale if update.scale > 0 else math.nan
+    if not (math.isfinite(relative) and relative >= 0):
+        relative = 0.0
+    return (LAW_SCALE, LAW_FIELDS, relative, True)
+
+
+def brier(predicted, passed):
+    """The Brier score of probabilities ``predicted`` against outcomes ``passed`` (0 best)."""
+    p, o = np.asarray(predicted, float), np.asarray(passed, float)
+    return float(np.mean((p - o) ** 2)) if len(p) else math.nan
+
+
+@dataclass(frozen=True)
+class Band:
+    """Shots whose predicted P(PASS) fell in [low, high): how many passed."""
+
+    low: float
+    high: float
+    shots: int
+    passed: int
+    mean_predicted: float
+
+    @property
+    def rate(self) -> float:
+        return self.passed / self.shots if self.shots else math.nan
+
+    @property
+    def interval(self) -> tuple[float, float]:
+        return wilson_interval(self.passed, self.shots)
+
+    @property
+    def honest(self) -> bool:
+        """The mean prediction lies inside the observed rate's 95 % interval."""
+        lo, hi = self.interval
+        return self.shots > 0 and lo <= self.mean_predicted <= hi
+
+
+def reliability(predicted, passed, edges=(0.0, 0.5, 0.7, 0.8, 0.9, 0.95, 1.0)):
+    """The observed pass rate in each band of predicted P(PASS) (the last band includes 1)."""
+    p, o = np.asarray(predicted, float), np.asarray(passed, bool)
+    bands = []
+    for k, (lo, hi) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
+        inside = (p >= lo) & ((p <= hi) if k == len(edges) - 2 else (p < hi))
+        bands.append(Band(lo, hi, int(inside.sum()), int(o[inside].sum()),
+                          float(p[inside].mean()) if inside.any() else math.nan))
+    return bands

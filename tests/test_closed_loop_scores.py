@@ -1,0 +1,45 @@
+"""Issue 45: the arithmetic of the predictions' record (studies/closed_loop.py): the Brier
+score and the reliability bands, against hand-computed cases, and the law's posterior as a
+scatter entry."""
+import math
+
+import pytest
+
+from airgun_xl.crush_law import LEGACY_LAW
+from airgun_xl.studies.acceptance import wilson_interval
+from airgun_xl.studies.closed_loop import Band, LawUpdate, brier, law_scatter, reliability
+from airgun_xl.studies.first_shot import LAW_FIELDS, LAW_SCALE
+
+
+def test_the_brier_score_is_the_mean_squared_miss():
+    assert brier([1.0, 0.0, 0.5], [True, False, True]) == pytest.approx(0.25 / 3, rel=1e-15)
+    assert brier([0.9] * 10, [True] * 9 + [False]) == pytest.approx(
+        (9 * 0.01 + 0.81) / 10, rel=1e-15)
+    assert math.isnan(brier([], []))
+
+
+def test_reliability_bands_count_each_prediction_once_and_close_the_last_band():
+    predicted = [0.1, 0.55, 0.65, 0.9, 0.95, 1.0, 1.0]
+    passed = [False, True, False, True, True, True, False]
+    bands = reliability(predicted, passed)
+    assert sum(b.shots for b in bands) == len(predicted)
+    last = bands[-1]  # [0.95, 1.0], 1.0 included
+    assert (last.low, last.high, last.shots, last.passed) == (0.95, 1.0, 3, 2)
+    assert last.interval == wilson_interval(2, 3)
+    assert last.mean_predicted == pytest.approx((0.95 + 1 + 1) / 3, rel=1e-15)
+    assert bands[0].shots == 1 and bands[0].passed == 0
+
+
+def test_a_band_is_honest_when_its_mean_prediction_is_inside_the_observed_interval():
+    assert Band(0.9, 0.95, 100, 92, 0.92).honest
+    assert not Band(0.9, 0.95, 100, 60, 0.92).honest
+    assert not Band(0.9, 0.95, 0, 0, math.nan).honest
+
+
+def test_the_laws_posterior_is_a_relative_scatter_of_its_scale():
+    update = LawUpdate(LEGACY_LAW.scaled(1.1), LEGACY_LAW, 1.1, 0.011, 1, (243.5, 243.5),
+                       None, "")
+    assert law_scatter(update) == (LAW_SCALE, LAW_FIELDS, pytest.approx(0.01, rel=1e-12), True)
+    unknown = LawUpdate(LEGACY_LAW, LEGACY_LAW, 1.0, math.nan, 1, (1.0, 1.0), None, "")
+    assert law_scatter(unknown)[2] == 0.0
+    assert update.warnings == [] and "optimistic" in unknown.warnings[0]
