@@ -43,3 +43,20 @@ def test_the_laws_posterior_is_a_relative_scatter_of_its_scale():
     unknown = LawUpdate(LEGACY_LAW, LEGACY_LAW, 1.0, math.nan, 1, (1.0, 1.0), None, "")
     assert law_scatter(unknown)[2] == 0.0
     assert update.warnings == [] and "optimistic" in unknown.warnings[0]
+
+
+def test_design_confidence_says_when_its_probability_holds_for_a_quiet_recording_only():
+    """Without a record named, P(PASS) judges the predictions unfiltered while a noisy
+    recording is judged through the default low-pass: said, and written with the figures;
+    with the record named (CFC 1000) both are judged alike, and nothing is said."""
+    from conftest import TEMPLATE
+
+    import airgun_xl
+    from airgun_xl.studies.first_shot import QUIET_RECORD_WARNING
+
+    spec = {"peak": "12kG:10%", "duration": "5ms:10%"}
+    quiet = airgun_xl.design(TEMPLATE, confidence=0.9, sd=["A28=1.5%"], shots=200, **spec)
+    assert QUIET_RECORD_WARNING in quiet.warnings
+    named = airgun_xl.design(TEMPLATE, confidence=0.9, sd=["A28=1.5%"], shots=200, cfc="1000",
+                             **spec)
+    assert QUIET_RECORD_WARNING not in named.warnings

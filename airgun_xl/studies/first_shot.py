@@ -35,6 +35,16 @@ SHOT_BYTES = 600
 #: Points of the scan over the parameter's range.
 SCAN_POINTS = 25
 
+#: Said by :func:`solve_confidence` when the specification names no record: the predictions
+#: are judged as they are, and a noisy recording would be judged through the default
+#: low-pass (issue 45: shot A's spiky peak reads 12.0 kG unfiltered, 9.3 kG through it).
+QUIET_RECORD_WARNING = (
+    "the specification names no record: P(PASS) judges each predicted shot as it is "
+    "(unfiltered), while a recording whose noise at rest exceeds 0.5 % of its peak is judged "
+    "through the default low-pass (6/D), which lowers a spiky pulse's peak; the probability "
+    "holds for a quiet recording only. Name the record (--cfc N or --record unfiltered) to "
+    "judge both alike, or use airgun-xl next once a shot is fired")
+
 #: The first round of :func:`solve_confidence` runs this fraction of the shots a setting.
 FIRST_ROUND = 0.05
 
@@ -259,4 +269,6 @@ def solve_confidence(p, spec, var, sds, n, seed=1, bounds=None, integrator="lega
     if spec.srs is not None:
         warnings.append("the SRS criterion is not in the probability: it is judged on the "
                         "designed shot's prediction only")
+    if noise == 0 and spec.resolved().judged.is_default:
+        warnings.append(QUIET_RECORD_WARNING)
     return ConfidenceDesign(best, mid, middle, first + final, n, warnings)
