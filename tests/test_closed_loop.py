@@ -10,6 +10,7 @@ lot: the first shot fails, and the loop must pass by the second.
 """
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -186,3 +187,35 @@ def test_bad_input_is_one_line_and_nothing_is_written_or_recorded(lot, tmp_path,
                 "changed shot": "differs from the one recorded"}[case]
     assert expected in err[0], err[0]
     assert not math.isnan(first.best.probability)
+
+
+def test_history_calibration_holds_each_prediction_against_its_verdict(lot, tmp_path, capsys):
+    """The second shot was fired from the first proposal: its P(PASS) and its PASS are the
+    record (LOT-B's and the third proposal's shots were never fired from a proposal), the
+    Brier score is (1 - p)^2, and the workbook prints on one page (LibreOffice)."""
+    import shutil
+    import subprocess
+
+    from airgun_xl.app.next_shot import prediction_record
+
+    work, first, _ = lot
+    out = tmp_path / "record.xlsx"
+    record = prediction_record(work / "arch", str(out))
+    predicted = [s["predicted"] for s in record.shots if s["lot"] == "LOT-A"]
+    assert predicted[0] == first.best.probability
+    assert record.shots[0]["verdict"] == "PASS" and record.shots[0]["proposal"] == "LOT-A@2"
+    lot_a = [s for s in record.shots if s["lot"] == "LOT-A"]
+    assert record.brier == pytest.approx(
+        sum((s["predicted"] - (s["verdict"] == "PASS")) ** 2 for s in record.shots)
+        / len(record.shots), rel=1e-12)
+    assert sum(b.shots for b in record.bands) == len(record.shots) and lot_a
+    assert main(["history", "--archive", str(work / "arch"), "--calibration", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["shots"] == json.loads(
+        json.dumps(list(record.shots)))
+    if shutil.which("soffice") and shutil.which("pdfinfo"):
+        subprocess.run(["soffice", f"-env:UserInstallation=file://{tmp_path}/lo", "--headless",
+                        "--convert-to", "pdf", "--outdir", str(tmp_path), str(out)],
+                       capture_output=True, timeout=600, check=True)
+        info = subprocess.run(["pdfinfo", str(tmp_path / "record.pdf")], capture_output=True,
+                              text=True, check=True).stdout
+        assert re.search(r"^Pages:\s+1$", info, re.M), info

@@ -434,3 +434,67 @@ def chain_lines(lot: str, rows: list[dict[str, Any]]) -> list[str]:
                      f"{nxt if not isinstance(nxt, (int, float)) else f'{nxt:.3f}':>12} "
                      f"{p(r['next_p_pass']):>8}  {r['shot']}")
     return lines
+
+
+@dataclass(frozen=True)
+class PredictionRecord:
+    """``history --calibration``: every shot fired from a proposal with its verdict, the
+    P(PASS) predicted for it, the bands and the Brier score."""
+
+    shots: tuple[dict[str, Any], ...]
+    bands: tuple[Any, ...]  # studies.closed_loop.Band
+    brier: float
+    files: tuple[Path, ...]
+
+    def lines(self) -> list[str]:
+        said = [f"{len(self.shots)} shots fired from next's proposals; Brier score "
+                + (f"{self.brier:.4f}" if self.shots else "none yet")]
+        for band in self.bands:
+            if band.shots:
+                lo, hi = band.interval
+                said.append(f"  P(PASS) {band.low:.2f}-{band.high:.2f}: {band.shots} shots, "
+                            f"mean predicted {band.mean_predicted:.3f}, passed "
+                            f"{band.rate:.3f} [{lo:.3f}, {hi:.3f}]: "
+                            + ("honest" if band.honest else "NOT honest" if band.shots >= 30
+                               else "under 30 shots"))
+        said += [f"wrote {f}" for f in self.files]
+        return said
+
+    def to_json(self) -> str:
+        from .documents import dumps
+
+        return dumps({"shots": self.shots, "brier": self.brier, "bands": [
+            {"low": b.low, "high": b.high, "shots": b.shots, "passed": b.passed,
+             "mean_predicted": b.mean_predicted, "interval": list(b.interval),
+             "honest": b.honest} for b in self.bands], "files": self.files})
+
+
+def prediction_record(root: str | Path | None, output: str | None = None,
+                      force: bool = False) -> PredictionRecord:
+    """Across the archive's lots, each P(PASS) predicted before a shot was fired against the
+    shot's verdict; ``output`` also writes the record's workbook (a reliability chart)."""
+    from ..archive import Archive, archive_dir
+    from ..archive.lots import lot_names
+    from ..studies.closed_loop import brier, reliability
+    from ..transaction import check_output, display
+
+    if output is not None:
+        check_output(output, force)
+    found = Archive(archive_dir(root))
+    shots = [{"lot": lot, "proposal": row["proposal"], "shot": row["shot"],
+              "predicted": float(row["predicted_before"]), "verdict": row["verdict"]}
+             for lot in lot_names(found.root) for row in chain(found.root, lot)
+             if isinstance(row["predicted_before"], (int, float))]
+    predicted = [s["predicted"] for s in shots]
+    passed = [s["verdict"] == "PASS" for s in shots]
+    bands = reliability(predicted, passed)
+    score = brier(predicted, passed)
+    files: tuple[Path, ...] = ()
+    if output is not None:
+        from ..reports.reliability import write_reliability
+
+        write_reliability(output, bands, score, shots, f"Predictions of {display(found.root)}: "
+                          "P(PASS) before each shot against its verdict", force,
+                          label=display(found.root.name))
+        files = (Path(output),)
+    return PredictionRecord(tuple(shots), tuple(bands), score, files)

@@ -34,6 +34,10 @@ def _add_history(sub):
                    help="a lot's chain instead (airgun-xl next): each shot fired, its "
                         "verdict, the P(PASS) predicted for it, the law version, the next "
                         "setting")
+    h.add_argument("--calibration", action="store_true",
+                   help="the record of next's predictions instead: P(PASS) predicted before "
+                        "each shot against its verdict, in bands, with the Brier score (-o "
+                        "writes it with a reliability chart)")
     h.add_argument("--since", metavar="DATE", help="only runs from this ISO date on, e.g. "
                                                    "2026-11-01")
     h.add_argument("--where", action="append", default=[], metavar="CELL=VALUE",
@@ -125,6 +129,12 @@ def run_history(args):
 
     if args.lot is not None:
         return _run_chain(args)
+    if args.calibration:
+        from ..app.next_shot import prediction_record
+
+        record = prediction_record(_history_archive(args), args.output, args.force)
+        print(record.to_json() if args.json else "\n".join(record.lines()))
+        return 0
     outcome = history(HistoryRequest(_history_archive(args), args.shot, args.since,
                                      tuple(args.where), args.output, args.force))
     if args.json:  # the index row of each entry, with its figures and its law

@@ -45,6 +45,10 @@ QUIET_RECORD_WARNING = (
     "holds for a quiet recording only. Name the record (--cfc N or --record unfiltered) to "
     "judge both alike, or use airgun-xl next once a shot is fired")
 
+#: What the middle design's search counts a shot that cannot be judged as (minus its
+#: smallest margin): worse than any judged shot's.
+DIVERGED_MARGIN = 1e6
+
 #: The first round of :func:`solve_confidence` runs this fraction of the shots a setting.
 FIRST_ROUND = 0.05
 
@@ -121,8 +125,11 @@ def solve_middle(p, spec, var, bounds=None, integrator="legacy", model="4-mass",
 
     def negative(x):
         count[0] += 1
-        return -float(margins(_run(p, var, [x], spec, integrator, model, runner, noise),
-                              spec)[0])
+        margin = float(margins(_run(p, var, [x], spec, integrator, model, runner, noise),
+                               spec)[0])
+        # a shot that cannot be judged (diverged) is the worst, but finite: the bounded
+        # search's parabola steps would otherwise multiply infinities (NaN, and a warning)
+        return -margin if math.isfinite(margin) else DIVERGED_MARGIN
 
     found = minimize_scalar(negative, bounds=(a, b), method="bounded",
                             options={"xatol": 1e-6 * max(abs(a), abs(b), 1e-12)})
