@@ -14,6 +14,7 @@ import re
 from pathlib import Path
 
 import numpy as np
+import openpyxl
 import pytest
 from conftest import TEMPLATE, write_trace_csv
 
@@ -219,3 +220,14 @@ def test_history_calibration_holds_each_prediction_against_its_verdict(lot, tmp_
         info = subprocess.run(["pdfinfo", str(tmp_path / "record.pdf")], capture_output=True,
                               text=True, check=True).stdout
         assert re.search(r"^Pages:\s+1$", info, re.M), info
+
+
+def test_the_next_workbook_carries_the_loops_warnings_with_its_p_pass(lot):
+    """Warnings travel with the figures: the next shot's Summary prints the P(PASS) and every
+    warning the loop said (the calibration's, a confidence not reached)."""
+    _, _, second = lot
+    book = openpyxl.load_workbook(second.output, read_only=True)
+    text = [str(c) for row in book["Summary"].iter_rows(values_only=True) for c in row if c]
+    assert any(t.startswith("next shot of lot LOT-A: A28 = ") for t in text)
+    for warning in second.warnings:
+        assert any(warning in t for t in text), warning

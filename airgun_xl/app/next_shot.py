@@ -348,7 +348,8 @@ def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: V
     params = var.apply(shot.params.replace(crush_law=law), best.setting)
     designed = with_cells(shot, Design([var], [best.setting], params, math.nan, math.nan,
                                        best.shots))
-    designed = dataclasses.replace(designed, warnings=[])  # the fired shot's are its verdict's
+    # what the loop said travels with the figures it qualifies (the Summary's P(PASS))
+    designed = dataclasses.replace(designed, warnings=list(warnings))
     lo, hi = best.interval
     worst = best.most_failing()
     notes = (f"next shot of lot {request.lot}: A28 = {best.setting:.6g} m/s, P(PASS) = "
