@@ -149,8 +149,8 @@ def test_another_lots_shots_are_never_used_and_a_shot_twice_counts_once(lot, tmp
     assert again.counted_once and again.update.shots == 2  # LOT-A's two, LOT-B's not
 
 
-@pytest.mark.parametrize("case", ["unknown lot", "no tolerances", "empty recording",
-                                  "changed shot", "no gun scatter"])
+@pytest.mark.parametrize("case", ["unknown lot", "no tolerances", "no peak or duration",
+                                  "empty recording", "changed shot", "no gun scatter"])
 def test_bad_input_is_one_line_and_nothing_is_written_or_recorded(lot, tmp_path, case,
                                                                    capsys):
     work, first, _ = lot
@@ -164,6 +164,8 @@ def test_bad_input_is_one_line_and_nothing_is_written_or_recorded(lot, tmp_path,
     if case == "unknown lot":
         argv[6] = "LOT-Z"
     elif case == "no tolerances":
+        argv[-4:] = ["--peak", "8.5kG", "--duration", "5ms"]
+    elif case == "no peak or duration":
         argv[-4:] = ["--velocity-change", "8m/s:10%"]
     elif case == "empty recording":
         rec.write_text("")
@@ -183,8 +185,9 @@ def test_bad_input_is_one_line_and_nothing_is_written_or_recorded(lot, tmp_path,
     assert code == 2 and len(err) == 1 and err[0].startswith("airgun-xl: error: "), err
     assert files_under(work / "arch") == before
     assert not (tmp_path / "s.next.xlsx").exists()
-    expected = {"unknown lot": "--lot: found 'LOT-Z'", "no tolerances": "without a peak or a "
-                "duration", "empty recording": "r.csv", "no gun scatter": "no A28 scatter",
+    expected = {"unknown lot": "--lot: found 'LOT-Z'", "no tolerances": "without a tolerance",
+                "no peak or duration": "without a peak or a duration",
+                "empty recording": "r.csv", "no gun scatter": "no A28 scatter",
                 "changed shot": "differs from the one recorded"}[case]
     assert expected in err[0], err[0]
     assert not math.isnan(first.best.probability)
