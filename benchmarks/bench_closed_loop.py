@@ -49,6 +49,7 @@ from airgun_xl.studies.closed_loop import brier, reliability
 from airgun_xl.studies.recorder import Recorder
 
 SPEC = {"peak": "8.5kG:5%", "duration": "5ms:20%"}
+V_RANGE = (10.0, 260.0)  # [m/s] the gun's settings (design's search range for A28)
 TARGET_KG = 8.5
 MOST_SHOTS = 5
 GUN, ZETA, LOT_SPREAD, TILT_SPREAD = 0.015, 0.10, 0.10, 0.05
@@ -110,7 +111,10 @@ def by_hand(lot, law, first, work, draws):
         measured = next(c.value for c in verdict.criteria if c.name == "peak")
         gamma = math.log(judged_peak(v * 1.01, noise) / judged_peak(v / 1.01, noise)) / \
             math.log(1.01 ** 2)
-        v *= (TARGET_KG / measured) ** (1 / gamma)
+        moved = v * (TARGET_KG / measured) ** (1 / gamma) if gamma > 0 else math.nan
+        if not math.isfinite(moved):  # the rule has no answer: the lot is not passed
+            return MOST_SHOTS + 1
+        v = min(max(moved, V_RANGE[0]), V_RANGE[1])  # what the gun can be set to
     return MOST_SHOTS + 1
 
 

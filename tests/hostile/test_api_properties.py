@@ -92,3 +92,33 @@ def test_a_sign_that_is_not_one_is_refused_by_every_function_alike(sign):
             call()
         refusals.add(str(caught.value))
     assert refusals == {f"--sign: found {float(sign)!r}, expected 1 or -1"}
+
+
+@settings(max_examples=12, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(given=st.dictionaries(st.sampled_from(["sd", "confidence", "shots", "lot", "seed",
+                                              "sign", "cfc"]), NOISE, max_size=2))
+def test_next_given_random_input_writes_what_it_says_or_nothing(given):
+    """airgun_xl.next_shot with random keywords: an outcome whose files are what was
+    written (the next workbook; the archive's records), or one line and nothing written or
+    recorded at all."""
+    import tempfile
+    from pathlib import Path
+
+    keywords = {"sd": ["A28=1.5%"], "shots": 100, "lot": "LOT-P", "sign": -1,
+                "peak": "9.5kG:10%", "duration": "5ms:15%", **given}
+    if isinstance(keywords["shots"], int) and not isinstance(keywords["shots"], bool):
+        keywords["shots"] = min(keywords["shots"], 200)  # a study's size, not its reading
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        try:
+            outcome = airgun_xl.next_shot(TEMPLATE, RECORDING, archive=folder / "arch",
+                                          new_lot=True, output=folder / "next.xlsx",
+                                          **keywords)
+        except AirgunXlError as exc:
+            text = str(exc)
+            assert text and "\n" not in text and len(text) < 600, text
+            assert list(folder.iterdir()) == []
+        else:
+            assert outcome.files == (folder / "next.xlsx",) and outcome.files[0].is_file()
+            assert sorted(p.name for p in folder.iterdir()) == ["arch", "next.xlsx"]
