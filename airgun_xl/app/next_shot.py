@@ -107,7 +107,7 @@ def run(request: NextRequest) -> NextOutcome:
     airgun_xl.errors.AirgunXlError
         Bad input, named; nothing is written or recorded.
     """
-    from ..archive.lots import file_sha256
+    from ..archive import sha256 as file_sha256
     from ..readers.recording import input_file
     from ..shot import Shot
     from ..studies.closed_loop import law_scatter, update_scale
@@ -191,8 +191,9 @@ def _scatter(request: NextRequest, shot: Shot) -> list[Any]:
 def _lot(request: NextRequest) -> tuple[Any, list[dict[str, Any]]]:
     """The lot's prior law (its latest version, or the report's law for a new lot) and its
     shots so far (each file checked unchanged)."""
+    from ..archive import sha256 as file_sha256
     from ..archive.laws import load_law
-    from ..archive.lots import file_sha256, proposals
+    from ..archive.lots import proposals
     from ..archive.records import versions
     from ..crush_law import LEGACY_LAW
     from ..errors import ArchiveError
@@ -286,8 +287,9 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
     """Store the law's new version, write the next shot's workbook, keep the verdict and the
     proposal; a failure takes back what was done."""
     from ..archive import Archive
+    from ..archive import sha256 as file_sha256
     from ..archive.laws import store_law
-    from ..archive.lots import file_sha256, store_proposal
+    from ..archive.lots import store_proposal
     from ..archive.verdicts import StoredVerdict, store_verdict
     from ..crush_law import CrushLaw
     from ..transaction import signals_held

@@ -8,7 +8,6 @@ recorded twice is counted once and a changed file is refused), the verdict of th
 law version it made, and the workbook it wrote (its SHA-256: the shot fired from it is known
 by its bytes). ``history --lot`` reads the chain back; what is read is untrusted.
 """
-import hashlib
 from pathlib import Path
 
 from ..errors import ArchiveError
@@ -22,15 +21,6 @@ LOTS = ".lots"
 
 def _folder(root, lot):
     return Path(root) / LOTS / safe_name(lot)
-
-
-def file_sha256(path):
-    """The SHA-256 of a file's bytes."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 def store_proposal(root, lot, record):
