@@ -234,3 +234,27 @@ def test_the_next_workbook_carries_the_loops_warnings_with_its_p_pass(lot):
     assert any(t.startswith("next shot of lot LOT-A: A28 = ") for t in text)
     for warning in second.warnings:
         assert any(warning in t for t in text), warning
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "mkfifo"), reason="needs a FIFO")
+def test_a_proposal_naming_a_fifo_is_refused_without_blocking(lot, tmp_path, capsys):
+    """What the loop reads back from the archive is untrusted: a proposal whose lot shot
+    names a FIFO (a read would block for ever) is one line and exit 2, nothing written."""
+    import os
+    import shutil
+
+    work, first, _ = lot
+    archive = tmp_path / "arch"
+    shutil.copytree(work / "arch", archive)
+    latest = sorted((archive / ".lots" / "LOT-A").glob("v*.json"))[-1]
+    record = json.loads(latest.read_text())
+    os.mkfifo(tmp_path / "fifo.xlsx")
+    record["shots"][0]["shot"] = str(tmp_path / "fifo.xlsx")
+    latest.write_text(json.dumps(record))
+    before = files_under(archive)
+    code = main(["next", str(first.output), str(work / "rec2.csv"), "--archive", str(archive),
+                 "--lot", "LOT-A", "--sd", "A28=1.5%", "--shots", str(SHOTS), "--peak",
+                 SPEC["peak"], "--duration", SPEC["duration"], "-o", str(tmp_path / "n.xlsx")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "differs from the one recorded" in err[0], err
+    assert files_under(archive) == before and not (tmp_path / "n.xlsx").exists()

@@ -107,7 +107,6 @@ def run(request: NextRequest) -> NextOutcome:
     airgun_xl.errors.AirgunXlError
         Bad input, named; nothing is written or recorded.
     """
-    from ..archive import sha256 as file_sha256
     from ..readers.recording import input_file
     from ..shot import Shot
     from ..studies.closed_loop import law_scatter, update_scale
@@ -118,9 +117,9 @@ def run(request: NextRequest) -> NextOutcome:
     _tolerances(spec)
     sds = _scatter(request, shot)
     prior, earlier = _lot(request)
-    this = {"shot": str(request.shot), "shot_sha256": file_sha256(request.shot),
+    this = {"shot": str(request.shot), "shot_sha256": _sha256(request.shot, "workbook"),
             "recording": str(request.recording),
-            "recording_sha256": file_sha256(input_file(request.recording)),
+            "recording_sha256": _sha256(input_file(request.recording), "recording"),
             **_reading(request)}
     counted_once = any((s["shot_sha256"], s["recording_sha256"]) ==
                        (this["shot_sha256"], this["recording_sha256"]) for s in earlier)
@@ -191,14 +190,13 @@ def _scatter(request: NextRequest, shot: Shot) -> list[Any]:
 def _lot(request: NextRequest) -> tuple[Any, list[dict[str, Any]]]:
     """The lot's prior law (its latest version, or the report's law for a new lot) and its
     shots so far (each file checked unchanged)."""
-    from ..archive import sha256 as file_sha256
-    from ..archive.laws import load_law
+    from ..archive.laws import LAWS, load_law
     from ..archive.lots import proposals
     from ..archive.records import versions
     from ..crush_law import LEGACY_LAW
-    from ..errors import ArchiveError
+    from ..errors import AirgunXlError, ArchiveError
 
-    has_law = bool(versions(Path(request.archive) / ".laws" / request.lot))
+    has_law = bool(versions(Path(request.archive) / LAWS / request.lot))
     chain = proposals(request.archive, request.lot)
     if not has_law and not chain:
         if not request.new_lot:
@@ -215,14 +213,26 @@ def _lot(request: NextRequest) -> tuple[Any, list[dict[str, Any]]]:
         for key, what in (("shot", "workbook"), ("recording", "recording")):
             try:
                 path = s[key] if key == "shot" else _recording_file(s[key])
-                same = file_sha256(path) == s[f"{key}_sha256"]
-            except (OSError, KeyError, TypeError):
+                same = _sha256(path, what) == s[f"{key}_sha256"]
+            except (AirgunXlError, KeyError, TypeError):  # gone, not a file, too large
                 same = False
             if not same:
                 raise ArchiveError(f"{s.get(key, '?')}: the lot {request.lot}'s {what} "
                                    "differs from the one recorded (or is gone), expected it "
                                    "unchanged: the lot's law is fitted on the shots as fired")
     return prior, earlier
+
+
+def _sha256(path: str | Path, what: str) -> str:
+    """The SHA-256 of a file the loop names (given, or read back from the archive's records:
+    untrusted): a regular file, read without blocking and capped as every input is
+    (:func:`airgun_xl.readers.guard.read_bytes`), or one line naming it."""
+    import hashlib
+
+    from ..readers.guard import read_bytes
+
+    return hashlib.sha256(read_bytes(path, f"expected the {what} a lot's shot was fired with",
+                                     what)).hexdigest()
 
 
 def _recording_file(text: str) -> str:
@@ -287,8 +297,8 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
     """Store the law's new version, write the next shot's workbook, keep the verdict and the
     proposal; a failure takes back what was done."""
     from ..archive import Archive
-    from ..archive import sha256 as file_sha256
-    from ..archive.laws import store_law
+    from ..archive import sha256 as file_sha256  # the workbook just written: ours
+    from ..archive.laws import LAWS, store_law
     from ..archive.lots import store_proposal
     from ..archive.verdicts import StoredVerdict, store_verdict
     from ..crush_law import CrushLaw
@@ -300,7 +310,7 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
             ref = store_law(request.archive, request.lot, update.law, lot_shots,
                             [{"shot": s["shot"]} for s in lot_shots], request.argv)
             version = int(ref.rpartition("@")[2])
-            done.append(StoredVerdict(Path(request.archive) / ".laws" / request.lot /
+            done.append(StoredVerdict(Path(request.archive) / LAWS / request.lot /
                                       f"v{version:04d}.json", Archive(request.archive)))
         law = CrushLaw(update.law.coefficients, update.law.v_range, "fitted", source=ref)
         _write(request, output, shot, spec, verdict, update, best, law, ref, warnings)
