@@ -585,19 +585,21 @@ def next_shot(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *
               seed: int = 1, output: str | os.PathLike[str] | None = None, force: bool = False,
               channel: str | None = None, sign: float = 1.0, time_unit: str | None = None,
               accel_unit: str | None = None, integrator: str = "legacy",
-              **spec: Unpack[SpecKeywords]) -> NextOutcome:
+              vary: str | None = None, **spec: Unpack[SpecKeywords]) -> NextOutcome:
     """The closed loop, as ``airgun-xl next`` runs it: judge the fired ``shot``'s
     ``recording``, update ``lot``'s law in ``archive`` on every shot of the lot, choose the
-    A28 most likely to pass with the gun's scatter (``sd=["A28=1.5%"]``) and the law drawn
-    from its update, write the next shot's workbook (``output``, else SHOT.next.xlsx) and keep
-    the verdict, the law's version and the proposal in the archive.
+    A28 (with ``vary``, also a second knob: ``"E13"``, ``"E16"`` or ``"A2"``) most likely to
+    pass with the gun's scatter (``sd=["A28=1.5%"]``) and the law drawn from its update,
+    write the next shot's workbook (``output``, else SHOT.next.xlsx) and keep the verdict,
+    the law's version and the proposal in the archive.
 
     Returns
     -------
     airgun_xl.app.next_shot.NextOutcome
         ``verdict`` (the fired shot's), ``update`` (the law's scale and its standard error),
-        ``law`` (its new version), ``setting`` [m/s], ``best`` (P(PASS) with its interval),
-        ``reached``, ``files``, ``warnings``.
+        ``law`` (its new version), ``setting`` [m/s], ``second`` (with ``vary``: its cell,
+        unit and value), ``best`` (P(PASS) with its interval), ``reached``, ``files``,
+        ``warnings``.
 
     Raises
     ------
@@ -614,7 +616,8 @@ def next_shot(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *
         Path(shot), os.fspath(recording), Path(archive), lot, fields, new_lot, _texts(sd),
         _number("--confidence", confidence), _whole("--shots", shots), _whole("--seed", seed),
         channel, _number("--sign", sign), time_unit, accel_unit, integrator,
-        Path(output) if output is not None else None, force, ("next",)))
+        Path(output) if output is not None else None, force, ("next",),
+        None if vary is None else str(vary)))
 
 
 __all__ = [

@@ -90,6 +90,7 @@ SCHEMAS: dict[str, dict] = {
             "lot": _TEXT, "shot": _TEXT, "recording": _TEXT,
             "verdict": {"enum": ["PASS", "FAIL"]}, "law": _TEXT, "scale": _NUMBER,
             "scale_error": _NUMBER_OR_NULL, "setting_A28": _NUMBER,
+            "second_cell": _TEXT, "second_value": _NUMBER,
             "p_pass": {"type": "number", "minimum": 0, "maximum": 1},
             "interval": {"type": "array", "items": _NUMBER, "minItems": 2, "maxItems": 2},
             "draws": {"type": "integer"}, "most_likely_to_fail": {"type": ["string", "null"]},

@@ -2,7 +2,7 @@
 fired until PASS or 5 shots, once with `airgun-xl next` and once with the rule labs use by
 hand; how soon each passes, and whether next's predicted P(PASS) came true.
 
-    python benchmarks/bench_closed_loop.py [--lots N] [--draws N] [--quick]
+    python benchmarks/bench_closed_loop.py [--lots N] [--draws N] [--vary CELL] [--quick]
 
 The lab, on shot A (the template):
 - a lot's true law is the report's times a scale drawn with a 10 % spread, tilted with speed
@@ -16,7 +16,8 @@ Every lot's first shot is the setting `design --confidence` finds on the nominal
 gun's, the lot-to-lot 10 % and zeta's scatter drawn, each prediction judged as a recording of
 this recorder's noise would be). Then:
 - **next**: `airgun_xl.next_shot` after each shot (the gun's 1.5 % and zeta's 10 % given as
-  the scatter), the next shot fired from the workbook it wrote;
+  the scatter; with `--vary E13`, the mitigator's radius set with the velocity), the next
+  shot fired from the workbook it wrote;
 - **by hand**: the velocity scaled by (target / measured peak) ^ (1 / gamma), gamma the
   model's own d ln(peak) / d ln(v) on the nominal law at the velocity fired.
 Both meet the same lots and the same draws of the gun, zeta and the recorder's noise.
@@ -118,7 +119,7 @@ def by_hand(lot, law, first, work, draws):
     return MOST_SHOTS + 1
 
 
-def with_next(lot, law, first, work, draws, n_draws, calls):
+def with_next(lot, law, first, work, draws, n_draws, calls, vary=None):
     """Shots to the first PASS by next; each (predicted P(PASS), passed) of a proposal
     fired."""
     shot = with_velocity(work / "next0.xlsx", first)
@@ -129,7 +130,7 @@ def with_next(lot, law, first, work, draws, n_draws, calls):
         out = airgun_xl.next_shot(shot, rec, archive=work / "archive", lot=f"LOT-{lot}",
                                   new_lot=k == 0, sd=[f"A28={GUN:.1%}", f"E43={ZETA:.0%}"],
                                   shots=n_draws, seed=lot * 10 + k,
-                                  output=work / f"next{k + 1}.xlsx", **SPEC)
+                                  output=work / f"next{k + 1}.xlsx", vary=vary, **SPEC)
         calls.append(time.perf_counter() - started)
         if predicted is not None:
             record.append((predicted, out.verdict.passed))
@@ -159,6 +160,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--lots", type=int, default=200)
     parser.add_argument("--draws", type=int, default=1000, help="next's draws a setting")
+    parser.add_argument("--vary", metavar="CELL", help="next's second knob (E13, E16, A2)")
     parser.add_argument("--quick", action="store_true",
                         help="two lots, 200 draws: shows the benchmark runs, measures nothing")
     args = parser.parse_args()
@@ -175,7 +177,8 @@ def main():
                      for _ in range(MOST_SHOTS)]
             work = Path(tmp) / f"lot{lot}"
             work.mkdir()
-            shots, record = with_next(lot, law, first, work, draws, n_draws, calls)
+            shots, record = with_next(lot, law, first, work, draws, n_draws, calls,
+                                      args.vary)
             results["next"].append(shots)
             honest_record += record
             results["by hand"].append(by_hand(lot, law, first, work, draws))
@@ -193,7 +196,8 @@ def main():
     print("--quick: one repeat on a small case; these figures measure nothing\n" if args.quick
           else f"{lots} lots, next with {n_draws:,} draws a setting; the first shot at "
                f"{first:.2f} m/s (design --confidence: P(PASS) {p_first:.3f} on the nominal "
-               f"law); {time.perf_counter() - started:.0f} s, next "
+               f"law); {time.perf_counter() - started:.0f} s, next"
+               f"{f' --vary {args.vary}' if args.vary else ''} "
                f"{statistics.median(calls):.2f} s a call (median)\n")
     widths = [max(len(r[i]) for r in rows) for i in range(6)]
     for r in rows:

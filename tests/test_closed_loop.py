@@ -149,8 +149,42 @@ def test_another_lots_shots_are_never_used_and_a_shot_twice_counts_once(lot, tmp
     assert again.counted_once and again.update.shots == 2  # LOT-A's two, LOT-B's not
 
 
+def test_a_second_knob_passes_a_lot_the_velocity_alone_cannot(tmp_path):
+    """A lot 25 % stronger than the report's, a duration to 10 %: on shot A's mitigator the
+    velocity that gives 8.5 kG gives about 3.9 ms (under 4.05), so A28 alone proposes a shot
+    with P(PASS) 0 (and it fails: 3.91 ms); with --vary E13 the mitigator's radius is set with
+    the velocity, P(PASS) reaches 0.9 and the second shot passes. The next workbook holds the
+    radius in E13, and a fill of it runs with it."""
+    spec = {"peak": "8.5kG:5%", "duration": "4.5ms:10%"}
+    found = {}
+    for vary in (None, "E13"):
+        work = tmp_path / str(vary)
+        work.mkdir()
+        shot = work / "shot1.xlsx"
+        shot.write_bytes(TEMPLATE.read_bytes())
+        fire(shot, work / "rec1.csv", scale=1.25, seed=3)
+        first = airgun_xl.next_shot(shot, work / "rec1.csv", archive=work / "arch",
+                                    lot="LOT-S", new_lot=True, sd=GUN, shots=SHOTS,
+                                    vary=vary, **spec)
+        fire(first.output, work / "rec2.csv", scale=1.25, seed=4)
+        verdict = airgun_xl.accept(first.output, work / "rec2.csv", **spec)
+        found[vary] = first, verdict
+    alone, alone_verdict = found[None]
+    assert alone.best.probability < 0.05 and not alone.reached and alone.second is None
+    assert not alone_verdict.passed
+    both, both_verdict = found["E13"]
+    assert both.reached and both.best.probability >= 0.9 and both_verdict.passed
+    cell, unit, radius = both.second
+    sheet = airgun_xl.load(TEMPLATE).params.rcone
+    assert (cell, unit) == ("E13", "m") and radius != sheet  # a wider mitigator: longer pulse
+    fired = airgun_xl.load(both.output).params
+    assert (fired.rcone, fired.v31) == (radius, both.setting)
+    assert json.loads(both.to_json())["next"]["E13_m"] == radius
+
+
 @pytest.mark.parametrize("case", ["unknown lot", "no tolerances", "no peak or duration",
-                                  "empty recording", "changed shot", "no gun scatter"])
+                                  "empty recording", "changed shot", "no gun scatter",
+                                  "vary A28", "vary E40", "vary unknown"])
 def test_bad_input_is_one_line_and_nothing_is_written_or_recorded(lot, tmp_path, case,
                                                                    capsys):
     work, first, _ = lot
@@ -171,6 +205,8 @@ def test_bad_input_is_one_line_and_nothing_is_written_or_recorded(lot, tmp_path,
         rec.write_text("")
     elif case == "no gun scatter":
         argv[8] = "E43=10%"
+    elif case.startswith("vary"):
+        argv += ["--vary", {"vary A28": "A28", "vary E40": "E40", "vary unknown": "Q9"}[case]]
     else:  # a shot of the lot edited after it was recorded
         changed = work / "shot1.xlsx"
         kept = changed.read_bytes()
@@ -188,7 +224,10 @@ def test_bad_input_is_one_line_and_nothing_is_written_or_recorded(lot, tmp_path,
     expected = {"unknown lot": "--lot: found 'LOT-Z'", "no tolerances": "without a tolerance",
                 "no peak or duration": "without a peak or a duration",
                 "empty recording": "r.csv", "no gun scatter": "no A28 scatter",
-                "changed shot": "differs from the one recorded"}[case]
+                "changed shot": "differs from the one recorded",
+                "vary A28": "--vary: found 'A28', expected a second knob",
+                "vary E40": "--vary: found 'E40', expected a second knob",
+                "vary unknown": "--vary: found 'Q9', expected one of"}[case]
     assert expected in err[0], err[0]
     assert not math.isnan(first.best.probability)
 

@@ -8,8 +8,10 @@ options, the lot (unknown without ``new_lot``), the specification (it needs tole
 gun's scatter, the lot's earlier shots (each file unchanged since it was recorded), the
 recording and the output.
 
-This first part updates the law's scale (a scale is what one shot, or shots at one speed,
-pins); the gun's scatter is the one given (``--sd A28=...``).
+This part updates the law's scale (a scale is what one shot, or shots at one speed, pins);
+the gun's scatter is the one given (``--sd A28=...``). ``vary`` names a second knob set with
+the velocity (E13 or E16, for the duration; a lot stronger or weaker than the law the shot
+was designed on cannot meet both a peak and a duration by the velocity alone).
 """
 from __future__ import annotations
 
@@ -56,6 +58,12 @@ class NextRequest:
     output: Path | None = None  # default SHOT.next.xlsx beside the shot
     force: bool = False
     argv: tuple[str, ...] = ()
+    vary: str | None = None  # a second knob set with A28 (E13, E16 or A2)
+
+
+#: The second knobs ``next --vary`` takes: the mitigator's geometry and the exchange mass
+#: (A28 is always set; E40 is the lot's strength, the law's, not a setting).
+SECOND_KNOBS = (address("rcone"), address("hcone"), address("m1"))
 
 
 @dataclass(frozen=True)
@@ -75,6 +83,7 @@ class NextOutcome:
     proposal: str  # the proposal's version, LOT@N
     files: tuple[Path, ...]
     warnings: tuple[str, ...]
+    second: tuple[str, str, float] | None = None  # (cell, unit, value) set with A28 (vary)
 
     def to_json(self) -> str:
         """``next --json``: the verdict, the law's update, the setting and its P(PASS)."""
@@ -88,7 +97,10 @@ class NextOutcome:
             "law": {"version": self.law, "scale": self.update.scale,
                     "scale_standard_error": self.update.error, "shots": self.update.shots,
                     "note": self.update.note},
-            "next": {"A28_m_s": self.setting, "p_pass": self.best.probability,
+            "next": {"A28_m_s": self.setting,
+                     **({f"{self.second[0]}_{self.second[1]}": self.second[2]}
+                        if self.second else {}),
+                     "p_pass": self.best.probability,
                      "interval": [lo, hi], "draws": self.best.shots,
                      "most_likely_to_fail": worst[0] if worst else None},
             "confidence": self.confidence, "reached": self.reached,
@@ -134,8 +146,9 @@ def run(request: NextRequest) -> NextOutcome:
     warnings = list(dict.fromkeys([*map(str, shot.warnings), *verdict.warnings,
                                    *update.warnings, *conf_warnings]))
     if not reached:
-        warnings.append(f"next: no A28 in range reaches P(PASS) = {request.confidence:g}; the "
-                        f"best found is {best.probability:.4f} at {best.setting:.6g} m/s")
+        warnings.append(f"next: no A28{f' and {request.vary}' if request.vary else ''} in range"
+                        f" reaches P(PASS) = {request.confidence:g}; the best found is "
+                        f"{best.probability:.4f} at {setting_text(request, best)}")
     return _publish(request, output, shot, spec, verdict, update, best, reached, lot_shots,
                     counted_once, warnings)
 
@@ -158,10 +171,33 @@ def _checked(request: NextRequest) -> Path:
     if not request.lot or safe_name(request.lot) != request.lot:
         raise OptionError(f"--lot: found {request.lot!r}, expected a lot name of letters, "
                           "digits, '-', '_' and '.' (such as LOT-2026-07)")
+    if request.vary is not None:
+        second_knob(request.vary)
     output = request.output if request.output is not None else default_output(request.shot)
     check_output(output, request.force, inputs=[request.shot, input_file(request.recording)])
     Archive(request.archive, create=True, dry_run=True)  # a folder that is not one: refused
     return output
+
+
+def second_knob(name: str) -> Any:
+    """The design variable ``--vary`` names (one of :data:`SECOND_KNOBS`), or one line."""
+    from ..studies.design import variable
+
+    var = variable(name)
+    if var.cell not in SECOND_KNOBS:
+        raise OptionError(f"--vary: found {name!r}, expected a second knob set with A28: "
+                          f"{', '.join(SECOND_KNOBS)} (A28 is always set; E40 is the lot's "
+                          "strength, which the law's update gives)")
+    return var
+
+
+def setting_text(request: NextRequest, best: PassProbability) -> str:
+    """The setting chosen, as a person sets it: A28 (and the second knob)."""
+    text = f"A28 = {best.setting:.6g} m/s"
+    if request.vary is not None:
+        var = second_knob(request.vary)
+        text += f", {var.cell} = {best.second:.6g} {var.unit}"
+    return text
 
 
 def _tolerances(spec: Any) -> None:
@@ -285,8 +321,10 @@ def _choose(request: NextRequest, spec: Any, p: Any, sds: list[Any],
     from ..studies.design import variable
     from ..studies.first_shot import solve_confidence
 
+    second = second_knob(request.vary) if request.vary is not None else None
     found = solve_confidence(p, spec, variable(address("v31")), sds, request.shots, request.seed,
-                             integrator=request.integrator, noise=noise)
+                             integrator=request.integrator, noise=noise, second=second,
+                             keep_middle=False)
     return found.best, list(found.warnings)
 
 
@@ -323,7 +361,10 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
         record = {"lot": request.lot, "shot": str(request.shot),
                   "recording": str(request.recording), "verdict": verdict.word,
                   "law": ref, "scale": update.scale, "scale_error": update.error,
-                  "setting_A28": best.setting, "p_pass": best.probability,
+                  "setting_A28": best.setting,
+                  **({"second_cell": request.vary and second_knob(request.vary).cell,
+                      "second_value": best.second} if request.vary else {}),
+                  "p_pass": best.probability,
                   "interval": [lo, hi], "draws": best.shots,
                   "most_likely_to_fail": worst[0] if worst else None,
                   "confidence": request.confidence, "reached": reached,
@@ -342,8 +383,10 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
                 thing.take_back()
         raise
     proposal = f"{request.lot}@{int(stored.path.stem[1:])}"
+    knob = second_knob(request.vary) if request.vary is not None else None
     return NextOutcome(verdict, update, ref, best.setting, best, request.confidence, reached,
-                       counted_once, output, proposal, (output,), tuple(warnings))
+                       counted_once, output, proposal, (output,), tuple(warnings),
+                       (knob.cell, knob.unit, best.second) if knob is not None else None)
 
 
 def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: Verdict,
@@ -356,15 +399,19 @@ def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: V
     from .design import with_cells
     from .fill import Options, fill_workbook
 
-    var = variable(address("v31"))
-    params = var.apply(shot.params.replace(crush_law=law), best.setting)
-    designed = with_cells(shot, Design([var], [best.setting], params, math.nan, math.nan,
-                                       best.shots))
+    knobs, values = [variable(address("v31"))], [best.setting]
+    if request.vary is not None:
+        knobs.append(second_knob(request.vary))
+        values.append(best.second)
+    params = shot.params.replace(crush_law=law)
+    for var, value in zip(knobs, values, strict=True):
+        params = var.apply(params, value)
+    designed = with_cells(shot, Design(knobs, values, params, math.nan, math.nan, best.shots))
     # what the loop said travels with the figures it qualifies (the Summary's P(PASS))
     designed = dataclasses.replace(designed, warnings=list(warnings))
     lo, hi = best.interval
     worst = best.most_failing()
-    notes = (f"next shot of lot {request.lot}: A28 = {best.setting:.6g} m/s, P(PASS) = "
+    notes = (f"next shot of lot {request.lot}: {setting_text(request, best)}, P(PASS) = "
              f"{best.probability:.4f} (95 % interval {lo:.4f}-{hi:.4f}, {best.shots:,} draws "
              f"of the gun ({', '.join(request.sd)}) and the law), seed {request.seed}",
              f"most likely to fail: {worst[0] if worst else 'none'}",
@@ -395,7 +442,7 @@ def lines(request: NextRequest, outcome: NextOutcome) -> list[str]:
     said += [f"lot {request.lot}: the law {outcome.law}, the prior scaled by {u.scale:.4f} "
              f"+/- {u.error:.4f} (1 standard error) on {u.shots} shot"
              f"{'s' * (u.shots > 1)}", f"  {u.note}",
-             f"next: A28 = {outcome.setting:.6g} m/s, P(PASS) = {b.probability:.4f} "
+             f"next: {setting_text(request, b)}, P(PASS) = {b.probability:.4f} "
              f"[{lo:.4f}, {hi:.4f}] over {b.shots:,} draws"
              + (f"; most likely to fail: {worst[0]}" if worst else ""),
              f"  {'reaches' if outcome.reached else 'does NOT reach'} --confidence "

@@ -34,6 +34,10 @@ def add_parser(sub):
                    help="start the lot: its prior is the report's law")
     p.add_argument("--sd", action="append", metavar="CELL=SD",
                    help="the gun's scatter, A28=1.5%% (needed), and zeta's, E43=10%%")
+    p.add_argument("--vary", metavar="CELL", action=One,
+                   help="a second knob set with A28 for the duration: E13, E16 or A2 "
+                        "(a lot whose strength differs from the law's cannot meet a peak "
+                        "and a duration by A28 alone)")
     p.add_argument("--confidence", type=float, default=0.9, metavar="P",
                    help="the P(PASS) asked of the next shot (default 0.9): exit 3 below it")
     p.add_argument("--shots", type=int, default=2000, metavar="N",
@@ -57,7 +61,7 @@ def request_of(args):
                        args.confidence, args.shots, args.seed, args.channel, args.sign,
                        args.time_unit, args.accel_unit, args.integrator,
                        Path(args.output) if args.output else None, args.force,
-                       tuple(args.argv))
+                       tuple(args.argv), args.vary)
 
 
 def run(args):

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -140,6 +141,121 @@ def solve_middle(p, spec, var, bounds=None, integrator="legacy", model="4-mass",
     return MiddleDesign(x, y, span, count[0], (xs, ys))
 
 
+#: Levels of a :class:`Pair`'s second variable in its first scan (``next --vary``).
+LEVELS = 9
+
+#: Points a level's best first setting is searched on again, across two scan steps: its
+#: resolution a tenth of a step (about 1 m/s of A28).
+FINE_POINTS = 21
+
+#: Most single runs of the pair's middle design's last search (Nelder-Mead).
+PAIR_EVALUATIONS = 60
+
+
+@dataclass(frozen=True)
+class Pair:
+    """Two variables set together (``next --vary``): ``first`` (the velocity) and ``second``
+    (such as E13 or E16, for the duration); a setting is a tuple (first, second)."""
+
+    first: Any
+    second: Any
+
+    @property
+    def label(self) -> str:
+        return f"{self.first.label} and {self.second.label}"
+
+    def apply(self, p, x):
+        return self.second.apply(self.first.apply(p, x[0]), x[1])
+
+
+def _judged(p, var, xs, spec, integrator, model, runner, noise):
+    """:class:`BlockJudge`'s values at each setting of ``var``; a setting that makes no shot
+    (parameters refused: a second variable can reach them) is NaN, the worst margin."""
+    params, ok = [], np.zeros(len(xs), dtype=bool)
+    for k, x in enumerate(xs):
+        try:
+            params.append(apply_model(var.apply(p, x), model))
+            ok[k] = True
+        except AirgunXlError:
+            pass
+    values = np.full((len(xs), len(BLOCK_VALUES)), np.nan)
+    if params:
+        values[ok] = (runner or run_batch)(params, integrator,
+                                           extra=BlockJudge(spec, noise=noise)).extras
+    return values
+
+
+@dataclass
+class PairMiddle:
+    """The pair's setting whose prediction sits deepest inside the tolerances, and the
+    candidates of :func:`solve_confidence`: at each level of the second variable, the first
+    variable's best setting (the ridge), deepest first."""
+
+    value: tuple[float, float]
+    margin: float
+    candidates: list[tuple[float, float]]
+    evaluations: int
+
+
+def solve_middle_pair(p, spec, pair, integrator="legacy", model="4-mass", runner=None,
+                      noise=0.0, bounds=None):
+    """The :class:`Pair` setting with the largest smallest margin: a scan of
+    :data:`SCAN_POINTS` first settings at :data:`LEVELS` second ones, each level's best
+    searched again on :data:`FINE_POINTS` points, then Nelder-Mead (scipy, bounded, at most
+    :data:`PAIR_EVALUATIONS` runs) from the deepest.
+
+    Raises
+    ------
+    DesignError
+        When no setting gives a pulse that can be judged.
+    """
+    from scipy.optimize import minimize
+
+    (lo1, hi1), (lo2, hi2) = bounds or pair.first.bounds(p), pair.second.bounds(p)
+    xs, ys = np.linspace(lo1, hi1, SCAN_POINTS), np.linspace(lo2, hi2, LEVELS)
+
+    def judged(points):
+        return margins(_judged(p, pair, points, spec, integrator, model, runner, noise), spec)
+
+    coarse = judged([(x, y) for y in ys for x in xs]).reshape(LEVELS, SCAN_POINTS)
+    if not np.isfinite(coarse).any():
+        raise DesignError(f"no {pair.label} in {lo1:.4g}-{hi1:.4g} {pair.first.unit} and "
+                          f"{lo2:.4g}-{hi2:.4g} {pair.second.unit} gives a pulse that can be "
+                          "judged (every shot diverged)")
+    step = xs[1] - xs[0]
+    rows = [np.linspace(max(xs[j] - step, lo1), min(xs[j] + step, hi1), FINE_POINTS)
+            for j in np.argmax(coarse, axis=1)]
+    fine = judged([(x, y) for y, row in zip(ys, rows, strict=True)
+                   for x in row]).reshape(LEVELS, FINE_POINTS)
+    ridge = sorted(((float(row[int(np.argmax(m))]), float(y), float(np.max(m)))
+                    for y, row, m in zip(ys, rows, fine, strict=True) if np.isfinite(m).any()),
+                   key=lambda r: -r[2])
+    count = [coarse.size + fine.size]
+    spans = np.array([hi1 - lo1, hi2 - lo2])
+    origin = np.array([lo1, lo2])
+
+    def negative(u):
+        count[0] += 1
+        margin = float(judged([tuple(origin + np.clip(u, 0, 1) * spans)])[0])
+        return -margin if math.isfinite(margin) else DIVERGED_MARGIN
+
+    start = (np.array(ridge[0][:2]) - origin) / spans
+    simplex = [start, start + [0.1 * step / spans[0], 0.0],
+               start + [0.0, 0.5 * (ys[1] - ys[0]) / spans[1]]]
+    found = minimize(negative, start, method="Nelder-Mead", bounds=[(0, 1), (0, 1)],
+                     options={"initial_simplex": np.clip(simplex, 0, 1),
+                              "maxfev": PAIR_EVALUATIONS, "xatol": 1e-4, "fatol": 1e-5})
+    if -found.fun > ridge[0][2]:
+        x, y = origin + np.clip(found.x, 0, 1) * spans
+        value, margin = (float(x), float(y)), -float(found.fun)
+    else:
+        value, margin = ridge[0][:2], ridge[0][2]
+    # the levels whose best passes nominally (or, when none does, the three deepest)
+    candidates = [r[:2] for r in ridge if r[2] >= 0][:CANDIDATES + 1] or [
+        r[:2] for r in ridge[:3]]
+    return PairMiddle(value, margin, candidates, count[0])
+
+
 @dataclass
 class PassProbability:
     """A Monte Carlo's pass rate at one setting."""
@@ -150,6 +266,7 @@ class PassProbability:
     failures: dict[str, int]  # criterion -> shots failing it (a shot may fail several)
     diverged: int
     invalid: int  # draws that are not a shot (a negative mass): counted as failures
+    second: float = math.nan  # a :class:`Pair`'s second setting (NaN: one variable)
 
     @property
     def probability(self) -> float:
@@ -208,6 +325,7 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
                  f"a Monte Carlo of {n:,} shots of {p.rows:,} rows", "fewer --shots")
     values, fields_list = drawn if drawn is not None else draws(p, sds, n, seed)
     base = var.apply(p, setting) if var is not None and setting is not None else p
+    first, second = setting if isinstance(setting, tuple) else (setting, math.nan)
     params, invalid = [], np.zeros(n, dtype=bool)
     offsets = [(fields, 0.0 if fields == LAW_FIELDS else
                 getattr(base, fields[0]) - getattr(p, fields[0])) for fields in fields_list]
@@ -231,47 +349,69 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
     for f in flags.values():
         ok &= f
     failures = {name: int((~f).sum()) + int(invalid.sum()) for name, f in flags.items()}
-    return PassProbability(float(setting) if setting is not None else math.nan,
+    return PassProbability(float(first) if first is not None else math.nan,
                            int(ok.sum()), n, failures, int(batch.diverged.sum()),
-                           int(invalid.sum()))
+                           int(invalid.sum()), float(second))
 
 
 @dataclass
 class ConfidenceDesign:
-    """The setting with the highest pass probability, and the middle design's."""
+    """The setting with the highest pass probability, and the middle design's (None when it
+    was not run with every shot: ``keep_middle`` False)."""
 
     best: PassProbability
-    middle: PassProbability
-    middle_design: MiddleDesign
+    middle: PassProbability | None
+    middle_design: Any  # MiddleDesign, or PairMiddle for a Pair
     tried: list[PassProbability]
     shots: int
     warnings: list[str] = field(default_factory=list)
 
 
-def solve_confidence(p, spec, var, sds, n, seed=1, bounds=None, integrator="legacy",
-                     model="4-mass", runner=None, progress=None, noise=0.0):
-    """The setting of ``var`` most likely to pass (see the module's notes); ``noise`` [kG]:
-    the rest noise of the recordings the shots will be judged on (:class:`BlockJudge`)."""
-    middle = solve_middle(p, spec, var, bounds, integrator, model, runner, noise)
-    xs, ys = middle.scan
+def _span(middle):
+    """One variable's candidates: across the span where the prediction passes."""
+    xs, _ys = middle.scan
     step = xs[1] - xs[0] if len(xs) > 1 else 0.0
     if middle.passing is not None:
         lo, hi = middle.passing
         span = np.linspace(max(lo - step, xs[0]), min(hi + step, xs[-1]), CANDIDATES)
     else:  # nothing passes nominally: round the middle design
         span = np.clip(middle.value + step * np.linspace(-1, 1, CANDIDATES), xs[0], xs[-1])
-    candidates = sorted({float(x) for x in span} | {middle.value})
+    return sorted({float(x) for x in span} | {middle.value})
+
+
+def solve_confidence(p, spec, var, sds, n, seed=1, bounds=None, integrator="legacy",
+                     model="4-mass", runner=None, progress=None, noise=0.0, second=None,
+                     keep_middle=True):
+    """The setting of ``var`` most likely to pass (see the module's notes); ``noise`` [kG]:
+    the rest noise of the recordings the shots will be judged on (:class:`BlockJudge`).
+
+    ``second``: a second variable set with ``var`` (a :class:`Pair`, candidates from
+    :func:`solve_middle_pair`); the results' ``second`` holds its setting. ``keep_middle``
+    False runs only the first round's best with every shot (the middle design's probability
+    is then not known)."""
+    if second is None:
+        middle = solve_middle(p, spec, var, bounds, integrator, model, runner, noise)
+        knobs, candidates = var, _span(middle)
+    else:
+        knobs = Pair(var, second)
+        middle = solve_middle_pair(p, spec, knobs, integrator, model, runner, noise, bounds)
+        candidates = sorted(set(middle.candidates) | {middle.value})
     first_n = max(200, int(round(n * FIRST_ROUND)))
     drawn_first = draws(p, sds, first_n, seed)
-    first = [pass_probability(p, spec, sds, first_n, seed, var, x, integrator, model, runner,
+    first = [pass_probability(p, spec, sds, first_n, seed, knobs, x, integrator, model, runner,
                               progress, drawn_first, noise) for x in candidates]
-    ranked = sorted(first, key=lambda r: -r.probability)
-    finalists = sorted({r.setting for r in ranked[:FINALISTS]} | {middle.value})
+    # without the middle design in the final round, a tie goes to it (the deepest margin)
+    ranked = sorted(zip(candidates, first, strict=True), key=lambda r: (
+        -r[1].probability, not keep_middle and r[0] != middle.value))
+    finalists = [x for x, _ in ranked[:FINALISTS]]
+    if keep_middle and middle.value not in finalists:
+        finalists.append(middle.value)
     drawn = draws(p, sds, n, seed + 1)  # fresh draws: the first round's luck does not carry
-    final = [pass_probability(p, spec, sds, n, seed + 1, var, x, integrator, model, runner,
-                              progress, drawn, noise) for x in finalists]
+    final = [pass_probability(p, spec, sds, n, seed + 1, knobs, x, integrator, model, runner,
+                              progress, drawn, noise) for x in sorted(finalists)]
     best = max(final, key=lambda r: r.probability)
-    mid = next(r for r in final if r.setting == middle.value)
+    mid = (final[sorted(finalists).index(middle.value)] if middle.value in finalists
+           else None)
     warnings = []
     if spec.srs is not None:
         warnings.append("the SRS criterion is not in the probability: it is judged on the "
