@@ -585,13 +585,16 @@ def next_shot(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *
               seed: int = 1, output: str | os.PathLike[str] | None = None, force: bool = False,
               channel: str | None = None, sign: float = 1.0, time_unit: str | None = None,
               accel_unit: str | None = None, integrator: str = "legacy",
-              vary: str | None = None, **spec: Unpack[SpecKeywords]) -> NextOutcome:
+              vary: str | None = None, scheduler: str | None = None,
+              workers: int | None = None, chunk: int | None = None,
+              **spec: Unpack[SpecKeywords]) -> NextOutcome:
     """The closed loop, as ``airgun-xl next`` runs it: judge the fired ``shot``'s
     ``recording``, update ``lot``'s law in ``archive`` on every shot of the lot, choose the
     A28 (with ``vary``, also a second knob: ``"E13"``, ``"E16"`` or ``"A2"``) most likely to
-    pass with the gun's scatter (``sd=["A28=1.5%"]``) and the law drawn from its update,
-    write the next shot's workbook (``output``, else SHOT.next.xlsx) and keep the verdict,
-    the law's version and the proposal in the archive.
+    pass with the gun's scatter (``sd=["A28=1.5%"]``) and the law drawn from its update
+    (on a Dask cluster with ``scheduler`` or ``workers``, ``chunk`` shots a task), write the
+    next shot's workbook (``output``, else SHOT.next.xlsx) and keep the verdict, the law's
+    version and the proposal in the archive.
 
     Returns
     -------
@@ -617,7 +620,9 @@ def next_shot(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *
         _number("--confidence", confidence), _whole("--shots", shots), _whole("--seed", seed),
         channel, _number("--sign", sign), time_unit, accel_unit, integrator,
         Path(output) if output is not None else None, force, ("next",),
-        None if vary is None else str(vary)))
+        None if vary is None else str(vary), None if scheduler is None else str(scheduler),
+        None if workers is None else _whole("--workers", workers),
+        None if chunk is None else _whole("--chunk", chunk)))
 
 
 __all__ = [

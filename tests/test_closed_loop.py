@@ -184,7 +184,8 @@ def test_a_second_knob_passes_a_lot_the_velocity_alone_cannot(tmp_path):
 
 @pytest.mark.parametrize("case", ["unknown lot", "no tolerances", "no peak or duration",
                                   "empty recording", "changed shot", "no gun scatter",
-                                  "vary A28", "vary E40", "vary unknown"])
+                                  "vary A28", "vary E40", "vary unknown",
+                                  "chunk without a cluster"])
 def test_bad_input_is_one_line_and_nothing_is_written_or_recorded(lot, tmp_path, case,
                                                                    capsys):
     work, first, _ = lot
@@ -205,6 +206,8 @@ def test_bad_input_is_one_line_and_nothing_is_written_or_recorded(lot, tmp_path,
         rec.write_text("")
     elif case == "no gun scatter":
         argv[8] = "E43=10%"
+    elif case == "chunk without a cluster":
+        argv += ["--chunk", "64"]
     elif case.startswith("vary"):
         argv += ["--vary", {"vary A28": "A28", "vary E40": "E40", "vary unknown": "Q9"}[case]]
     else:  # a shot of the lot edited after it was recorded
@@ -227,7 +230,8 @@ def test_bad_input_is_one_line_and_nothing_is_written_or_recorded(lot, tmp_path,
                 "changed shot": "differs from the one recorded",
                 "vary A28": "--vary: found 'A28', expected a second knob",
                 "vary E40": "--vary: found 'E40', expected a second knob",
-                "vary unknown": "--vary: found 'Q9', expected one of"}[case]
+                "vary unknown": "--vary: found 'Q9', expected one of",
+                "chunk without a cluster": "--chunk: found it without --scheduler"}[case]
     assert expected in err[0], err[0]
     assert not math.isnan(first.best.probability)
 

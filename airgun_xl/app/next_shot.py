@@ -59,6 +59,9 @@ class NextRequest:
     force: bool = False
     argv: tuple[str, ...] = ()
     vary: str | None = None  # a second knob set with A28 (E13, E16 or A2)
+    scheduler: str | None = None  # the draws on a Dask cluster (its scheduler's address)
+    workers: int | None = None  # or on a local one of this many processes
+    chunk: int | None = None  # shots a cluster task
 
 
 #: The second knobs ``next --vary`` takes: the mitigator's geometry and the exchange mass
@@ -317,14 +320,17 @@ def _noise(verdict: Verdict) -> float:
 def _choose(request: NextRequest, spec: Any, p: Any, sds: list[Any],
             noise: float) -> tuple[PassProbability, list[str]]:
     """The A28 most likely to pass, drawing the gun, zeta and the law, each prediction judged
-    as a recording of the fired shot's noise would be."""
+    as a recording of the fired shot's noise would be (on the batch lanes, or a Dask
+    cluster: the same draws, the same shots, the same P(PASS))."""
     from ..studies.design import variable
     from ..studies.first_shot import solve_confidence
+    from .running import cluster_runner
 
     second = second_knob(request.vary) if request.vary is not None else None
-    found = solve_confidence(p, spec, variable(address("v31")), sds, request.shots, request.seed,
-                             integrator=request.integrator, noise=noise, second=second,
-                             keep_middle=False)
+    with cluster_runner(request.scheduler, request.workers, request.chunk) as runner:
+        found = solve_confidence(p, spec, variable(address("v31")), sds, request.shots,
+                                 request.seed, integrator=request.integrator, noise=noise,
+                                 runner=runner, second=second, keep_middle=False)
     return found.best, list(found.warnings)
 
 

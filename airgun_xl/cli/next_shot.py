@@ -3,6 +3,7 @@ loop. Exit 0 when the setting proposed reaches ``--confidence``, 3 when none doe
 is still written), 2 for bad input (nothing written or recorded)."""
 from pathlib import Path
 
+from .cluster_options import add_cluster_options
 from .recording_options import RECORDING_HELP, add_recording_options
 from .run_options import SHOT_HELP, add_force, add_integrator, add_json, add_output
 from .spec_options import RECORD_HELP, add_spec_options
@@ -48,6 +49,7 @@ def add_parser(sub):
     add_recording_options(p, anti_alias=False, cfc_help=RECORD_HELP)
     add_spec_options(p, cfc=False)
     add_integrator(p)
+    add_cluster_options(p)
     add_json(p, "the verdict, the law's update and the next setting")
     p.set_defaults(run=run)
 
@@ -61,7 +63,8 @@ def request_of(args):
                        args.confidence, args.shots, args.seed, args.channel, args.sign,
                        args.time_unit, args.accel_unit, args.integrator,
                        Path(args.output) if args.output else None, args.force,
-                       tuple(args.argv), args.vary)
+                       tuple(args.argv), args.vary, args.scheduler, args.workers,
+                       args.chunk)
 
 
 def run(args):
