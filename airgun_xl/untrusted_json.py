@@ -95,6 +95,7 @@ SCHEMAS: dict[str, dict] = {
             "interval": {"type": "array", "items": _NUMBER, "minItems": 2, "maxItems": 2},
             "draws": {"type": "integer"}, "most_likely_to_fail": {"type": ["string", "null"]},
             "confidence": _NUMBER, "reached": {"type": "boolean"}, "sd": _TEXTS,
+            "gun": _TEXT,
             "seed": {"type": "integer"}, "next_workbook": _TEXT,
             "next_sha256": {"type": "string", "pattern": "^[0-9a-f]{64}$"},
             "shots": {"type": "array", "items": {

@@ -8,8 +8,11 @@ options, the lot (unknown without ``new_lot``), the specification (it needs tole
 gun's scatter, the lot's earlier shots (each file unchanged since it was recorded), the
 recording and the output.
 
-This part updates the law's scale (a scale is what one shot, or shots at one speed, pins);
-the gun's scatter is the one given (``--sd A28=...``). ``vary`` names a second knob set with
+This part updates the law's scale (a scale is what one shot, or shots at one speed, pins).
+The gun's scatter is the one given (``--sd A28=...``) until the lot has
+:data:`~airgun_xl.studies.closed_loop.GUN_SHOTS` shots; from then on each shot's launch
+velocity is fitted with the scale and the scatter is estimated from them (its source said
+with every P(PASS)). ``vary`` names a second knob set with
 the velocity (E13 or E16, for the duration; a lot stronger or weaker than the law the shot
 was designed on cannot meet both a peak and a duration by the velocity alone).
 """
@@ -87,6 +90,7 @@ class NextOutcome:
     files: tuple[Path, ...]
     warnings: tuple[str, ...]
     second: tuple[str, str, float] | None = None  # (cell, unit, value) set with A28 (vary)
+    gun: str = ""  # the gun's scatter drawn, and where it came from
 
     def to_json(self) -> str:
         """``next --json``: the verdict, the law's update, the setting and its P(PASS)."""
@@ -106,7 +110,7 @@ class NextOutcome:
                      "p_pass": self.best.probability,
                      "interval": [lo, hi], "draws": self.best.shots,
                      "most_likely_to_fail": worst[0] if worst else None},
-            "confidence": self.confidence, "reached": self.reached,
+            "gun": self.gun, "confidence": self.confidence, "reached": self.reached,
             "proposal": self.proposal, "files": self.files, "warnings": self.warnings})
 
 
@@ -124,13 +128,12 @@ def run(request: NextRequest) -> NextOutcome:
     """
     from ..readers.recording import input_file
     from ..shot import Shot
-    from ..studies.closed_loop import law_scatter, update_scale
+    from ..studies.closed_loop import GUN_SHOTS, law_scatter, update_scale
 
     output = _checked(request)
     shot = Shot.from_workbook(request.shot)
     spec = require(resolve(shot, request.spec), request.shot)
     _tolerances(spec)
-    sds = _scatter(request, shot)
     prior, earlier = _lot(request)
     this = {"shot": str(request.shot), "shot_sha256": _sha256(request.shot, "workbook"),
             "recording": str(request.recording),
@@ -139,21 +142,25 @@ def run(request: NextRequest) -> NextOutcome:
     counted_once = any((s["shot_sha256"], s["recording_sha256"]) ==
                        (this["shot_sha256"], this["recording_sha256"]) for s in earlier)
     lot_shots = earlier if counted_once else [*earlier, this]
+    estimated = len(lot_shots) >= GUN_SHOTS
+    sds = _scatter(request, estimated)
     verdict = _judge(request, spec)
     params, traces = _read_lot(lot_shots)
-    update = update_scale(params, traces, prior, spec.judged.cfc, request.integrator)
+    update = update_scale(params, traces, prior, spec.judged.cfc, request.integrator,
+                          velocities=estimated)
+    sds, gun, gun_warnings = _gun(update, sds, len(lot_shots), shot.params.v31)
     p_next = shot.params.replace(crush_law=update.law)
     best, conf_warnings = _choose(request, spec, p_next, [*sds, law_scatter(update)],
                                   _noise(verdict))
     reached = best.probability >= request.confidence and best.interval[1] >= request.confidence
     warnings = list(dict.fromkeys([*map(str, shot.warnings), *verdict.warnings,
-                                   *update.warnings, *conf_warnings]))
+                                   *update.warnings, *gun_warnings, *conf_warnings]))
     if not reached:
         warnings.append(f"next: no A28{f' and {request.vary}' if request.vary else ''} in range"
                         f" reaches P(PASS) = {request.confidence:g}; the best found is "
                         f"{best.probability:.4f} at {setting_text(request, best)}")
     return _publish(request, output, shot, spec, verdict, update, best, reached, lot_shots,
-                    counted_once, warnings)
+                    counted_once, warnings, gun)
 
 
 def _checked(request: NextRequest) -> Path:
@@ -212,18 +219,54 @@ def _tolerances(spec: Any) -> None:
                           "aims A28 at them)")
 
 
-def _scatter(request: NextRequest, shot: Shot) -> list[Any]:
-    """The gun's scatter and zeta's, as given; the gun's is needed."""
+def _scatter(request: NextRequest, estimated: bool) -> list[Any]:
+    """The gun's scatter and zeta's, as given; the gun's is needed until the lot's shots
+    estimate it (``estimated``)."""
+    from ..studies.closed_loop import GUN_SHOTS
     from ..studies.sweep import parse_sds
 
     sds = parse_sds(request.sd)
-    if not any(cell == address("v31") for cell, *_ in sds):
+    if not estimated and not any(cell == address("v31") for cell, *_ in sds):
         raise OptionError("--sd: found no A28 scatter, expected the gun's shot-to-shot "
-                          "scatter such as --sd A28=1.5% (and E43=10% for zeta's)")
+                          "scatter such as --sd A28=1.5% (and E43=10% for zeta's) until the "
+                          f"lot has {GUN_SHOTS} shots to estimate it from")
     if any(cell == address("sigmay") for cell, *_ in sds):
         raise OptionError("--sd: found E40, expected the gun's (A28) and zeta's (E43) only: "
                           "the lot's crush strength is the law's, drawn from its update")
     return list(sds)
+
+
+def _gun(update: LawUpdate, sds: list[Any], shots: int,
+         velocity: float) -> tuple[list[Any], str, list[str]]:
+    """The gun's scatter drawn: estimated from the lot's launch velocities once it has
+    :data:`~airgun_xl.studies.closed_loop.GUN_SHOTS` shots, else the one given; with the
+    words saying which, and a warning when the given one lies outside the estimate's 95 %
+    interval."""
+    from ..studies.closed_loop import GUN_SHOTS, gun_scatter
+
+    given = next((sd for sd in sds if sd[0] == address("v31")), None)
+    shown = "" if given is None else (f"{given[0]}={given[2] * 100:g}%" if given[3]
+                                      else f"{given[0]}={given[2]:g}")
+    found = gun_scatter(update)
+    if found is None:
+        assert given is not None  # _scatter refused it otherwise
+        return sds, (f"the gun's scatter {shown} as given (--sd): the lot has {shots} "
+                     f"shot{'s' * (shots > 1)}, and it is estimated from the shots' launch "
+                     f"velocities from {GUN_SHOTS}"), []
+    rest = [sd for sd in sds if sd[0] != address("v31")]
+    cell, fields, _sd, _rel = given if given is not None else (
+        address("v31"), ("v31", "v32", "v33"), 0.0, True)
+    words = found.words()
+    warnings = []
+    if given is not None:
+        value = given[2] if given[3] else given[2] / abs(velocity)  # relative to the set A28
+        words += f"; the {shown} given is not used"
+        lo, hi = found.interval
+        if not lo <= value <= hi:
+            warnings.append(f"--sd {shown}: the gun's scatter given lies outside the "
+                            f"95 % interval estimated from the lot's shots ({lo:.2%}-{hi:.2%})"
+                            f"; the estimate, {found.sd:.2%}, is drawn")
+    return [*rest, (cell, fields, found.sd, True)], words, warnings
 
 
 def _lot(request: NextRequest) -> tuple[Any, list[dict[str, Any]]]:
@@ -337,7 +380,7 @@ def _choose(request: NextRequest, spec: Any, p: Any, sds: list[Any],
 def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: Verdict,
              update: LawUpdate, best: PassProbability, reached: bool,
              lot_shots: list[dict[str, Any]], counted_once: bool,
-             warnings: list[str]) -> NextOutcome:
+             warnings: list[str], gun: str) -> NextOutcome:
     """Store the law's new version, write the next shot's workbook, keep the verdict and the
     proposal; a failure takes back what was done."""
     from ..archive import Archive
@@ -357,7 +400,7 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
             done.append(StoredVerdict(Path(request.archive) / LAWS / request.lot /
                                       f"v{version:04d}.json", Archive(request.archive)))
         law = CrushLaw(update.law.coefficients, update.law.v_range, "fitted", source=ref)
-        _write(request, output, shot, spec, verdict, update, best, law, ref, warnings)
+        _write(request, output, shot, spec, verdict, update, best, law, ref, warnings, gun)
         done.append(output)
         with signals_held():
             done.append(store_verdict(request.archive, shot, verdict, request.recording,
@@ -374,7 +417,7 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
                   "interval": [lo, hi], "draws": best.shots,
                   "most_likely_to_fail": worst[0] if worst else None,
                   "confidence": request.confidence, "reached": reached,
-                  "sd": list(request.sd), "seed": request.seed,
+                  "sd": list(request.sd), "gun": gun, "seed": request.seed,
                   "next_workbook": str(output), "next_sha256": file_sha256(output),
                   "shots": lot_shots, "warnings": warnings,
                   "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
@@ -392,12 +435,13 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
     knob = second_knob(request.vary) if request.vary is not None else None
     return NextOutcome(verdict, update, ref, best.setting, best, request.confidence, reached,
                        counted_once, output, proposal, (output,), tuple(warnings),
-                       (knob.cell, knob.unit, best.second) if knob is not None else None)
+                       (knob.cell, knob.unit, best.second) if knob is not None else None,
+                       gun)
 
 
 def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: Verdict,
            update: LawUpdate, best: PassProbability, law: Any, ref: str,
-           warnings: list[str]) -> None:
+           warnings: list[str], gun: str) -> None:
     """The next shot's workbook: the chosen A28..A30, the lot's law (its Crush law sheet),
     and on its Summary the prediction of P(PASS) and where it came from."""
     from ..outputs import from_sheet
@@ -420,6 +464,7 @@ def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: V
     notes = (f"next shot of lot {request.lot}: {setting_text(request, best)}, P(PASS) = "
              f"{best.probability:.4f} (95 % interval {lo:.4f}-{hi:.4f}, {best.shots:,} draws "
              f"of the gun ({', '.join(request.sd)}) and the law), seed {request.seed}",
+             gun,
              f"most likely to fail: {worst[0] if worst else 'none'}",
              f"the lot's law {ref}: the prior scaled by {update.scale:.4f} +/- "
              f"{update.error:.4f} on {update.shots} shot{'s' * (update.shots > 1)}; "
@@ -451,6 +496,7 @@ def lines(request: NextRequest, outcome: NextOutcome) -> list[str]:
              f"next: {setting_text(request, b)}, P(PASS) = {b.probability:.4f} "
              f"[{lo:.4f}, {hi:.4f}] over {b.shots:,} draws"
              + (f"; most likely to fail: {worst[0]}" if worst else ""),
+             f"  {outcome.gun}",
              f"  {'reaches' if outcome.reached else 'does NOT reach'} --confidence "
              f"{outcome.confidence:g}",
              f"wrote {outcome.output}; kept the verdict, the law {outcome.law} and the "

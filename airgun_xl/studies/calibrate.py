@@ -95,6 +95,9 @@ class FitResult:
     params: list = field(default_factory=list)  # each shot's ShotParams, fitted
     errors: dict = field(default_factory=dict)  # standard error of each value (Jacobian)
     bounds: dict = field(default_factory=dict)  # (low, high) each value was held to
+    #: with ``velocities``: (impact speed set [m/s], fitted factor on it, its standard error)
+    #: of each shot
+    velocities: list = field(default_factory=list)
 
 
 def _run(p, integrator):
@@ -619,8 +622,13 @@ def check_fit(names, objective="l2"):
 #: A fitted value within this fraction of a bound is tried at the bound (fit_parameters).
 BOUND_REACH = 0.05
 
+#: A shot's launch velocity is fitted within this fraction of its set value (a gun 15 % off
+#: its setting is not scatter).
+VELOCITY_REACH = 0.15
 
-def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
+
+def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy",
+                   velocities=False):
     """Fit E40, E43 and/or a law scale to measured shots by least squares.
 
     Parameters
@@ -632,6 +640,10 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
     objective : {"l2", "iso18571"}
         The filtered pulses' difference over each measured pulse (10 % rule), or one minus
         each shot's ISO/TS 18571 overall rating.
+    velocities : bool
+        Also fit each shot's launch velocity (A28..A30, a factor on the set value within
+        +/- :data:`VELOCITY_REACH`): the shots' own speeds, with the pooled values
+        (:attr:`FitResult.velocities`). L2 only.
 
     Returns
     -------
@@ -640,6 +652,8 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
     from scipy.optimize import least_squares, minimize
 
     names = check_fit(names, objective)
+    if velocities and objective != "l2":
+        raise OptionError("the launch velocities are fitted on the L2 objective only")
     p0 = pairs[0][0]
     start = {address("sigmay"): p0.sigmay, address("zeta"): p0.zeta, "scale": 1.0}
     x0, lo, hi = [], [], []
@@ -650,11 +664,16 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
         hi.append(start[n] * high if high else 0.5)
     evaluations = [0]
 
+    k = len(pairs)
+
     def shots(x):
         values = dict(zip(names, x[:len(names)], strict=True))
+        factors = x[len(names) + k:] if velocities else np.ones(k)
         out = []
-        for p, _ in pairs:
+        for (p, _), factor in zip(pairs, factors, strict=True):
             changes = {}
+            if velocities:
+                changes.update({f: getattr(p, f) * float(factor) for f in ("v31", "v32", "v33")})
             if address("sigmay") in values:
                 changes["sigmay"] = values[address("sigmay")]
             if address("zeta") in values:
@@ -668,7 +687,7 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
 
     def residuals(x, objective="l2", nudges=None):
         evaluations[0] += 1
-        nudges = x[len(names):] if nudges is None else nudges
+        nudges = x[len(names):len(names) + k] if nudges is None else nudges
         aligned = [align(_run(p, integrator), rec, nudge * dt)
                    for p, (_, rec), nudge, dt in zip(shots(x), pairs, nudges, steps,
                                                      strict=True)]
@@ -677,19 +696,18 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
     # the values, and each shot's alignment nudged within 2 samples of the threshold's (a
     # crossing on a noisy rise is early on average: left fixed, it biased E40 by 0.6 of its
     # standard error)
-    k = len(pairs)
-    start_x = np.concatenate([np.clip(x0, lo, hi), np.zeros(k)])
+    m = k if velocities else 0
+    start_x = np.concatenate([np.clip(x0, lo, hi), np.zeros(k), np.ones(m)])
     scale = np.concatenate([np.where(start_x[:len(names)] > 0, np.abs(start_x[:len(names)]),
-                                     0.01), np.full(k, 0.1)])
-    fit = least_squares(residuals, start_x, bounds=(np.concatenate([lo, np.full(k, -2.0)]),
-                                               np.concatenate([hi, np.full(k, 2.0)])),
+                                     0.01), np.full(k, 0.1), np.full(m, 0.01)])
+    upper = np.concatenate([hi, np.full(k, 2.0), np.full(m, 1 + VELOCITY_REACH)])
+    lower = np.concatenate([lo, np.full(k, -2.0), np.full(m, 1 - VELOCITY_REACH)])
+    fit = least_squares(residuals, start_x, bounds=(lower, upper),
                         x_scale=scale, diff_step=1e-4, xtol=1e-10, ftol=1e-10, gtol=1e-10,
                         max_nfev=200)
     # a fit that stops short of a bound its cost still falls towards (the residuals are
     # piecewise on the model's grid, so the trust region can stall within a few % of it) is
     # taken to the bound and polished from there when that costs less
-    upper = np.concatenate([hi, np.full(k, 2.0)])
-    lower = np.concatenate([lo, np.full(k, -2.0)])
     for i in range(len(names)):
         for bound in (lower[i], upper[i]):
             if abs(fit.x[i] - bound) <= BOUND_REACH * abs(bound) and fit.x[i] != bound:
@@ -700,9 +718,12 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
                     fit = least_squares(residuals, trial, bounds=(lower, upper),
                                         x_scale=scale, diff_step=1e-4, xtol=1e-10,
                                         ftol=1e-10, gtol=1e-10, max_nfev=100)
-    x, cost, nudges = fit.x[:len(names)], float(fit.cost), fit.x[len(names):]
-    errors = error_budget(fit, residual_blocks([rec for _, rec in pairs]), residuals,
-                          scale)[0][:len(names)]
+    x, cost, nudges = fit.x[:len(names)], float(fit.cost), fit.x[len(names):len(names) + k]
+    budget = error_budget(fit, residual_blocks([rec for _, rec in pairs]), residuals,
+                          scale)[0]
+    errors = budget[:len(names)]
+    speeds = [(float(p.v31 - p.v1), float(f), float(e)) for (p, _), f, e in zip(
+        pairs, fit.x[len(names) + k:], budget[len(names) + k:], strict=True)] if velocities else []
     if objective == "iso18571":
         # the rating is jagged in the parameters (its DTW and phase search move in steps), so
         # a finite-difference slope can point the wrong way: a derivative-free search (Powell,
@@ -715,9 +736,11 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy"):
         if found.fun < worse(x):
             x, cost = found.x, float(found.fun)
     return FitResult(dict(zip(names, map(float, x), strict=True)),
-                     {n: start[n] for n in names}, cost, evaluations[0], shots(x),
+                     {n: start[n] for n in names}, cost, evaluations[0],
+                     shots(np.concatenate([x, fit.x[len(names):]])),
                      dict(zip(names, map(float, errors), strict=True)),
-                     {n: (float(a), float(b)) for n, a, b in zip(names, lo, hi, strict=True)})
+                     {n: (float(a), float(b)) for n, a, b in zip(names, lo, hi, strict=True)},
+                     speeds)
 
 
 @dataclass
@@ -749,6 +772,9 @@ class Calibration:
     law_intervals: list = field(default_factory=list)  # NodeInterval of each law node
     warnings: list = field(default_factory=list)
     notes: list = field(default_factory=list)  # said with the figures; no verdict on them
+    #: with ``velocities``: each shot's (impact speed set [m/s], fitted factor, its standard
+    #: error)
+    velocities: list = field(default_factory=list)
 
     @property
     def trusted(self):
@@ -845,7 +871,7 @@ def verdict(cal, cfc, objective, p0):
 
 
 def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objective="l2",
-              integrator="legacy", anti_alias="auto"):
+              integrator="legacy", anti_alias="auto", velocities=False):
     """Calibrate the model on measured shots: the crush-factor law (the report's iteration,
     then least squares on the law's values, :func:`refine_law`), then the named parameters
     (:func:`fit_parameters`), and its :func:`verdict`.
@@ -861,6 +887,9 @@ def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objecti
         Names from :data:`FIT_PARAMETERS`.
     anti_alias : float, "auto" or "none"
         The recorders' anti-alias filter, modelled on the runs.
+    velocities : bool
+        With ``fit``, also each shot's launch velocity (:func:`fit_parameters`):
+        :attr:`Calibration.velocities`.
 
     Returns
     -------
@@ -890,19 +919,20 @@ def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objecti
         counter["runs"] += evaluations * len(pairs)
         params = [p.replace(crush_law=refined) for p in params]
         pairs = list(zip(params, recs, strict=True))
-    fitted, start, errors, bounds = {}, {}, {}, {}
+    fitted, start, errors, bounds, velocity_fit = {}, {}, {}, {}, []
     if fit:
-        result = fit_parameters(pairs, fit, cfc, objective, integrator)
+        result = fit_parameters(pairs, fit, cfc, objective, integrator, velocities)
         counter["runs"] += result.evaluations * len(pairs)
         params, fitted, start = result.params, result.values, result.start
         errors, bounds = result.errors, result.bounds
+        velocity_fit = result.velocities
     runs = [_run(p, integrator) for p in params]
     counter["runs"] += len(runs)
     aligned = [align(run, rec) for run, rec in zip(runs, recs, strict=True)]
     after = [score(a) for a in aligned]
     cal = Calibration(params, law_cal, fitted, start, before, after, aligned,
                       counter["runs"], time.perf_counter() - started, errors, bounds, nodes,
-                      law_errors, law_shares, recs)
+                      law_errors, law_shares, recs, velocities=velocity_fit)
     for rec, run in zip(recs, runs, strict=True):  # the same runs, cross-checked
         cal.warnings += [f"{rec.trace.name}: {w}" for w in rec.warnings]
         ok = np.isfinite(run.accel_kg)

@@ -6,6 +6,9 @@ next setting chosen on what the lot is now known to be.
   with ``fit=("scale",)``), with the scale's standard error. A scale is what one shot, or
   shots at one speed, can pin; the law's shape over speed needs shots spread over it, and is
   the prior's until then (said in :attr:`LawUpdate.note`).
+- :func:`gun_scatter`: the gun's shot-to-shot scatter, from the lot's shots' launch
+  velocities fitted with the scale (:func:`update_scale` with ``velocities``) against their
+  set values, once :data:`GUN_SHOTS` shots exist.
 - :func:`law_scatter`: the scale's standard error as a scatter of the law (relative, around
   1), drawn with the gun's and zeta's by :func:`~.first_shot.pass_probability` (the law known
   to its standard error: a posterior, not a shot-to-shot scatter).
@@ -38,6 +41,9 @@ class LawUpdate:
     speeds: tuple[float, float]  # [m/s] the lowest and highest impact speed of the shots
     calibration: Any  # studies.calibrate.Calibration
     note: str
+    #: with ``velocities``: each shot's (impact speed set [m/s], fitted factor, its standard
+    #: error)
+    launch: tuple[tuple[float, float, float], ...] = ()
 
     @property
     def warnings(self) -> list[str]:
@@ -49,9 +55,10 @@ class LawUpdate:
         return said
 
 
-def update_scale(params, traces, prior, cfc=None, integrator="legacy"):
+def update_scale(params, traces, prior, cfc=None, integrator="legacy", velocities=False):
     """The prior law scaled to the shots (``params`` each with its set values, ``traces``
-    each its recording), by least squares on the filtered pulses.
+    each its recording), by least squares on the filtered pulses; with ``velocities``, each
+    shot's launch velocity fitted with it (:attr:`LawUpdate.launch`).
 
     Returns
     -------
@@ -60,14 +67,69 @@ def update_scale(params, traces, prior, cfc=None, integrator="legacy"):
     from .calibrate import calibrate
 
     start = [p.replace(crush_law=prior) for p in params]
-    cal = calibrate(start, traces, law=False, fit=("scale",), cfc=cfc, integrator=integrator)
+    cal = calibrate(start, traces, law=False, fit=("scale",), cfc=cfc, integrator=integrator,
+                    velocities=velocities)
     scale, error = float(cal.fitted["scale"]), float(cal.errors.get("scale", math.nan))
     speeds = [p.v31 - p.v1 for p in params]
     lo, hi = min(speeds), max(speeds)
     n = len(params)
     note = (f"{n} shot{'s' * (n > 1)} at {lo:.4g}" + (f" to {hi:.4g}" if hi > lo else "")
             + " m/s pin the law's scale only; its shape over speed stays the prior's")
-    return LawUpdate(prior.scaled(scale), prior, scale, error, n, (lo, hi), cal, note)
+    if velocities:
+        note += "; each shot's launch velocity fitted with it"
+    return LawUpdate(prior.scaled(scale), prior, scale, error, n, (lo, hi), cal, note,
+                     tuple(tuple(v) for v in cal.velocities))
+
+
+#: Shots of a lot from which the gun's scatter is estimated (:func:`gun_scatter`): with 7
+#: degrees of freedom the 95 % interval of a standard deviation is 0.66 to 2.0 times the
+#: estimate (chi-square); with fewer, one lucky shot can halve the estimate and the P(PASS)
+#: drawn from it would be over-confident.
+GUN_SHOTS = 8
+
+
+@dataclass(frozen=True)
+class GunScatter:
+    """The gun's shot-to-shot scatter: a relative standard deviation of the launch velocity
+    [-], its 95 % interval, from ``shots`` shots; the mean launch velocity's offset from the
+    set value (the gun's bias) [-]."""
+
+    sd: float
+    interval: tuple[float, float]
+    shots: int
+    bias: float
+    bias_error: float
+
+    def words(self) -> str:
+        lo, hi = self.interval
+        return (f"the gun's scatter {self.sd:.2%} (95 % interval {lo:.2%}-{hi:.2%}), estimated "
+                f"from {self.shots} shots' launch velocities fitted against their set values")
+
+
+def gun_scatter(update):
+    """The gun's scatter from the lot's fitted launch velocities (:attr:`LawUpdate.launch`),
+    or None under :data:`GUN_SHOTS` shots.
+
+    The factors' sample variance less the mean of their squared standard errors (what the
+    recordings' noise adds, not the gun): s^2 = var(f) - mean(se^2), at least 0; its 95 %
+    interval from the chi-square distribution of (n - 1) var / sigma^2."""
+    from scipy.stats import chi2
+
+    launch = update.launch
+    n = len(launch)
+    if n < GUN_SHOTS:
+        return None
+    factors = np.array([f for _v, f, _e in launch])
+    errors = np.array([e for _v, _f, e in launch])
+    errors = np.where(np.isfinite(errors), errors, 0.0)
+    spread = float(np.var(factors, ddof=1))
+    noise = float(np.mean(errors ** 2))
+    sd = math.sqrt(max(spread - noise, 0.0))
+    dof = n - 1
+    lo = math.sqrt(max(dof * spread / chi2.ppf(0.975, dof) - noise, 0.0))
+    hi = math.sqrt(max(dof * spread / chi2.ppf(0.025, dof) - noise, 0.0))
+    bias = float(np.mean(factors) - 1.0)
+    return GunScatter(sd, (lo, hi), n, bias, math.sqrt(spread / n))
 
 
 def law_scatter(update):
