@@ -24,6 +24,13 @@ LEGACY_COEFFICIENTS = (1.257647, 0.008340218, -0.0001897436, 0.0000005551838, 0.
 DEGREE = 6
 
 
+def chebyshev_nodes(lo, hi, n):
+    """``n`` Chebyshev nodes of [``lo``, ``hi``], ascending: where a polynomial through
+    them strays least from the function sampled."""
+    k = np.arange(n)
+    return (lo + hi) / 2 + (hi - lo) / 2 * np.cos((2 * k + 1) * np.pi / (2 * n))[::-1]
+
+
 @dataclass(frozen=True)
 class CrushLaw:
     """A strain-rate amplification law of the crush force, Eq. (8): a polynomial of degree 6
@@ -72,6 +79,24 @@ class CrushLaw:
     def scaled(self, scale):
         """The law times ``scale`` (every coefficient), named fitted."""
         return CrushLaw(tuple(scale * c for c in self.coefficients), self.v_range, "fitted")
+
+    def tilted(self, scale, tilt, v_ref):
+        """The law times ``scale`` (1 + ``tilt`` (V - ``v_ref``) / ``v_ref``) [-, -, m/s]: a
+        lot stronger or weaker, and more or less so with speed; the polynomial of the same
+        degree through the product at the Chebyshev nodes of its range (a degree-7 product
+        kept at 6, as the archive and the kernel hold a law), named fitted. A tilt of 0 is
+        :meth:`scaled`, exactly."""
+        if tilt == 0:
+            return self.scaled(scale)
+        from numpy.polynomial import Polynomial
+
+        lo, hi = self.v_range
+        nodes = chebyshev_nodes(lo, hi, len(self.coefficients))
+        values = self.poly(nodes) * scale * (1 + tilt * (nodes - v_ref) / v_ref)
+        poly = Polynomial.fit(nodes, values, len(nodes) - 1).convert()
+        coefficients = tuple(float(c) for c in poly.coef)
+        coefficients += (0.0,) * (len(self.coefficients) - len(coefficients))
+        return CrushLaw(coefficients, self.v_range, "fitted")
 
     @property
     def is_legacy(self):

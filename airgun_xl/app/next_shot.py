@@ -103,6 +103,9 @@ class NextOutcome:
             "criteria": [dataclasses.asdict(c) for c in self.verdict.criteria],
             "law": {"version": self.law, "scale": self.update.scale,
                     "scale_standard_error": self.update.error, "shots": self.update.shots,
+                    **({"tilt": self.update.tilt,
+                        "tilt_standard_error": self.update.tilt_error,
+                        "tilt_about_m_s": self.update.v_ref} if self.update.tilted else {}),
                     "note": self.update.note},
             "next": {"A28_m_s": self.setting,
                      **({f"{self.second[0]}_{self.second[1]}": self.second[2]}
@@ -410,6 +413,8 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
         record = {"lot": request.lot, "shot": str(request.shot),
                   "recording": str(request.recording), "verdict": verdict.word,
                   "law": ref, "scale": update.scale, "scale_error": update.error,
+                  **({"tilt": update.tilt, "tilt_error": update.tilt_error,
+                      "tilt_about": update.v_ref} if update.tilted else {}),
                   "setting_A28": best.setting,
                   **({"second_cell": request.vary and second_knob(request.vary).cell,
                       "second_value": best.second} if request.vary else {}),
@@ -467,8 +472,8 @@ def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: V
              gun,
              f"most likely to fail: {worst[0] if worst else 'none'}",
              f"the lot's law {ref}: the prior scaled by {update.scale:.4f} +/- "
-             f"{update.error:.4f} on {update.shots} shot{'s' * (update.shots > 1)}; "
-             f"{update.note}",
+             f"{update.error:.4f}{tilt_text(update)} on {update.shots} "
+             f"shot{'s' * (update.shots > 1)}; {update.note}",
              f"from {request.shot} ({verdict.word}), recording {request.recording}")
     assert designed.source is not None
     options = Options(request.integrator, force=request.force, command=request.argv,
@@ -477,6 +482,14 @@ def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: V
     fill_workbook(designed, output, from_sheet(designed.source.outputs_block), options,
                   said.extend)
     warnings.extend(w for w in said if w not in warnings)
+
+
+def tilt_text(update: LawUpdate) -> str:
+    """The law's tilt with speed, when the shots' speeds pinned one (else nothing)."""
+    if not update.tilted:
+        return ""
+    return (f" and tilted by {update.tilt:+.4f} +/- {update.tilt_error:.4f} per "
+            f"{update.v_ref:.4g} m/s")
 
 
 def lines(request: NextRequest, outcome: NextOutcome) -> list[str]:
@@ -491,7 +504,7 @@ def lines(request: NextRequest, outcome: NextOutcome) -> list[str]:
     if outcome.counted_once:
         said.append("  this shot was recorded in the lot before: counted once")
     said += [f"lot {request.lot}: the law {outcome.law}, the prior scaled by {u.scale:.4f} "
-             f"+/- {u.error:.4f} (1 standard error) on {u.shots} shot"
+             f"+/- {u.error:.4f} (1 standard error){tilt_text(u)} on {u.shots} shot"
              f"{'s' * (u.shots > 1)}", f"  {u.note}",
              f"next: {setting_text(request, b)}, P(PASS) = {b.probability:.4f} "
              f"[{lo:.4f}, {hi:.4f}] over {b.shots:,} draws"

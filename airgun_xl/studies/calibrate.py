@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..cells import address
-from ..crush_law import DEGREE, CrushLaw
+from ..crush_law import DEGREE, CrushLaw, chebyshev_nodes
 from ..errors import OptionError
 from .measured import KG_MS2, on_measured_grid, threshold_shift
 
@@ -98,6 +98,7 @@ class FitResult:
     #: with ``velocities``: (impact speed set [m/s], fitted factor on it, its standard error)
     #: of each shot
     velocities: list = field(default_factory=list)
+    covariance: np.ndarray | None = None  # of the values, in the order of ``values``
 
 
 def _run(p, integrator):
@@ -250,9 +251,7 @@ def calibrate_law(pairs, cfc=None, degree=DEGREE, integrator="legacy",
     return out
 
 
-def _chebyshev_nodes(lo, hi, n):
-    k = np.arange(n)
-    return (lo + hi) / 2 + (hi - lo) / 2 * np.cos((2 * k + 1) * np.pi / (2 * n))[::-1]
+_chebyshev_nodes = chebyshev_nodes
 
 
 def law_through(v_nodes, x_nodes, v_range):
@@ -497,7 +496,7 @@ def _correlated(Js, acf):
 JACOBIAN_STEP = 3e-3
 
 
-def error_budget(fit, blocks, residuals=None, scale=None):
+def error_budget(fit, blocks, residuals=None, scale=None, covariance=False):
     """Standard errors of a least-squares fit's parameters, and each shot's share of each
     parameter's variance.
 
@@ -534,7 +533,9 @@ def error_budget(fit, blocks, residuals=None, scale=None):
     -------
     (numpy.ndarray, numpy.ndarray)
         The standard errors (one a parameter), and the shares [-] (parameters x shots, each
-        row summing to 1) of each shot in each parameter's variance: the shots that pin it.
+        row summing to 1) of each shot in each parameter's variance: the shots that pin it;
+        with ``covariance``, a third: the parameters' covariance matrix (the same sandwich,
+        whole; its diagonal the errors squared).
     """
     r = np.asarray(fit.fun, dtype=float)
     if residuals is not None:
@@ -550,8 +551,10 @@ def error_budget(fit, blocks, residuals=None, scale=None):
     try:
         H = np.linalg.inv(J.T @ J)
     except np.linalg.LinAlgError:
-        return np.full(n, np.inf), np.full((n, len(blocks)), np.nan)
+        singular = np.full(n, np.inf), np.full((n, len(blocks)), np.nan)
+        return (*singular, np.full((n, n), np.inf)) if covariance else singular
     parts = np.zeros((len(blocks), n))
+    whole = np.zeros((n, n))
     start = 0
     for k, block in enumerate(blocks):
         rows = slice(start, start + block.rows)
@@ -578,13 +581,15 @@ def error_budget(fit, blocks, residuals=None, scale=None):
         offset = block.offset * math.sqrt(float(
             1 + 2 * np.sum(2 / np.pi * np.arcsin(noise_rho[1:block.rest.size]))))
         parts[k] = s2 * np.diag(noise) + (offset * G.sum(axis=1)) ** 2
+        whole += s2 * noise + np.outer(offset * G.sum(axis=1), offset * G.sum(axis=1))
     if start != m:  # the blocks describe other residuals: a fault of ours, not the data's
         raise ValueError(f"error budget: {start} rows in the blocks, {m} residuals")
     variance = parts.sum(axis=0)
     with np.errstate(invalid="ignore", divide="ignore"):
         shares = (parts / variance).T
     errors = np.sqrt(np.clip(variance, 0, None))
-    return np.where(np.isfinite(errors), errors, np.inf), shares
+    errors = np.where(np.isfinite(errors), errors, np.inf)
+    return (errors, shares, whole) if covariance else (errors, shares)
 
 
 def _objective_residuals(aligned, objective):
@@ -622,13 +627,17 @@ def check_fit(names, objective="l2"):
 #: A fitted value within this fraction of a bound is tried at the bound (fit_parameters).
 BOUND_REACH = 0.05
 
+#: The law's tilt with speed is fitted within +/- this (a law 50 % stronger at twice the
+#: reference speed than at it).
+TILT_REACH = 0.5
+
 #: A shot's launch velocity is fitted within this fraction of its set value (a gun 15 % off
 #: its setting is not scatter).
 VELOCITY_REACH = 0.15
 
 
 def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy",
-                   velocities=False):
+                   velocities=False, tilt_about=None):
     """Fit E40, E43 and/or a law scale to measured shots by least squares.
 
     Parameters
@@ -644,6 +653,10 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy",
         Also fit each shot's launch velocity (A28..A30, a factor on the set value within
         +/- :data:`VELOCITY_REACH`): the shots' own speeds, with the pooled values
         (:attr:`FitResult.velocities`). L2 only.
+    tilt_about : float or None
+        With the scale, also fit the law's tilt with speed about this speed [m/s]
+        (:meth:`~airgun_xl.crush_law.CrushLaw.tilted`, within +/- :data:`TILT_REACH`),
+        named ``"tilt"``. L2 only.
 
     Returns
     -------
@@ -652,16 +665,25 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy",
     from scipy.optimize import least_squares, minimize
 
     names = check_fit(names, objective)
-    if velocities and objective != "l2":
-        raise OptionError("the launch velocities are fitted on the L2 objective only")
+    if (velocities or tilt_about is not None) and objective != "l2":
+        raise OptionError("the launch velocities and the law's tilt are fitted on the L2 "
+                          "objective only")
+    if tilt_about is not None and "scale" not in names:
+        raise OptionError("--fit: the law's tilt is fitted with its scale only")
     p0 = pairs[0][0]
-    start = {address("sigmay"): p0.sigmay, address("zeta"): p0.zeta, "scale": 1.0}
+    start = {address("sigmay"): p0.sigmay, address("zeta"): p0.zeta, "scale": 1.0,
+             "tilt": 0.0}
     x0, lo, hi = [], [], []
     for n in names:
         _, low, high = FIT_PARAMETERS[n]
         x0.append(start[n])
         lo.append(start[n] * low if low else 0.0)
         hi.append(start[n] * high if high else 0.5)
+    if tilt_about is not None:
+        names = [*names, "tilt"]
+        x0.append(0.0)
+        lo.append(-TILT_REACH)
+        hi.append(TILT_REACH)
     evaluations = [0]
 
     k = len(pairs)
@@ -678,7 +700,10 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy",
                 changes["sigmay"] = values[address("sigmay")]
             if address("zeta") in values:
                 changes["zeta"] = values[address("zeta")]
-            if "scale" in values:
+            if "tilt" in values:
+                changes["crush_law"] = p.crush_law.tilted(values["scale"], values["tilt"],
+                                                          tilt_about)
+            elif "scale" in values:
                 changes["crush_law"] = p.crush_law.scaled(values["scale"])
             out.append(p.replace(**changes))
         return out
@@ -719,8 +744,8 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy",
                                         x_scale=scale, diff_step=1e-4, xtol=1e-10,
                                         ftol=1e-10, gtol=1e-10, max_nfev=100)
     x, cost, nudges = fit.x[:len(names)], float(fit.cost), fit.x[len(names):len(names) + k]
-    budget = error_budget(fit, residual_blocks([rec for _, rec in pairs]), residuals,
-                          scale)[0]
+    budget, _shares, whole = error_budget(fit, residual_blocks([rec for _, rec in pairs]),
+                                          residuals, scale, covariance=True)
     errors = budget[:len(names)]
     speeds = [(float(p.v31 - p.v1), float(f), float(e)) for (p, _), f, e in zip(
         pairs, fit.x[len(names) + k:], budget[len(names) + k:], strict=True)] if velocities else []
@@ -740,7 +765,7 @@ def fit_parameters(pairs, names, cfc=None, objective="l2", integrator="legacy",
                      shots(np.concatenate([x, fit.x[len(names):]])),
                      dict(zip(names, map(float, errors), strict=True)),
                      {n: (float(a), float(b)) for n, a, b in zip(names, lo, hi, strict=True)},
-                     speeds)
+                     speeds, whole[:len(names), :len(names)])
 
 
 @dataclass
@@ -775,6 +800,7 @@ class Calibration:
     #: with ``velocities``: each shot's (impact speed set [m/s], fitted factor, its standard
     #: error)
     velocities: list = field(default_factory=list)
+    covariance: np.ndarray | None = None  # of the fitted values, in the order of ``fitted``
 
     @property
     def trusted(self):
@@ -825,7 +851,7 @@ def verdict(cal, cfc, objective, p0):
         if min(value - lo, hi - value) <= AT_BOUND * (hi - lo):
             found.append(f"--fit {name}: {value:.6g} is at its bound ({lo:.4g}..{hi:.4g}): "
                          "not identified by these pulses")
-        elif not error <= UNIDENTIFIED * abs(value):
+        elif not error <= UNIDENTIFIED * (TILT_REACH if name == "tilt" else abs(value)):
             found.append(f"--fit {name}: {value:.6g} +/- {error:.3g} (1 standard error): the "
                          "pulses do not pin it down (not identified)")
     if address("zeta") in cal.fitted and cfc:
@@ -871,7 +897,7 @@ def verdict(cal, cfc, objective, p0):
 
 
 def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objective="l2",
-              integrator="legacy", anti_alias="auto", velocities=False):
+              integrator="legacy", anti_alias="auto", velocities=False, tilt_about=None):
     """Calibrate the model on measured shots: the crush-factor law (the report's iteration,
     then least squares on the law's values, :func:`refine_law`), then the named parameters
     (:func:`fit_parameters`), and its :func:`verdict`.
@@ -890,6 +916,9 @@ def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objecti
     velocities : bool
         With ``fit``, also each shot's launch velocity (:func:`fit_parameters`):
         :attr:`Calibration.velocities`.
+    tilt_about : float or None
+        With ``fit=("scale",)``, also the law's tilt with speed about this speed [m/s]
+        (:func:`fit_parameters`), fitted as ``"tilt"``.
 
     Returns
     -------
@@ -919,20 +948,22 @@ def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objecti
         counter["runs"] += evaluations * len(pairs)
         params = [p.replace(crush_law=refined) for p in params]
         pairs = list(zip(params, recs, strict=True))
-    fitted, start, errors, bounds, velocity_fit = {}, {}, {}, {}, []
+    fitted, start, errors, bounds, velocity_fit, covariance = {}, {}, {}, {}, [], None
     if fit:
-        result = fit_parameters(pairs, fit, cfc, objective, integrator, velocities)
+        result = fit_parameters(pairs, fit, cfc, objective, integrator, velocities,
+                                tilt_about)
         counter["runs"] += result.evaluations * len(pairs)
         params, fitted, start = result.params, result.values, result.start
         errors, bounds = result.errors, result.bounds
-        velocity_fit = result.velocities
+        velocity_fit, covariance = result.velocities, result.covariance
     runs = [_run(p, integrator) for p in params]
     counter["runs"] += len(runs)
     aligned = [align(run, rec) for run, rec in zip(runs, recs, strict=True)]
     after = [score(a) for a in aligned]
     cal = Calibration(params, law_cal, fitted, start, before, after, aligned,
                       counter["runs"], time.perf_counter() - started, errors, bounds, nodes,
-                      law_errors, law_shares, recs, velocities=velocity_fit)
+                      law_errors, law_shares, recs, velocities=velocity_fit,
+                      covariance=covariance)
     for rec, run in zip(recs, runs, strict=True):  # the same runs, cross-checked
         cal.warnings += [f"{rec.trace.name}: {w}" for w in rec.warnings]
         ok = np.isfinite(run.accel_kg)

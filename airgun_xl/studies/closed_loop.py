@@ -4,14 +4,17 @@ next setting chosen on what the lot is now known to be.
 - :func:`update_scale`: the lot's prior law (its previous version, or the report's law for a
   new lot) scaled to every shot of the lot by least squares (:func:`~.calibrate.calibrate`
   with ``fit=("scale",)``), with the scale's standard error. A scale is what one shot, or
-  shots at one speed, can pin; the law's shape over speed needs shots spread over it, and is
-  the prior's until then (said in :attr:`LawUpdate.note`).
+  shots at one speed, can pin. Once the shots' impact speeds spread over :data:`TILT_SPAN`,
+  the law's tilt with speed is fitted with it (its first-order shape, about the shots' mean
+  speed), with the two's covariance; the higher-order shape stays the prior's (said in
+  :attr:`LawUpdate.note`).
 - :func:`gun_scatter`: the gun's shot-to-shot scatter, from the lot's shots' launch
   velocities fitted with the scale (:func:`update_scale` with ``velocities``) against their
   set values, once :data:`GUN_SHOTS` shots exist.
 - :func:`law_scatter`: the scale's standard error as a scatter of the law (relative, around
-  1), drawn with the gun's and zeta's by :func:`~.first_shot.pass_probability` (the law known
-  to its standard error: a posterior, not a shot-to-shot scatter).
+  1), or the scale's and the tilt's covariance, drawn with the gun's and zeta's by
+  :func:`~.first_shot.pass_probability` (the law known to its standard error: a posterior,
+  not a shot-to-shot scatter).
 - :func:`brier` and :func:`reliability`: how honest the predictions were, once shots were
   fired at the settings proposed: the Brier score, and the observed pass rate in each band of
   predicted P(PASS) with its Wilson 95 % interval.
@@ -25,7 +28,12 @@ from typing import Any
 import numpy as np
 
 from .acceptance import wilson_interval
-from .first_shot import LAW_FIELDS, LAW_SCALE
+from .first_shot import JOINT, LAW_FIELDS, LAW_SCALE
+
+#: The lot's shots' impact speeds must spread over this fraction of the fastest before the
+#: law's tilt with speed is fitted: shots at one speed pin a tilt only through each pulse's
+#: own sweep of speeds, which the scale mostly absorbs.
+TILT_SPAN = 0.05
 
 
 @dataclass(frozen=True)
@@ -44,10 +52,23 @@ class LawUpdate:
     #: with ``velocities``: each shot's (impact speed set [m/s], fitted factor, its standard
     #: error)
     launch: tuple[tuple[float, float, float], ...] = ()
+    #: with the tilt (shots spread over :data:`TILT_SPAN`): the law's tilt with speed about
+    #: ``v_ref`` [-, m/s] and the scale's and tilt's covariance (2 x 2)
+    tilt: float = 0.0
+    tilt_error: float = math.nan
+    v_ref: float = math.nan
+    covariance: Any = None
+
+    @property
+    def tilted(self) -> bool:
+        return math.isfinite(self.v_ref)
 
     @property
     def warnings(self) -> list[str]:
         said = list(self.calibration.warnings) if self.calibration is not None else []
+        if self.tilted and not np.all(np.isfinite(np.asarray(self.covariance, float))):
+            said.append("the law's scale and tilt have no covariance (the fit could not "
+                        "estimate one): P(PASS) draws the scale alone, and is optimistic")
         if not (math.isfinite(self.error) and self.error >= 0):
             said.append("the law's scale has no standard error (the fit could not estimate "
                         "one): P(PASS) draws the law as if it were known exactly, and is "
@@ -67,18 +88,30 @@ def update_scale(params, traces, prior, cfc=None, integrator="legacy", velocitie
     from .calibrate import calibrate
 
     start = [p.replace(crush_law=prior) for p in params]
-    cal = calibrate(start, traces, law=False, fit=("scale",), cfc=cfc, integrator=integrator,
-                    velocities=velocities)
-    scale, error = float(cal.fitted["scale"]), float(cal.errors.get("scale", math.nan))
     speeds = [p.v31 - p.v1 for p in params]
     lo, hi = min(speeds), max(speeds)
+    v_ref = float(np.mean(speeds)) if hi - lo >= TILT_SPAN * hi else math.nan
+    cal = calibrate(start, traces, law=False, fit=("scale",), cfc=cfc, integrator=integrator,
+                    velocities=velocities, tilt_about=v_ref if math.isfinite(v_ref) else None)
+    scale, error = float(cal.fitted["scale"]), float(cal.errors.get("scale", math.nan))
     n = len(params)
-    note = (f"{n} shot{'s' * (n > 1)} at {lo:.4g}" + (f" to {hi:.4g}" if hi > lo else "")
-            + " m/s pin the law's scale only; its shape over speed stays the prior's")
+    note = f"{n} shot{'s' * (n > 1)} at {lo:.4g}" + (f" to {hi:.4g}" if hi > lo else "")
+    if math.isfinite(v_ref):
+        tilt, tilt_error = float(cal.fitted["tilt"]), float(cal.errors.get("tilt", math.nan))
+        note += (f" m/s pin the law's scale and its tilt with speed ({tilt:+.4f} +/- "
+                 f"{tilt_error:.4f} per {v_ref:.4g} m/s about {v_ref:.4g} m/s); its "
+                 "higher-order shape stays the prior's")
+        law = prior.tilted(scale, tilt, v_ref)
+    else:
+        tilt, tilt_error = 0.0, math.nan
+        note += (" m/s pin the law's scale only; its shape over speed stays the prior's "
+                 f"(the tilt is fitted once the shots' speeds spread over {TILT_SPAN:.0%})")
+        law = prior.scaled(scale)
     if velocities:
         note += "; each shot's launch velocity fitted with it"
-    return LawUpdate(prior.scaled(scale), prior, scale, error, n, (lo, hi), cal, note,
-                     tuple(tuple(v) for v in cal.velocities))
+    return LawUpdate(law, prior, scale, error, n, (lo, hi), cal, note,
+                     tuple(tuple(v) for v in cal.velocities), tilt, tilt_error, v_ref,
+                     cal.covariance[:2, :2] if math.isfinite(v_ref) else None)
 
 
 #: Shots of a lot from which the gun's scatter is estimated (:func:`gun_scatter`): with 7
@@ -134,7 +167,15 @@ def gun_scatter(update):
 
 def law_scatter(update):
     """The ``sds`` entry that draws the law from its posterior: its scale around 1, with the
-    standard error relative to the scale fitted."""
+    standard error relative to the scale fitted; with a tilt, the scale (around 1) and the
+    tilt (around 0, about ``v_ref``) drawn together from their covariance, to first order
+    relative to the law updated (an entry :data:`~.first_shot.JOINT`)."""
+    if update.tilted:
+        cov = np.asarray(update.covariance, dtype=float)
+        scaled = cov * np.array([[1 / update.scale ** 2, 1 / update.scale],
+                                 [1 / update.scale, 1.0]])
+        if update.scale > 0 and np.all(np.isfinite(scaled)):
+            return (LAW_SCALE, LAW_FIELDS, (scaled, update.v_ref), JOINT)
     relative = update.error / update.scale if update.scale > 0 else math.nan
     if not (math.isfinite(relative) and relative >= 0):
         relative = 0.0

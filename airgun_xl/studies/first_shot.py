@@ -289,6 +289,12 @@ class PassProbability:
 #: :mod:`airgun_xl.studies.closed_loop`).
 LAW_SCALE, LAW_FIELDS = "scale", ("crush_law",)
 
+#: An ``sds`` entry ``(LAW_SCALE, LAW_FIELDS, (covariance, v_ref), JOINT)`` draws the law's
+#: scale (around 1) and its tilt with speed (around 0, about ``v_ref`` [m/s]) together from
+#: their 2 x 2 covariance (:meth:`~airgun_xl.crush_law.CrushLaw.tilted`): two columns of the
+#: draws, the second named :data:`LAW_TILT`.
+JOINT, LAW_TILT = "joint", ("crush_law_tilt",)
+
 
 def _mean(p, fields):
     return 1.0 if fields == LAW_FIELDS else getattr(p, fields[0])
@@ -302,10 +308,18 @@ def draws(p, sds, n, seed):
 
     check_spreads(p, [sd for sd in sds if sd[1] != LAW_FIELDS])
     rng = np.random.default_rng(seed)
-    columns = [rng.normal(_mean(p, fields), sd * abs(_mean(p, fields)) if relative else sd, n)
-               for _cell, fields, sd, relative in sds]
-    return (np.column_stack(columns) if columns else np.zeros((n, 0)),
-            [fields for _cell, fields, _sd, _rel in sds])
+    columns, names = [], []
+    for _cell, fields, sd, relative in sds:
+        if relative == JOINT:  # the law's scale and tilt, together
+            pair = rng.multivariate_normal([1.0, 0.0], np.asarray(sd[0], dtype=float), n,
+                                           method="eigh")
+            columns += [pair[:, 0], pair[:, 1]]
+            names += [LAW_FIELDS, LAW_TILT]
+        else:
+            columns.append(rng.normal(_mean(p, fields), sd * abs(_mean(p, fields)) if relative
+                                      else sd, n))
+            names.append(fields)
+    return np.column_stack(columns) if columns else np.zeros((n, 0)), names
 
 
 def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator="legacy",
@@ -327,18 +341,24 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
     base = var.apply(p, setting) if var is not None and setting is not None else p
     first, second = setting if isinstance(setting, tuple) else (setting, math.nan)
     params, invalid = [], np.zeros(n, dtype=bool)
-    offsets = [(fields, 0.0 if fields == LAW_FIELDS else
+    law = (LAW_FIELDS, LAW_TILT)
+    offsets = [(fields, 0.0 if fields in law else
                 getattr(base, fields[0]) - getattr(p, fields[0])) for fields in fields_list]
+    v_ref = next((sd[2][1] for sd in sds if sd[3] == JOINT), math.nan)
     for i in range(n):
         try:
             changes = {f: float(value + shift) for (fields, shift), value
                        in zip(offsets, values[i], strict=True) for f in fields
-                       if fields != LAW_FIELDS}
-            for (fields, _), value in zip(offsets, values[i], strict=True):
-                if fields == LAW_FIELDS:  # a scale at or below 0 is no law: not a shot
-                    if not value > 0:
-                        raise DesignError(f"a drawn law scale of {value:.3g}")
-                    changes["crush_law"] = base.crush_law.scaled(float(value))
+                       if fields not in law}
+            drawn_law = {fields: float(value) for (fields, _), value
+                         in zip(offsets, values[i], strict=True) if fields in law}
+            if LAW_FIELDS in drawn_law:  # a scale at or below 0 is no law: not a shot
+                value = drawn_law[LAW_FIELDS]
+                if not value > 0:
+                    raise DesignError(f"a drawn law scale of {value:.3g}")
+                changes["crush_law"] = (base.crush_law.tilted(value, drawn_law[LAW_TILT], v_ref)
+                                        if LAW_TILT in drawn_law
+                                        else base.crush_law.scaled(value))
             params.append(apply_model(base.replace(**changes), model))
         except AirgunXlError:
             invalid[i] = True
