@@ -93,9 +93,9 @@ def test_history_lot_shows_each_step(lot, capsys):
 def test_one_shot_pins_only_the_scale_and_says_so(lot):
     _, first, _ = lot
     assert first.update.shots == 1
-    assert "pin the law's scale only" in first.update.note
+    assert "1 shot at 243.5 m/s pins the law's scale only" in first.update.note
     request = NextRequest(Path("shot.xlsx"), "rec.csv", Path("arch"), "LOT-A")
-    assert any("pin the law's scale only" in line for line in lines(request, first))
+    assert any("pins the law's scale only" in line for line in lines(request, first))
 
 
 @pytest.mark.parametrize("which", ["one shot: the scale", "two speeds: scale and tilt"])

@@ -104,8 +104,9 @@ def update_scale(params, traces, prior, cfc=None, integrator="legacy", velocitie
         law = prior.tilted(scale, tilt, v_ref)
     else:
         tilt, tilt_error = 0.0, math.nan
-        note += (" m/s pin the law's scale only; its shape over speed stays the prior's "
-                 f"(the tilt is fitted once the shots' speeds spread over {TILT_SPAN:.0%})")
+        note += (f" m/s pin{'s' * (n == 1)} the law's scale only; its shape over speed stays "
+                 "the prior's "
+                 f"(its tilt is fitted once the shots' speeds spread over {TILT_SPAN:.0%})")
         law = prior.scaled(scale)
     if velocities:
         note += "; each shot's launch velocity fitted with it"
