@@ -162,6 +162,27 @@ def test_the_fills_charts_are_in_the_summarys_units(workbooks):
     assert "Time (ms)" in text and "Time (s)" not in text
     assert "Force (kN)" in text and 'formatCode="#,##0,"' in text
     assert "Frequency (kHz)" in text
+    # issue 46: the spectrum's axis starts on a whole kHz (shot A's lobe ends at 1.8 kHz,
+    # whose ticks read 1.8, 3.8, 5.8 kHz before), so its ticks fall on round kHz
+    spectrum = next(x for x in text.split("</c:chartSpace>") if "Frequency (kHz)" in x)
+    minimum = re.search(r'<c:valAx>.*?<c:min val="([^"]+)"/>', spectrum, re.S).group(1)
+    assert float(minimum) % 1000 == 0, minimum
+
+
+def test_the_diff_reports_value_axes_name_the_columns_unit(workbooks):
+    """Issue 46: both value axes of the "Worst column" chart carry the column's unit (the
+    header's, in brackets), the difference's too."""
+    from openpyxl import load_workbook
+
+    ws = load_workbook(workbooks["diff"])["Worst column"]
+    texts = [c.value for c in ws["A"] if isinstance(c.value, str)]
+    titles = [t for t in texts if t.startswith("new - legacy")]
+    assert len(titles) == 1 and re.fullmatch(r"new - legacy \(.+\)", titles[0]), titles
+    with zipfile.ZipFile(workbooks["diff"]) as z:
+        xml = "".join(z.read(n).decode() for n in z.namelist()
+                      if re.fullmatch(r"xl/charts/chart\d+\.xml", n))
+    # the axes' titles point at those cells (a header is workbook text: never a formula)
+    assert xml.count("<c:tx><c:strRef>") >= 3
 
 
 #: Workbooks in the macro's layout: their parameter sheet stays first and active (the macro

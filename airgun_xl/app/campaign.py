@@ -437,9 +437,9 @@ def run(request: CampaignRequest, on_row: Callable[[Row], None] | None = None,
     if summary is not None:
         from ..reports.campaign import write_campaign
 
-        write_campaign(summary, rows, f"Campaign: {len(shots)} shots filled by airgun-xl "
-                                      f"({counts['filled']} filled, {counts['failed']} "
-                                      f"failed, {lost_part}{counts['skipped']} skipped)",
+        write_campaign(summary, rows, f"Campaign of {len(shots)} shots by airgun-xl: "
+                                      f"{counts['filled']} filled, {counts['failed']} "
+                                      f"failed, {lost_part}{counts['skipped']} skipped",
                        request.settings.force, label=summary.name)
         lines.append(f"wrote {summary}: one row a shot, the peak against v0")
         written.append(summary)

@@ -1,5 +1,6 @@
 """The --report workbook of ``diff``: a per-column error table, and the worst column's two
 curves with their difference."""
+import re
 from pathlib import Path
 
 import numpy as np
@@ -101,10 +102,17 @@ def _write_worst(wb, name, time, x, y, shot=None):
     ws.write_string(n + 2, 0, f"Worst column: {name}, both curves and their difference")
     chart.set_title({"name": ["Worst column", n + 2, 0]})
     chart.set_x_axis(axis("Time (ms)", tlo, thi))
+    # the value axes carry the column's unit, as its header gives it (in brackets at its end)
+    unit = re.search(r"\(([^()]+)\)\s*$", name)
+    shown = f"({unit.group(1)})" if unit else "(the column's unit)"
+    ws.write_string(n + 3, 0, name if unit else f"{name} {shown}")
+    ws.write_string(n + 4, 0, f"new - legacy {shown}")
     y_axis = axis("", lo, hi)
-    y_axis["name"] = ["Worst column", 0, 1]
+    y_axis["name"] = ["Worst column", n + 3, 0]
     chart.set_y_axis(y_axis)
-    chart.set_y2_axis(axis("new - legacy", dlo, dhi, gridlines=False, num_format="0.0E+00"))
+    y2_axis = axis("", dlo, dhi, gridlines=False, num_format="0.0E+00")
+    y2_axis["name"] = ["Worst column", n + 4, 0]
+    chart.set_y2_axis(y2_axis)
     chart.set_legend({"position": "bottom"})
     chart.set_size(chart_size(16, 26))
     ws.insert_chart(1, 5, chart)

@@ -301,7 +301,8 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
                       if compared.params.unloading == "continuous" else
                       f"Acceleration, {variant_name(result)}"}
         add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]) * 1e3, labels,
-                   {"spectrum": (np.floor(summary.spectrum.band_start / 100) * 100,
+                   # from a whole kHz below the lobe's end: the ticks fall on round kHz
+                   {"spectrum": (np.floor(summary.spectrum.band_start / 1000) * 1000,
                                  SPECTRUM_MAX_HZ)}, shot)
     close_workbook(wb, shown if shown is not None else tmp)
     return warnings

@@ -12,6 +12,7 @@ from ..xlsx.report import (
     axis,
     chart_size,
     data_pages,
+    fit_wrapped_row,
     general_format,
     one_page,
     report_workbook,
@@ -27,8 +28,14 @@ FIGURE_HEADERS = {"peak_kg": "Peak (kG)", "time_of_peak": "Time of peak (s)",
 AXIS_UNITS = {"Pa": ("MPa", "#,##0.0,,"), "m/s": ("m/s", "0.0"), "N/m": ("N/m", "0.00E+00"),
               "s": ("s", "0.00E+00")}
 
-#: Most levels a family of curves has (one series per level); more: a scatter.
+#: Most levels a family of curves has (one series per level); an input with more is drawn
+#: at :data:`FAMILY_SHOWN` of its levels, evenly spaced (first and last included).
 MAX_FAMILY = 12
+FAMILY_SHOWN = 7
+
+#: A curve of more points than this is drawn as a line without markers: at print size a
+#: marker a point would merge them into a band.
+MARKED_POINTS = 25
 
 
 def _label(cell, unit=None):
@@ -83,17 +90,20 @@ def write_sweep(result, path, force, stats=None, sensitivity=None, shot=None, se
 
 
 def families(result, i):
-    """The curves of the peak against cell ``i`` of a grid: [(label, x, peak)], one per level
-    of the other cell with the fewest levels (the rest held at their middle level); None
-    for samples (a Monte Carlo, Sobol), a single input, or more than :data:`MAX_FAMILY`
-    levels."""
+    """The curves of the peak against cell ``i`` of a grid, ([(label, x, peak)], note): one
+    per level of the other cell with the fewest levels (the rest held at their middle
+    level), at most :data:`MAX_FAMILY` of them (past it, :data:`FAMILY_SHOWN` levels evenly
+    spaced, first and last included, said in the note); None for samples (a Monte Carlo,
+    Sobol) or a single input."""
     k = len(result.cells)
     if result.kind != "grid" or k < 2:
         return None
     levels = [np.unique(result.values[:, j]) for j in range(k)]
     j = min((m for m in range(k) if m != i), key=lambda m: len(levels[m]))
-    if len(levels[j]) > MAX_FAMILY:
-        return None
+    shown = levels[j]
+    if len(shown) > MAX_FAMILY:
+        shown = shown[np.unique(np.round(np.linspace(0, len(shown) - 1,
+                                                     FAMILY_SHOWN)).astype(int))]
     held = np.ones(len(result.values), dtype=bool)
     fixed = []
     for m in range(k):
@@ -105,14 +115,16 @@ def families(result, i):
     unit, fmt = AXIS_UNITS.get(c.unit if c else "", (c.unit if c else "", None))
     scale = 1e-6 if unit == "MPa" else 1.0
     out = []
-    for level in levels[j]:
+    for level in shown:
         rows = held & (result.values[:, j] == level)
         order = np.argsort(result.values[rows, i], kind="stable")
         name = f"{result.cells[j]} = {level * scale:.4g} {unit}".rstrip()
         if fixed:
             name += " (" + ", ".join(fixed) + ")"
         out.append((name, result.values[rows, i][order], result.figures[rows, 0][order]))
-    return out
+    note = (f"{len(shown)} of the {len(levels[j])} levels of {result.cells[j]}"
+            if len(shown) < len(levels[j]) else "")
+    return out, note
 
 
 #: Charts on the sweep's Charts sheet: two a row, each this many default columns and rows.
@@ -131,7 +143,7 @@ def _write_charts(wb, result, shot):
     plo, phi = nice_range(peaks, include_zero=True) if len(peaks) else (0.0, 1.0)
     col = 0
     for i, cell in enumerate(result.cells):
-        family = families(result, i)
+        family, note = families(result, i) or (None, "")
         finite = result.values[:, i][np.isfinite(result.values[:, i])]
         title, fmt = _cell_axis(cell, finite)
         if family is None:
@@ -145,17 +157,19 @@ def _write_charts(wb, result, shot):
             for m, (name, x, y) in enumerate(family):
                 data.append((col, f"{cell} ({name})", x, y))
                 color = FAMILY_COLORS[m % len(FAMILY_COLORS)]
+                marker = ({"type": "circle", "size": 3, "border": {"color": color},
+                           "fill": {"color": color}} if len(x) <= MARKED_POINTS
+                          else {"type": "none"})
                 chart.add_series({"name": name, "categories": ["Chart data", 1, col, len(x), col],
                                   "values": ["Chart data", 1, col + 1, len(x), col + 1],
                                   "line": {"color": color, "width": 1.25},
-                                  "marker": {"type": "circle", "size": 3,
-                                             "border": {"color": color},
-                                             "fill": {"color": color}}})
+                                  "marker": marker})
                 col += 2
             chart.set_legend({"position": "bottom"})
         lo = float(finite.min()) if len(finite) else 0.0
         hi = float(finite.max()) if len(finite) else 1.0
-        chart.set_title({"name": f"Peak acceleration against {cell}",
+        chart.set_title({"name": f"Peak acceleration against {cell}"
+                                 + (f"\n({note})" if note else ""),
                          "name_font": {"size": 11}})
         chart.set_x_axis(axis(title, lo, hi if hi > lo else lo + 1.0, num_format=fmt))
         chart.set_y_axis(axis("Peak (kG)", plo, phi, num_format="0.0"))
@@ -187,12 +201,17 @@ FAMILY_COLORS = ("#1f4e79", "#c00000", "#548235", "#7f6000", "#7030a0", "#00b0f0
                  "#ff7f00", "#595959", "#a50021", "#2e75b6", "#92d050", "#bf9000")
 
 
+#: The Warnings sheet's text column, in characters (a line of wrapped text holds about as
+#: many: the default font's digits are its widest common glyphs).
+WARNING_CHARS = 120
+
+
 def _write_warnings(wb, result, style, shot):
     """The Warnings sheet: how many shots have a warning, how often each cell is named, and
     every distinct warning with its count; printed on one page."""
     ws = wb.add_worksheet("Warnings")
     ws.set_column(0, 0, 14)
-    ws.set_column(1, 1, 120)
+    ws.set_column(1, 1, WARNING_CHARS)
     flagged, cells = result.flagged()
     bold = style.bold
     ws.write_string(0, 0, "Shots", bold)
@@ -214,6 +233,7 @@ def _write_warnings(wb, result, style, shot):
     for text, n in sorted(counts.items(), key=lambda item: -item[1])[:40]:
         ws.write_number(row, 0, n, style.of("count"))
         ws.write_string(row, 1, text, style.wrap)
+        fit_wrapped_row(ws, row, text, WARNING_CHARS)
         row += 1
     one_page(ws, row, 1, shot=shot, title="Warnings")
 

@@ -200,6 +200,18 @@ def data_pages(ws, last_row, last_col, header_rows=1, shot=None, title=None):
 #: Pixels of a default column (8.43 characters) and of a default row (15 points).
 COLUMN_PX, ROW_PX = 64, 20
 
+#: Points of a line of the default font.
+LINE_POINTS = 15
+
+
+def fit_wrapped_row(ws, row, text, chars):
+    """Size ``row`` to the lines wrapped ``text`` takes in a column (or merged range) of
+    ``chars`` characters: the spreadsheet keeps a written row at one line's height, so a
+    wrapped text taller than that would overprint the rows below it."""
+    lines = max(1, -(-len(text) // chars))
+    if lines > 1:
+        ws.set_row(row, LINE_POINTS * lines)
+
 
 def chart_size(columns, rows):
     """(width, height) [px] of a chart that covers ``columns`` default columns and ``rows``

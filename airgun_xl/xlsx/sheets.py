@@ -250,16 +250,19 @@ def _summary_rows(result, summary, prov):
          f"the archive's law {p.crush_law.source} (calibrate --archive --name)"
          if p.crush_law.source else "the Crush law sheet (airgun-xl calibrate)"),
         ("Time step", p.delta, "step", address("delta")),
-        ("Critical time step", prov.dt_crit
-         if prov.dt_crit != float("inf") else "none: implicit in the OBR chain",
-         "step", "largest step stable for the OBR chain, the springs that always act "
-         "(airgun-xl check)"),
+        ("Critical time step", prov.dt_crit, "step", "largest step stable for the OBR chain, "
+         "the springs that always act (airgun-xl check)")
+        if prov.dt_crit != float("inf") else
+        ("Critical time step", "n/a", "", "none: the Newmark integrator is implicit in the "
+         "OBR chain, so no step bounds it"),
         ("Critical time step, unloading", prov.dt_unloading, "step",
          "largest step stable while the mitigator unloads at full length"),
         ("Critical time step, compacted", prov.dt_compacted, "step",
          "largest step stable while the mitigator unloads fully compacted"),
         ("Time step / critical", prov.dt_ratio, "ratio",
-         "above 1 the run diverges from its first steps"),
+         "above 1 the run diverges from its first steps")
+        if prov.dt_crit != float("inf") else
+        ("Time step / critical", "n/a", "", "no critical time step (Newmark)"),
         ("Rows", result.rows, "count", "time rows of the run"),
         ("Rows on the sheets", prov.sheet_rows, "count", ""),
         ("Every N-th row", prov.every, "count", "1: every row is on the sheets"),
