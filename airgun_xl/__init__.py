@@ -29,6 +29,7 @@ from .version import __version__
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
+    from pathlib import Path
     from typing import Unpack
 
     from .app.accept import AcceptOutcome
@@ -76,7 +77,8 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
            output: str | os.PathLike[str] | None = None, force: bool = False,
            archive: str | os.PathLike[str] | None = None, channel: str | None = None,
            sign: float = 1.0, time_unit: str | None = None, accel_unit: str | None = None,
-           crush_law: str = "workbook", **spec: Unpack[SpecKeywords]) -> AcceptOutcome:
+           crush_law: str = "workbook", pdf: str | os.PathLike[str] | None = None,
+           reproducible: bool = False, **spec: Unpack[SpecKeywords]) -> AcceptOutcome:
     """Judge a recording against the shot's specification, as ``airgun-xl accept`` does.
 
     The specification is the ``profile``'s, then the shot's Specification sheet's, then
@@ -102,6 +104,9 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
     crush_law : str
         The law the shot's prediction runs: ``workbook`` (its Crush law sheet's, else the
         macro's), ``legacy`` (the macro's, Eq. 8) or ``NAME[@N]`` of ``archive``'s library.
+    pdf : path, optional
+        Also write the client's test report as a PDF (needs matplotlib);
+        ``reproducible`` leaves its date out (the same run, the same bytes).
 
     Returns
     -------
@@ -122,7 +127,8 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
     return run(AcceptRequest(
         Path(shot), os.fspath(recording), fields, Path(output) if output is not None else None,
         force, Path(archive) if archive is not None else None, channel,
-        _number("--sign", sign), time_unit, accel_unit, ("accept",), crush_law))
+        _number("--sign", sign), time_unit, accel_unit, ("accept",), crush_law,
+        _path("--pdf", pdf) if pdf is not None else None, bool(reproducible)))
 
 
 def calibrate(*files: str | os.PathLike[str], law: bool = False,
@@ -391,6 +397,15 @@ def _texts(value: str | Sequence[str] | None) -> tuple[str, ...]:
         return tuple(str(v) for v in value)
     except TypeError:  # one value of another type: read as text, refused by the grammar
         return (str(value),)
+
+
+def _path(option: str, value: object) -> Path:
+    """A file's path given as text or a path; else one line naming the option."""
+    from pathlib import Path
+
+    if not isinstance(value, (str, os.PathLike)):
+        raise OptionError(f"{option}: found {value!r}, expected a file's path")
+    return Path(value)
 
 
 def _number(option: str, value: object) -> float:

@@ -117,7 +117,7 @@ SLOW_MODULES = {
     "test_hostile_spec_properties",
     "test_hostile_archive", "test_pure_python", "test_typing", "test_sensitivity",
     "test_calibration_intervals", "test_benchmarks", "test_golden_commands",
-    "test_api_properties", "test_closed_loop",
+    "test_api_properties", "test_closed_loop", "test_pdf_report",
 }
 
 

@@ -45,6 +45,8 @@ class AcceptRequest:
     accel_unit: str | None = None
     argv: tuple[str, ...] = ()  # the command, as the archive records it
     crush_law: str = "workbook"  # workbook, legacy or NAME[@N] of the archive's library
+    pdf: Path | None = None  # the client's test report, as a PDF
+    reproducible: bool = False  # the PDF without a date: the same run, the same bytes
 
 
 @dataclass(frozen=True)
@@ -141,6 +143,14 @@ def run(request: AcceptRequest) -> AcceptOutcome:
     if request.output is not None:
         check_output(request.output, request.force,
                      inputs=[request.shot, input_file(request.recording)])
+    if request.pdf is not None:
+        from ..reports.pdf_report import require_matplotlib
+
+        require_matplotlib()
+        check_output(request.pdf, request.force,
+                     inputs=[request.shot, input_file(request.recording),
+                             *([request.output] if request.output is not None else [])],
+                     suffixes=(".pdf",))
     if request.archive is not None:  # a folder that is not an archive: refused before work
         if request.output is None:
             raise OptionError("--archive: found no verdict workbook to name, expected an "
@@ -168,15 +178,48 @@ def run(request: AcceptRequest) -> AcceptOutcome:
     time, kg = verdict.record
     pulse, spectra = report_data(time, kg, spec, verdict)
     archived = None
-    if request.output is not None:
-        archived = _write(request, shot, verdict, trace, rec, pulse, spectra)
+    if request.pdf is not None:  # first: a workbook that fails after it takes it back
+        _write_pdf(request, verdict, trace, rec, pulse, spectra)
+    try:
+        if request.output is not None:
+            archived = _write(request, shot, verdict, trace, rec, pulse, spectra)
+    except BaseException:
+        if request.pdf is not None:
+            request.pdf.unlink(missing_ok=True)
+        raise
     eq = spectra["equivalent"]
-    files = tuple(p for p in (archived, request.output) if p is not None)
+    files = tuple(p for p in (archived, request.output, request.pdf) if p is not None)
     record = verdict_record(verdict, shot, request.recording,
                             request.output if request.output is not None else "", request.argv)
     return AcceptOutcome(verdict, Path(request.shot), trace.name, request.output, archived,
                          (float(eq[0]), float(eq[1])), float(np.max(spectra["pv"])), files,
                          record)
+
+
+def _about(request: AcceptRequest, verdict: Verdict, trace: Any, rec: Any) -> list[
+        tuple[str, str]]:
+    """What the verdict's pages say of the shot and the recording read."""
+    return [("Shot", str(request.shot)), ("Recording", trace.name),
+            ("Units read", f"time {trace.units[0]}, acceleration {trace.units[1]}"),
+            ("Record judged", verdict.definitions[0].removeprefix("record judged: ")),
+            ("Baseline", rec.base.words()), ("Verdict", verdict.word)]
+
+
+def _write_pdf(request: AcceptRequest, verdict: Verdict, trace: Any, rec: Any,
+               pulse: dict[str, Any], spectra: dict[str, Any]) -> None:
+    """The client's test report (``--pdf``), published whole or not at all."""
+    from ..reports.pdf_report import write_verdict_pdf
+    from ..transaction import atomic_path
+    from ..untrusted_json import printable
+
+    assert request.pdf is not None
+    about = [(label, printable(text)) for label, text in _about(request, verdict, trace, rec)]
+    heading = (printable(Path(request.shot).name), printable(Path(trace.name).name),
+               printable(verdict.spec.source or "options"))  # the names: a page's width
+    with atomic_path(request.pdf, request.force) as tmp:
+        write_verdict_pdf(tmp, verdict, about, pulse, spectra,
+                          [printable(w) for w in verdict.warnings], heading,
+                          request.reproducible)
 
 
 def _write(request: AcceptRequest, shot: Shot, verdict: Verdict, trace: Any, rec: Any,
@@ -188,10 +231,7 @@ def _write(request: AcceptRequest, shot: Shot, verdict: Verdict, trace: Any, rec
     from ..transaction import signals_held
 
     assert request.output is not None
-    about = [("Shot", str(request.shot)), ("Recording", trace.name),
-             ("Units read", f"time {trace.units[0]}, acceleration {trace.units[1]}"),
-             ("Record judged", verdict.definitions[0].removeprefix("record judged: ")),
-             ("Baseline", rec.base.words()), ("Verdict", verdict.word)]
+    about = _about(request, verdict, trace, rec)
     stored = None
     try:
         if request.archive is not None:

@@ -23,6 +23,12 @@ def add_parser(sub):
     p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
     p.add_argument("recording", metavar="RECORDING", help="the recorded pulse: " + RECORDING_HELP)
     add_output(p, "verdict workbook", "SHOT.accept.xlsx")
+    p.add_argument("--pdf", metavar="FILE.pdf", action=One,
+                   help="also write the client's test report as a PDF (the verdict, the "
+                        "criteria, the warnings, the sources, the charts and a signature "
+                        "block; needs matplotlib: pip install 'airgun-xl[plots]')")
+    p.add_argument("--reproducible", action="store_true",
+                   help="leave the date out of the PDF: the same run gives the same bytes")
     add_force(p)
     add_recording_options(p, anti_alias=False, cfc_help=(
         RECORD_HELP + ", over the sheet's and the profile's (refused where the filter is "
@@ -47,7 +53,8 @@ def request_of(args):
         shot_path.stem + ".accept.xlsx")
     return AcceptRequest(shot_path, args.recording, SpecFields.of(args), output, args.force,
                          Path(args.archive) if args.archive else None, args.channel, args.sign,
-                         args.time_unit, args.accel_unit, tuple(args.argv), args.crush_law)
+                         args.time_unit, args.accel_unit, tuple(args.argv), args.crush_law,
+                         Path(args.pdf) if args.pdf else None, args.reproducible)
 
 
 def run(args):

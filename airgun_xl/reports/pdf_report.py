@@ -1,0 +1,273 @@
+"""The client's test report as a PDF (issue 46): the verdict's pages drawn directly, without a
+spreadsheet application, by matplotlib's PDF backend (vector charts, text kept as text in
+embedded TrueType fonts, so a PDF reader or ``pdftotext`` reads it back).
+
+A report is a list of A4 pages. The first holds what the client is handed: the verdict, every
+criterion with its value, limits and margin, the warnings, the recording's quality, where each
+field of the specification came from, and a block for the test engineer's name and signature;
+the text flows onto further pages when it is long. Then the charts: the pulse (with its
+corridor or the peak's limits), its SRS and pseudo-velocity on log axes. Every page has a
+header (the shot, the recording, the specification's source) and a footer (the tool's version,
+the date, page n of m).
+
+``reproducible`` leaves the date out of the footer and of the file's metadata: the same run
+gives the same bytes.
+"""
+from __future__ import annotations
+
+import datetime
+import textwrap
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import OptionError
+from ..version import __version__
+
+#: A4 portrait [inch].
+PAGE = (8.27, 11.69)
+
+#: Margins [fraction of the page]: left, right, top (below the header), bottom (above the
+#: footer).
+LEFT, RIGHT, TOP, BOTTOM = 0.08, 0.92, 0.93, 0.07
+
+#: Characters a full-width line of body text holds (9 pt DejaVu Sans on 0.84 of A4's width).
+LINE_CHARS = 105
+
+#: Line height of body text [fraction of the page's height].
+LINE = 0.0135
+
+#: Colours of the verdict's word.
+PASS_COLOUR, FAIL_COLOUR = "#006100", "#9C0006"
+
+
+def require_matplotlib(option: str = "--pdf") -> None:
+    """One line naming the option when matplotlib (the ``plots`` extra) is not installed."""
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        raise OptionError(f"{option}: needs matplotlib, expected it installed (pip install "
+                          "'airgun-xl[plots]')") from None
+
+
+class _Pages:
+    """Pages being written: text flows down the current page, and a new one starts when the
+    next line would pass the bottom margin."""
+
+    def __init__(self) -> None:
+        self.figures: list[Any] = []
+        self.y = 0.0
+        self.new()
+
+    def new(self) -> None:
+        from matplotlib.figure import Figure  # no pyplot: the caller's backend is left alone
+
+        self.figures.append(Figure(figsize=PAGE))
+        self.y = TOP
+
+    @property
+    def figure(self) -> Any:
+        return self.figures[-1]
+
+    def room(self, height: float) -> None:
+        if self.y - height < BOTTOM:
+            self.new()
+
+    def text(self, text: str, size: float = 9.0, bold: bool = False, colour: str = "black",
+             indent: float = 0.0, width: int = LINE_CHARS) -> None:
+        """``text`` wrapped to the page's width, line by line."""
+        lines = textwrap.wrap(text, width - int(indent * 120)) or [""]
+        for line in lines:
+            height = LINE * size / 9.0
+            self.room(height)
+            self.figure.text(LEFT + indent, self.y, line, fontsize=size, color=colour,
+                             fontweight="bold" if bold else "normal", va="top", ha="left",
+                             parse_math=False)
+            self.y -= height
+
+    def gap(self, lines: float = 0.6) -> None:
+        self.y -= LINE * lines
+
+    def table(self, header: list[str], rows: list[list[str]], columns: list[float],
+              colours: list[str | None] | None = None) -> None:
+        """A table of text: ``columns`` the left edge of each column [fraction of the
+        page's width from the left margin]; a long cell is wrapped within its column."""
+        edges = [*columns, RIGHT - LEFT]
+        widths = [max(8, int((b - a) * 125)) for a, b in zip(edges[:-1], edges[1:],
+                                                               strict=True)]
+        for k, row in enumerate([header, *rows]):
+            wrapped = [textwrap.wrap(cell, w) or [""] for cell, w in zip(row, widths,
+                                                                         strict=True)]
+            height = LINE * max(len(w) for w in wrapped)
+            self.room(height)
+            for x, lines, col in zip(columns, wrapped, range(len(row)), strict=True):
+                colour = (colours[k - 1] if colours and k and col == len(row) - 1
+                          else None) or "black"
+                for j, line in enumerate(lines):
+                    self.figure.text(LEFT + x, self.y - j * LINE, line, fontsize=8.5,
+                                     va="top", ha="left", color=colour,
+                                     fontweight="bold" if k == 0 or colour != "black"
+                                     else "normal", parse_math=False)
+            self.y -= height + LINE * 0.25
+
+
+def _criteria_rows(verdict: Any) -> tuple[list[list[str]], list[str | None]]:
+    from ..studies.acceptance import limits_text
+
+    rows: list[list[str]] = []
+    colours: list[str | None] = []
+    for c in verdict.criteria:
+        value = f"{c.value:.5g}" if np.isfinite(c.value) else "n/a"
+        margin = f"{c.margin:+.2f} {c.margin_unit}" if np.isfinite(c.margin) else "n/a"
+        rows.append([c.name, value, c.unit, limits_text(c), margin,
+                     "PASS" if c.passed else "FAIL"])
+        colours.append(PASS_COLOUR if c.passed else FAIL_COLOUR)
+    return rows, colours
+
+
+def _text_pages(pages: _Pages, verdict: Any, about: list[tuple[str, str]],
+                warnings: list[str]) -> None:
+    """The verdict, the criteria, the warnings, the recording, the sources, the signature."""
+    from matplotlib.lines import Line2D
+
+    pages.text("Shock test report", size=16, bold=True)
+    pages.gap(1.0)
+    pages.text(f"Verdict: {verdict.word}", size=14, bold=True,
+               colour=PASS_COLOUR if verdict.passed else FAIL_COLOUR)
+    pages.gap()
+    pages.table(["Item", "Value"], [[label, value] for label, value in about], [0.0, 0.2])
+    pages.gap()
+    pages.text("Criteria", size=11, bold=True)
+    rows, colours = _criteria_rows(verdict)
+    pages.table(["Criterion", "Value", "Unit", "Limits", "Margin", "Result"], rows,
+                [0.0, 0.17, 0.29, 0.37, 0.67, 0.80], colours)
+    pages.gap()
+    pages.text(f"Warnings ({len(warnings)})" if warnings else "Warnings: none", size=11,
+               bold=True, colour=FAIL_COLOUR if warnings else "black")
+    for w in warnings:
+        pages.text(f"- {w}", indent=0.02)
+    if verdict.quality is not None:
+        pages.gap()
+        pages.text("The recording, before it was judged", size=11, bold=True)
+        nominal = verdict.spec.duration.nominal if verdict.spec.duration else None
+        for label, text in verdict.quality.block(nominal):
+            pages.text(f"{label}: {text}", indent=0.02)
+    pages.gap()
+    pages.text("How it was judged", size=11, bold=True)
+    for line in verdict.definitions:
+        pages.text(f"- {line}", indent=0.02)
+    pages.gap()
+    pages.text("The specification's sources", size=11, bold=True)
+    for line in verdict.sources():
+        pages.text(f"- {line}", indent=0.02)
+    pages.gap(1.5)
+    pages.room(LINE * 10)  # the block whole on one page: its title and three lines
+    pages.text("Test engineer", size=11, bold=True)
+    pages.gap(1.2)
+    for label in ("Name", "Signature", "Date"):
+        pages.room(LINE * 2.4)
+        pages.figure.text(LEFT, pages.y, f"{label}:", fontsize=9, va="top",
+                          parse_math=False)
+        pages.figure.add_artist(Line2D([LEFT + 0.1, LEFT + 0.5],
+                                                 [pages.y - LINE, pages.y - LINE],
+                                                 color="black", linewidth=0.6))
+        pages.y -= LINE * 2.4
+
+
+def _chart_page(pages: _Pages, verdict: Any, pulse: dict[str, Any],
+                spectra: dict[str, Any]) -> None:
+    """The pulse with its limits, the SRS and the pseudo-velocity: one page."""
+    from matplotlib.ticker import FormatStrFormatter, NullFormatter
+
+    pages.new()
+    fig = pages.figure
+    t_ms = np.asarray(pulse["time"]) * 1e3
+    ax = fig.add_axes((LEFT + 0.03, 0.62, RIGHT - LEFT - 0.03, 0.28))
+    ax.plot(t_ms, pulse["kg"], color="#1f4e79", linewidth=0.8, label="Record judged")
+    if "upper" in pulse:
+        ax.plot(t_ms, pulse["ideal"], color="#7f7f7f", linewidth=0.8, linestyle="--",
+                label="Ideal pulse")
+        ax.plot(t_ms, pulse["upper"], color=FAIL_COLOUR, linewidth=0.8, label="Corridor")
+        ax.plot(t_ms, pulse["lower"], color=FAIL_COLOUR, linewidth=0.8)
+    elif verdict.spec.peak is not None:
+        lo, hi = verdict.spec.peak.limits
+        ax.axhspan(lo, hi, color="#c6efce", alpha=0.6, label="Peak's limits")
+    ax.set_xlabel("Time (ms)")
+    ax.set_ylabel("Acceleration (kG)")
+    ax.set_title("The record judged", fontsize=10)
+    ax.grid(True, color="#d9d9d9", linewidth=0.5)
+    ax.legend(fontsize=7, loc="upper right")
+    f = np.asarray(spectra["frequencies"])
+    for k, (key, title, unit) in enumerate((("srs", f"SRS (maximax, Q = {spectra['q']:g})",
+                                             "Acceleration (kG)"),
+                                            ("pv", "Pseudo-velocity", "Velocity (m/s)"))):
+        ax = fig.add_axes((LEFT + 0.03, 0.36 - k * 0.27, RIGHT - LEFT - 0.03, 0.2))
+        ax.loglog(f, spectra[key], color="#1f4e79", linewidth=0.9, label=title)
+        if key == "srs" and "required" in spectra:
+            ax.loglog(f, spectra["required"], color="black", linewidth=0.8,
+                      label="Required")
+            ax.loglog(f, spectra["lower"], color=FAIL_COLOUR, linewidth=0.6,
+                      linestyle="--", label="Tolerance")
+            ax.loglog(f, spectra["upper"], color=FAIL_COLOUR, linewidth=0.6,
+                      linestyle="--")
+        ax.set_xlabel("Frequency (Hz)")
+        ax.set_ylabel(unit)
+        for scale, values in ((ax.xaxis, f), (ax.yaxis, spectra[key])):
+            # plain numbers (100, 1000), not powers of ten; within a decade and a half the
+            # minor ticks are labelled too, or the axis would show one number or none
+            shown = np.asarray(values, dtype=float)
+            shown = shown[np.isfinite(shown) & (shown > 0)]
+            narrow = len(shown) and np.log10(shown.max() / shown.min()) < 1.5
+            scale.set_major_formatter(FormatStrFormatter("%g"))
+            scale.set_minor_formatter(FormatStrFormatter("%g") if narrow else NullFormatter())
+        ax.set_title(title, fontsize=10)
+        ax.grid(True, which="both", color="#e5e5e5", linewidth=0.4)
+        ax.legend(fontsize=7, loc="lower right")
+
+
+def write_verdict_pdf(path: str | Path, verdict: Any, about: list[tuple[str, str]],
+                      pulse: dict[str, Any], spectra: dict[str, Any], warnings: list[str],
+                      heading: tuple[str, str, str], reproducible: bool = False) -> None:
+    """The verdict's report at ``path`` (written as it is: the caller publishes it whole).
+
+    Parameters
+    ----------
+    about : list of (str, str)
+        The shot, the recording and what was read of it, as the verdict workbook gives them.
+    pulse, spectra : dict
+        :func:`airgun_xl.app.accept.report_data`'s: time [s], acceleration [kG], the
+        corridor's; frequencies [Hz], SRS [kG], pseudo-velocity [m/s].
+    heading : (str, str, str)
+        The shot, the recording and the specification's source, for every page's header.
+    reproducible : bool
+        No date in the footer or the metadata.
+    """
+    import matplotlib
+    from matplotlib.backends.backend_pdf import PdfPages
+
+    date = None if reproducible else datetime.datetime.now(datetime.UTC)
+    with matplotlib.rc_context({"pdf.fonttype": 42, "font.family": "DejaVu Sans",
+                                "path.simplify": False}):
+        pages = _Pages()
+        _text_pages(pages, verdict, about, warnings)
+        _chart_page(pages, verdict, pulse, spectra)
+        shot, recording, source = heading
+        stamp = (f"printed {date:%Y-%m-%d %H:%M} UTC" if date is not None
+                 else "date left out (--reproducible)")
+        total = len(pages.figures)
+        for n, fig in enumerate(pages.figures, start=1):
+            said = {"fontsize": 7.5, "parse_math": False}
+            fig.text(LEFT, 0.975, f"Shot: {shot}", va="top", **said)
+            fig.text(RIGHT, 0.975, f"Recording: {recording}", va="top", ha="right",
+                     **said)
+            fig.text(LEFT, 0.962, textwrap.shorten(f"Specification: {source}", 150),
+                     va="top", **said)
+            fig.text(LEFT, 0.03, f"airgun-xl {__version__}, {stamp}", **said)
+            fig.text(RIGHT, 0.03, f"page {n} of {total}", ha="right", **said)
+        metadata = {"Title": f"Shock test report: {shot}", "Creator": "airgun-xl",
+                    "Producer": f"airgun-xl {__version__} (matplotlib)",
+                    "CreationDate": date, "ModDate": date}
+        with PdfPages(path, metadata=metadata) as pdf:
+            for fig in pages.figures:
+                pdf.savefig(fig)

@@ -1,0 +1,123 @@
+"""Issue 46: the client's test report as a PDF (accept --pdf), read back with a PDF text
+extractor (poppler's pdftotext) and rendered (pdftoppm): the verdict, every criterion with
+its value, limits and margin, the warnings, the specification's sources, the charts drawn,
+and the same bytes twice with --reproducible."""
+import re
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+from conftest import TEMPLATE, write_trace_csv
+
+import airgun_xl
+from airgun_xl.cli import main
+from airgun_xl.crush_law import LEGACY_LAW
+from airgun_xl.studies.calibrate import synthetic_measurement
+
+pytest.importorskip("matplotlib")
+needs_poppler = pytest.mark.skipif(not (shutil.which("pdftotext") and shutil.which("pdftoppm")),
+                                   reason="needs poppler-utils (pdftotext, pdftoppm)")
+
+#: Shot A fired on a lot 10 % stronger, recorded at 51.2 kHz with 1 % noise: judged on the
+#: default record, 9.3337 kG and 4.7385 ms (tests/test_closed_loop.py's first shot).
+PASSING = {"peak": "9.3kG:5%", "duration": "4.74ms:15%"}
+FAILING = {"peak": "8.5kG:5%", "duration": "4.5ms:15%", "velocity-change": "8m/s:50%"}
+
+
+@pytest.fixture(scope="module")
+def fired(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("pdf")
+    shot = folder / "shot1.xlsx"
+    shot.write_bytes(TEMPLATE.read_bytes())
+    p = airgun_xl.load(shot).params.replace(crush_law=LEGACY_LAW.scaled(1.10))
+    write_trace_csv(folder / "rec$x^2$.csv", synthetic_measurement(p, dt=1 / 51_200, seed=3))
+    return folder, shot, folder / "rec$x^2$.csv"
+
+
+def _accept(fired, spec, name, *extra):
+    folder, shot, rec = fired
+    pdf = folder / f"{name}.pdf"
+    argv = ["accept", str(shot), str(rec), "-o", str(folder / f"{name}.xlsx"), "--pdf",
+            str(pdf), "--force", "--quiet", *extra]
+    for key, value in spec.items():
+        argv += [f"--{key}", value]
+    code = main(argv)
+    return code, pdf
+
+
+def _text(pdf):
+    return subprocess.run(["pdftotext", "-layout", str(pdf), "-"], capture_output=True,
+                          text=True, check=True).stdout
+
+
+@needs_poppler
+@pytest.mark.parametrize("case", ["PASS", "FAIL"])
+def test_the_pdf_reads_back_the_verdict_criteria_warnings_and_sources(fired, case, capsys):
+    code, pdf = _accept(fired, PASSING if case == "PASS" else FAILING, case.lower(),
+                        "--reproducible")
+    assert code == (0 if case == "PASS" else 3)
+    folder, shot, rec = fired
+    outcome = airgun_xl.accept(shot, rec, **{k.replace("-", "_"): v for k, v in (
+        PASSING if case == "PASS" else FAILING).items()})
+    text = _text(pdf)
+    flat = " ".join(text.split())
+    assert f"Verdict: {case}" in flat
+    for c in outcome.criteria:  # the value, limits, margin and result as the terminal's
+        row = re.search(rf"^{re.escape(c.name)}\s+(\S+)\s+{re.escape(c.unit)}\s+(.+?)\s{{2,}}"
+                        rf"(\S+ \S+)\s+(PASS|FAIL)$", text, re.M)
+        assert row is not None, (c.name, text)
+        assert row.group(1) == f"{c.value:.5g}"
+        assert row.group(2) == airgun_xl.studies.acceptance.limits_text(c)
+        assert row.group(3) == f"{c.margin:+.2f} {c.margin_unit}"
+        assert row.group(4) == ("PASS" if c.passed else "FAIL")
+    for warning in outcome.warnings:
+        assert " ".join(warning.split()) in flat, warning
+    for source in outcome.verdict.sources():
+        assert " ".join(source.split()) in flat, source
+    pages = int(re.search(r"Pages:\s+(\d+)", subprocess.run(
+        ["pdfinfo", str(pdf)], capture_output=True, text=True).stdout).group(1))
+    assert f"page 1 of {pages}" in flat and f"page {pages} of {pages}" in flat
+    # a file's name is text: "$x^2$" is not typeset as mathematics
+    assert "Recording: rec$x^2$.csv" in flat  # the header names the file
+    assert "Name:" in flat and "Signature:" in flat and "Date:" in flat
+
+
+@needs_poppler
+def test_the_charts_page_renders_with_its_curves(fired, tmp_path):
+    """The last page (pdftoppm at 60 dpi): the record's colour (#1f4e79) drawn in each of
+    its three charts' bands of the page, not a blank page."""
+    from PIL import Image
+
+    code, pdf = _accept(fired, FAILING, "charts", "--reproducible")
+    assert code == 3
+    last = re.search(r"Pages:\s+(\d+)", subprocess.run(
+        ["pdfinfo", str(pdf)], capture_output=True, text=True).stdout).group(1)
+    subprocess.run(["pdftoppm", "-r", "60", "-png", "-singlefile", "-f", last, "-l", last,
+                    str(pdf), str(tmp_path / "p")], check=True)
+    pixels = np.asarray(Image.open(tmp_path / "p.png").convert("RGB")).astype(int)
+    curve = np.all(np.abs(pixels - [31, 78, 121]) < 40, axis=2)
+    rows = np.flatnonzero(curve.any(axis=1)) / len(pixels)
+    # the pulse (top), the SRS and the pseudo-velocity (below): curve pixels in each third
+    for lo, hi in ((0.05, 0.4), (0.4, 0.68), (0.68, 0.95)):
+        assert np.any((rows > lo) & (rows < hi)), (lo, hi)
+
+
+def test_the_same_run_twice_with_reproducible_gives_the_same_bytes(fired):
+    first = _accept(fired, PASSING, "one", "--reproducible")[1].read_bytes()
+    second = _accept(fired, PASSING, "two", "--reproducible")[1].read_bytes()
+    assert first == second and first.startswith(b"%PDF")
+    dated = _accept(fired, PASSING, "dated")[1].read_bytes()
+    assert dated != first and b"/CreationDate" in dated and b"/CreationDate" not in first
+
+
+@pytest.mark.parametrize("given", ["report.xlsx", "."])
+def test_a_pdf_path_refused_is_one_line_and_nothing_written(fired, given, capsys, tmp_path):
+    folder, shot, rec = fired
+    out = tmp_path / "v.xlsx"
+    target = str(tmp_path / given) if given != "." else str(tmp_path)
+    code = main(["accept", str(shot), str(rec), "-o", str(out), "--pdf", target,
+                 "--peak", "9.3kG:5%"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and err[0].startswith("airgun-xl: error: "), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
