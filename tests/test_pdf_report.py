@@ -121,3 +121,34 @@ def test_a_pdf_path_refused_is_one_line_and_nothing_written(fired, given, capsys
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and err[0].startswith("airgun-xl: error: "), err
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+@needs_poppler
+def test_a_corridor_and_an_srs_requirement_are_on_the_pdf(tmp_path):
+    """The README's recording of shot A judged against MIL-STD-810H's half-sine corridor and
+    an SRS requirement with its dB tolerance: the corridor and SRS criteria read back, and
+    the charts page draws the corridor's limits and the requirement's lines (in the
+    failure colour, #9C0006) beside the record."""
+    from PIL import Image
+
+    requirement = tmp_path / "req.csv"
+    requirement.write_text("frequency [Hz],srs [g]\n200,150\n1000,1500\n4000,6000\n")
+    shot = tmp_path / "shot.xlsx"
+    shot.write_bytes(TEMPLATE.read_bytes())
+    pdf = tmp_path / "corridor.pdf"
+    code = main(["accept", str(shot), str(TEMPLATE.parent / "shot_a_recording.csv"), "--sign",
+                 "-1", "--cfc", "1000", "--profile", "mil-std-810h-half-sine", "--peak",
+                 "9.5kG", "--duration", "5ms", "--srs", str(requirement), "--srs-tol",
+                 "-40dB,+40dB", "--pdf", str(pdf), "--reproducible", "--quiet"])
+    assert code in (0, 3)
+    flat = " ".join(_text(pdf).split())
+    assert re.search(r"corridor \S+ % the record inside the band", flat), flat
+    assert re.search(r"\bSRS \S+ dB -40 to 40 dB ", flat), flat
+    last = re.search(r"Pages:\s+(\d+)", subprocess.run(
+        ["pdfinfo", str(pdf)], capture_output=True, text=True).stdout).group(1)
+    subprocess.run(["pdftoppm", "-r", "60", "-png", "-singlefile", "-f", last, "-l", last,
+                    str(pdf), str(tmp_path / "p")], check=True)
+    pixels = np.asarray(Image.open(tmp_path / "p.png").convert("RGB")).astype(int)
+    limits = np.all(np.abs(pixels - [156, 0, 6]) < 50, axis=2)
+    rows = np.flatnonzero(limits.any(axis=1)) / len(pixels)
+    assert np.any(rows < 0.4) and np.any((rows > 0.4) & (rows < 0.68))  # corridor, SRS

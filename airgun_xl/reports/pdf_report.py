@@ -175,10 +175,18 @@ def _text_pages(pages: _Pages, verdict: Any, about: list[tuple[str, str]],
         pages.y -= LINE * 2.4
 
 
+def _two_and_five(value: float, _position: object) -> str:
+    """A minor tick's label on a log axis: 2 and 5 times a power of ten, plainly."""
+    if not value > 0:
+        return ""
+    mantissa = value / 10 ** np.floor(np.log10(value))
+    return f"{value:g}" if any(abs(mantissa - m) < 1e-6 for m in (2.0, 5.0)) else ""
+
+
 def _chart_page(pages: _Pages, verdict: Any, pulse: dict[str, Any],
                 spectra: dict[str, Any]) -> None:
     """The pulse with its limits, the SRS and the pseudo-velocity: one page."""
-    from matplotlib.ticker import FormatStrFormatter, NullFormatter
+    from matplotlib.ticker import FormatStrFormatter, FuncFormatter, NullFormatter
 
     pages.new()
     fig = pages.figure
@@ -213,14 +221,13 @@ def _chart_page(pages: _Pages, verdict: Any, pulse: dict[str, Any],
                       linestyle="--")
         ax.set_xlabel("Frequency (Hz)")
         ax.set_ylabel(unit)
-        for scale, values in ((ax.xaxis, f), (ax.yaxis, spectra[key])):
-            # plain numbers (100, 1000), not powers of ten; within a decade and a half the
-            # minor ticks are labelled too, or the axis would show one number or none
-            shown = np.asarray(values, dtype=float)
-            shown = shown[np.isfinite(shown) & (shown > 0)]
-            narrow = len(shown) and np.log10(shown.max() / shown.min()) < 1.5
+        for scale, (lo, hi) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+            # plain numbers (100, 1000), not powers of ten; over less than two decades the
+            # minor ticks at 2 and 5 are labelled too, or the axis would show one number
             scale.set_major_formatter(FormatStrFormatter("%g"))
-            scale.set_minor_formatter(FormatStrFormatter("%g") if narrow else NullFormatter())
+            narrow = lo > 0 and np.log10(hi / lo) < 2
+            scale.set_minor_formatter(FuncFormatter(_two_and_five) if narrow
+                                      else NullFormatter())
         ax.set_title(title, fontsize=10)
         ax.grid(True, which="both", color="#e5e5e5", linewidth=0.4)
         ax.legend(fontsize=7, loc="lower right")
