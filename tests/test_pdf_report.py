@@ -152,3 +152,61 @@ def test_a_corridor_and_an_srs_requirement_are_on_the_pdf(tmp_path):
     limits = np.all(np.abs(pixels - [156, 0, 6]) < 50, axis=2)
     rows = np.flatnonzero(limits.any(axis=1)) / len(pixels)
     assert np.any(rows < 0.4) and np.any((rows > 0.4) & (rows < 0.68))  # corridor, SRS
+
+
+@needs_poppler
+def test_a_fills_pdf_holds_the_summarys_figures_the_verdict_and_the_charts(tmp_path):
+    """fill --pdf: the Summary's figures as the sheet shows them (its number format: 11.994
+    kG, 0.2885 ms...), the predicted verdict's criteria, the warnings (none here), and a
+    charts page whose six charts are drawn; the same bytes twice with --reproducible."""
+    from PIL import Image
+
+    from airgun_xl.reports.pdf_report import excel_number
+
+    outs = []
+    for k in range(2):
+        out, pdf = tmp_path / f"f{k}.xlsx", tmp_path / f"f{k}.pdf"
+        assert main(["fill", str(TEMPLATE), "-o", str(out), "--pdf", str(pdf), "--quiet",
+                     "--reproducible", "--peak", "12kG:10%", "--duration", "5ms:10%"]) == 0
+        outs.append(pdf.read_bytes())
+    assert outs[0] == outs[1]
+    flat = " ".join(_text(tmp_path / "f0.pdf").split())
+    assert "Predicted verdict: PASS" in flat and "Warnings: none" in flat
+    sheet = openpyxl_summary(tmp_path / "f0.xlsx")
+    for label in ("Peak acceleration (raw)", "Time of peak", "Pulse duration",
+                  "Maximum crush", "Final M1", "Dominant frequency 1", "Time step"):
+        value, fmt, unit = sheet[label]
+        assert f"{label} {excel_number(value, fmt)} {unit}" in flat, (label, value, fmt)
+    assert re.search(r"peak 11\.994 kG 10\.8 to 13\.2 kG \+9\.95 % PASS", flat), flat
+    last = re.search(r"Pages:\s+(\d+)", subprocess.run(
+        ["pdfinfo", str(tmp_path / "f0.pdf")], capture_output=True, text=True).stdout).group(1)
+    subprocess.run(["pdftoppm", "-r", "60", "-png", "-singlefile", "-f", last, "-l", last,
+                    str(tmp_path / "f0.pdf"), str(tmp_path / "p")], check=True)
+    pixels = np.asarray(Image.open(tmp_path / "p.png").convert("RGB")).astype(int)
+    curve = np.all(np.abs(pixels - [31, 78, 121]) < 40, axis=2)
+    rows = np.flatnonzero(curve.any(axis=1)) / len(pixels)
+    for lo, hi in ((0.1, 0.35), (0.38, 0.62), (0.66, 0.92)):  # the three rows of charts
+        assert np.any((rows > lo) & (rows < hi)), (lo, hi)
+
+
+def openpyxl_summary(path):
+    """{quantity: (value, number format, unit)} of a filled workbook's Summary sheet."""
+    import openpyxl
+
+    ws = openpyxl.load_workbook(path)["Summary"]
+    return {r[0].value: (r[1].value, r[1].number_format, r[2].value or "")
+            for r in ws.iter_rows(min_row=2) if isinstance(r[1].value, (int, float))}
+
+
+def test_fill_pdf_is_refused_for_a_campaign_and_a_wrong_name(tmp_path, capsys):
+    day = tmp_path / "day"
+    day.mkdir()
+    for name in ("a", "b"):
+        (day / f"{name}.xlsx").write_bytes(TEMPLATE.read_bytes())
+    assert main(["fill", str(day), "--pdf", str(tmp_path / "r.pdf"), "--jobs", "1"]) == 2
+    assert "--pdf: found with 2 shots, expected one shot's workbook" in capsys.readouterr().err
+    assert main(["fill", str(day / "a.xlsx"), "--pdf", str(tmp_path / "r.txt")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "r.txt: has the extension .txt, expected .pdf" in err[0]
+    assert sorted(p.name for p in day.iterdir()) == ["a.xlsx", "b.xlsx"]
+    assert not (tmp_path / "r.pdf").exists()

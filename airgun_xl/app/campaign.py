@@ -392,6 +392,9 @@ def checked_files(request: CampaignRequest) -> tuple[list[Path], int]:
     jobs = parse_jobs(request.jobs)
     summary = Path(request.summary) if request.summary else None
     files = shot_files(request.shots, exclude=[summary] if summary else ())
+    if request.settings.pdf and (len(files) > 1 or summary is not None):
+        raise OptionError(f"--pdf: found with {len(files)} shots, expected one shot's "
+                          "workbook (a campaign's shots are each their own report)")
     if request.settings.output and len(files) > 1:
         raise OptionError(f"-o: found with {len(files)} shots, expected one shot (a campaign "
                           "writes SHOT.out.xlsx beside each)")

@@ -70,6 +70,7 @@ class Options:
     srs_requirement: tuple[Any, ...] | None = None
     spec: Specification | None = None  # judges the prediction (else the shot's sheet)
     study_notes: tuple[str, ...] = ()  # what the study behind the shot found (design)
+    pdf: Path | None = None  # the shot's report as a PDF too (the Summary, the charts)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -209,6 +210,12 @@ def _check_outputs(shot: Shot, output: Path, outputs: Outputs, options: Options)
                      force_word=options.force_word)
     if options.archive is not None:
         Archive(options.archive.root, create=True, dry_run=True)  # a foreign folder: now
+    if options.pdf is not None:
+        from ..reports.pdf_report import require_matplotlib
+
+        require_matplotlib()
+        check_output(options.pdf, options.force, inputs=[*inputs, output],
+                     suffixes=(".pdf",), force_word=options.force_word)
     return sidecar
 
 
@@ -299,6 +306,9 @@ def _publish(shot: Shot, filled: Filled, output: Path, outputs: Outputs, info: P
                                       info, shown=output))
         filled = dataclasses.replace(filled, warnings=tuple(record))
         workbook = pub.files[0][0]
+        if options.pdf is not None:
+            progress("writing the PDF")
+            _write_pdf(shot, filled, pub.stage(options.pdf), info, options, record)
         if sidecar is not None:
             progress("writing the sidecar")
             render_history(result, pub.stage(sidecar), shown=sidecar)
@@ -323,6 +333,34 @@ def _publish(shot: Shot, filled: Filled, output: Path, outputs: Outputs, info: P
                 archive.remove_if_unused()
             raise
     return dataclasses.replace(filled, entry=pending.entry if pending is not None else None)
+
+
+def _write_pdf(shot: Shot, filled: Filled, path: Path, info: Provenance, options: Options,
+               record: list[str]) -> None:
+    """The shot's report as a PDF: its Summary's figures as the sheet shows them, the
+    predicted verdict, every warning, and the Charts page's charts."""
+    from ..engine.summary import SPECTRUM_MAX_HZ
+    from ..reports.pdf_report import summary_text, write_fill_pdf
+    from ..untrusted_json import printable
+    from ..xlsx.charts import CHARTS, series_data
+
+    result = filled.result
+    summary = filled.summary if filled.summary is not None else summarize(result)
+    name = shot.source.path.name if shot.source is not None else "shot"
+    written = dataclasses.replace(info, warnings=tuple(record)).written(
+        filled.stride, len(range(0, result.rows, filled.stride)), name)
+    rows = [(printable(a), printable(b), printable(c), printable(d))
+            for a, b, c, d in summary_text(result, summary, written)]
+    data = series_data(result, summary.spectrum, filled.compared, summary.natural_initial)
+    end = float(result.history.time[-1]) * 1e3
+    charts = [(spec, data, (float(math.floor(summary.spectrum.band_start / 1000) * 1000),
+                            SPECTRUM_MAX_HZ) if spec.key == "spectrum" else (0.0, end))
+              for spec in CHARTS if any(s.key in data for s in spec.series)]
+    source = filled.verdict.spec.source if filled.verdict is not None else ""
+    write_fill_pdf(path, rows, filled.verdict, [printable(w) for w in record], charts,
+                   (f"Shot: {printable(name)}", f"{result.model} model, {result.integrator} "
+                    "integrator", f"Specification: {printable(source or 'none given')}"),
+                   options.reproducible)
 
 
 # -- the command -------------------------------------------------------------------------
@@ -391,7 +429,8 @@ def fill_one(path: str | Path, settings: FillSettings, warn: Say, note: Say | No
     options = Options(settings.integrator, settings.host, settings.model,
                       settings.compare_models, settings.force, settings.allow_unstable,
                       settings.reproducible, command=tuple(settings.argv),
-                      spec=combine(settings.profile, shot.spec, settings.spec))
+                      spec=combine(settings.profile, shot.spec, settings.spec),
+                      pdf=Path(settings.pdf) if settings.pdf else None)
     if root is not None:
         outputs = dataclasses.replace(outputs, sidecar="never")  # the entry holds the history
         options = dataclasses.replace(options, track_all=True, archive=ArchiveRequest(
@@ -413,7 +452,8 @@ def run(request: FillRequest, warn: Say | None = None, note: Say | None = None,
     progress callback."""
     output, filled, root = fill_one(request.shot, request.settings, warn or (lambda w: None),
                                     note, progress_for)
-    files = (output,) + ((filled.sidecar,) if filled.sidecar is not None else ())
+    files = (output,) + ((filled.sidecar,) if filled.sidecar is not None else ()) + (
+        (Path(request.settings.pdf),) if request.settings.pdf else ())
     lines = summary_lines(output, filled)
     if filled.entry is not None and root is not None:
         lines.append(f"  archived as {filled.entry.ref} in {display(root)}")

@@ -33,6 +33,7 @@ class FillSettings:
     # a tolerance profile (issue 25), under each shot's sheet: read once, before any shot
     profile: str | Specification | None = None
     spec: Specification | None = None  # the options' specification fields, over the sheet's
+    pdf: str | None = None  # one shot only: its report as a PDF too
 
 
 def default_output(shot_path: str | Path) -> Path:

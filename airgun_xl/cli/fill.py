@@ -73,7 +73,12 @@ def _add_run(p):
     p.add_argument("--name", help="shot name in the archive (default: the cell beside a 'Shot' "
                                   "label in the sheet, else SHOT's file name)")
     p.add_argument("--reproducible", action="store_true",
-                   help="leave run times out of the Summary, so equal inputs give equal bytes")
+                   help="leave run times out of the Summary (and the date out of --pdf), so "
+                        "equal inputs give equal bytes")
+    p.add_argument("--pdf", metavar="FILE.pdf", action=One,
+                   help="one shot: also write its report as a PDF (the Summary, the predicted "
+                        "verdict, the warnings and the charts; needs matplotlib: pip install "
+                        "'airgun-xl[plots]')")
 
 
 def print_summary(output, filled):
@@ -95,7 +100,7 @@ def settings_of(args):
         args.crush_law, args.unloading, args.compare_models, archive_root(args.archive),
         args.name, args.reproducible, tuple(args.argv),
         load_profile(args.profile) if args.profile else None,  # once, before any shot
-        options_spec(SpecFields.of(args)))
+        options_spec(SpecFields.of(args)), args.pdf)
 
 
 def run(args):

@@ -10,6 +10,10 @@ corridor or the peak's limits), its SRS and pseudo-velocity on log axes. Every p
 header (the shot, the recording, the specification's source) and a footer (the tool's version,
 the date, page n of m).
 
+A fill's report (:func:`write_fill_pdf`) is its Summary (every figure with its unit and
+definition, the figures the warnings put in doubt marked so), the predicted verdict when the
+shot has a specification, the warnings, and the Charts page's six charts.
+
 ``reproducible`` leaves the date out of the footer and of the file's metadata: the same run
 gives the same bytes.
 """
@@ -233,6 +237,159 @@ def _chart_page(pages: _Pages, verdict: Any, pulse: dict[str, Any],
         ax.legend(fontsize=7, loc="lower right")
 
 
+def excel_number(value: float, fmt: str) -> str:
+    """``value`` as the spreadsheet shows it under number format ``fmt`` (the formats of
+    :data:`airgun_xl.xlsx.report.QUANTITIES`: ``0.000``, ``#,##0.0``, ``0.00%``,
+    ``0.000E+00``), so the PDF reads the workbook's figures."""
+    decimals = len(fmt.split(".", 1)[1].rstrip("%").split("E")[0]) if "." in fmt else 0
+    if fmt.endswith("%"):
+        return f"{value:.{decimals}%}"
+    if "E+" in fmt:
+        return f"{value:.{decimals}E}"
+    return f"{value:{',' if '#,##' in fmt else ''}.{decimals}f}"
+
+
+def _save(path: str | Path, pages: _Pages, heading: tuple[str, str, str],
+          date: datetime.datetime | None, title: str) -> None:
+    """Every page's header and footer, then the pages into ``path``."""
+    from matplotlib.backends.backend_pdf import PdfPages
+
+    left, right, source = heading
+    stamp = (f"printed {date:%Y-%m-%d %H:%M} UTC" if date is not None
+             else "date left out (--reproducible)")
+    total = len(pages.figures)
+    for n, fig in enumerate(pages.figures, start=1):
+        said = {"fontsize": 7.5, "parse_math": False}
+        fig.text(LEFT, 0.975, left, va="top", **said)
+        fig.text(RIGHT, 0.975, right, va="top", ha="right", **said)
+        fig.text(LEFT, 0.962, textwrap.shorten(source, 150), va="top", **said)
+        fig.text(LEFT, 0.03, f"airgun-xl {__version__}, {stamp}", **said)
+        fig.text(RIGHT, 0.03, f"page {n} of {total}", ha="right", **said)
+    metadata = {"Title": title, "Creator": "airgun-xl",
+                "Producer": f"airgun-xl {__version__} (matplotlib)",
+                "CreationDate": date, "ModDate": date}
+    with PdfPages(path, metadata=metadata) as pdf:
+        for fig in pages.figures:
+            pdf.savefig(fig)
+
+
+def summary_text(result: Any, summary: Any, info: Any) -> list[tuple[str, str, str, str]]:
+    """The Summary sheet's rows as text (:func:`airgun_xl.xlsx.sheets.summary_rows`): each
+    value in its shown unit and number format, a figure the warnings put in doubt marked as
+    the sheet marks it."""
+    import datetime as dt
+
+    from ..xlsx.report import QUANTITIES, number_format
+    from ..xlsx.report import shown as in_unit
+    from ..xlsx.sheets import flagged_figures, summary_rows
+
+    flags = flagged_figures(list(info.warnings))
+    out = []
+    for label, value, code, definition in summary_rows(result, summary, info):
+        unit = QUANTITIES[code].unit if code in QUANTITIES else code
+        if isinstance(value, (float, int, np.floating, np.integer)) and not isinstance(
+                value, bool):
+            text = (excel_number(in_unit(float(value), code), number_format(code))
+                    if code in QUANTITIES and np.isfinite(value) else f"{value}")
+        elif isinstance(value, dt.datetime):
+            text = value.isoformat()
+        else:
+            text = "" if value is None else str(value)
+        note = definition
+        if label in flags:
+            note = f"DOUBTED: see the warnings on {', '.join(flags[label])}" + (
+                f"; {definition}" if definition else "")
+        out.append((label, text, unit, note))
+    return out
+
+
+def _fill_charts(pages: _Pages, charts: list[tuple[Any, dict[str, Any], tuple[float, float]]]
+                 ) -> None:
+    """The fill's charts, two a row and three rows a page, as the Charts sheet draws them:
+    each series present, its x range, its title and axes' names."""
+    from ..xlsx.charts import nice_range
+
+    colours = ("#1f4e79", "#c00000", "#548235", "#7f6000")
+    for k, (spec, data, x_range) in enumerate(charts):
+        if k % 6 == 0:
+            pages.new()
+        row, col = divmod(k % 6, 2)
+        ax = pages.figure.add_axes((LEFT + 0.05 + col * 0.45, 0.68 - row * 0.3, 0.36, 0.2))
+        twin = None
+        x_factor = 1e-3 if (spec.x_format or "").endswith(",") else 1.0
+        lo, hi = np.asarray(x_range) * x_factor
+        shown: dict[bool, list[Any]] = {False: [], True: []}
+        for m, series in enumerate(s for s in spec.series if s.key in data):
+            x, y = data[series.key]
+            # the sheet's "0.0," and "#,##0," show thousands: Hz as kHz, N as kN
+            x = np.asarray(x) * x_factor
+            y = np.asarray(y) * (1e-3 if (spec.y_format or "").endswith(",") else 1.0)
+            shown[series.y2].append(y[(x >= lo) & (x <= hi)])
+            target = ax
+            if series.y2:
+                twin = twin or ax.twinx()
+                target = twin
+            style = {"color": colours[m % len(colours)], "linewidth": 0.8,
+                     "linestyle": "--" if series.dash else "-", "label": series.name}
+            if series.markers:
+                target.plot(x, y, marker="o", markersize=2.5, linestyle="none",
+                            color=style["color"], label=series.name)
+            else:
+                target.plot(x, y, **style)
+        ax.set_xlim(lo, hi)
+        # the y range of what lies in the x range, as the sheet's chart sets it (the
+        # spectrum's own lobe, left of its range, would flatten the rest)
+        for axis, values in ((ax, shown[False]), (twin, shown[True])):
+            if axis is not None and values:
+                axis.set_ylim(*nice_range(np.concatenate(values), include_zero=True))
+        ax.set_title(spec.title, fontsize=7.5, wrap=True)
+        ax.set_xlabel(spec.x_title, fontsize=7)
+        ax.set_ylabel(spec.y_title, fontsize=7)
+        if twin is not None and spec.y2_title:
+            twin.set_ylabel(spec.y2_title, fontsize=7)
+            twin.tick_params(labelsize=6)
+        ax.tick_params(labelsize=6)
+        ax.grid(True, color="#d9d9d9", linewidth=0.4)
+        if len([s for s in spec.series if s.key in data]) > 1:
+            handles = [h for a in (ax, twin) if a is not None
+                       for h in a.get_legend_handles_labels()[0]]
+            ax.legend(handles=handles, fontsize=5.5, loc="best")
+
+
+def write_fill_pdf(path: str | Path, rows: list[tuple[str, str, str, str]],
+                   verdict: Any, warnings: list[str],
+                   charts: list[tuple[Any, dict[str, Any], tuple[float, float]]],
+                   heading: tuple[str, str, str], reproducible: bool = False) -> None:
+    """A fill's report at ``path``: ``rows`` the Summary's (quantity, value as shown, unit,
+    definition), the predicted ``verdict`` (or None), the warnings, and ``charts``
+    (:class:`~airgun_xl.xlsx.charts.ChartSpec`, its series' data, its x range)."""
+    import matplotlib
+
+    date = None if reproducible else datetime.datetime.now(datetime.UTC)
+    with matplotlib.rc_context({"pdf.fonttype": 42, "font.family": "DejaVu Sans",
+                                "path.simplify": False}):
+        pages = _Pages()
+        pages.text("Shot report: the prediction", size=16, bold=True)
+        pages.gap(1.0)
+        if verdict is not None:
+            pages.text(f"Predicted verdict: {verdict.word}", size=13, bold=True,
+                       colour=PASS_COLOUR if verdict.passed else FAIL_COLOUR)
+            criteria, colours = _criteria_rows(verdict)
+            pages.table(["Criterion", "Value", "Unit", "Limits", "Margin", "Result"],
+                        criteria, [0.0, 0.17, 0.29, 0.37, 0.67, 0.80], colours)
+            pages.gap()
+        pages.text(f"Warnings ({len(warnings)})" if warnings else "Warnings: none",
+                   size=11, bold=True, colour=FAIL_COLOUR if warnings else "black")
+        for w in warnings:
+            pages.text(f"- {w}", indent=0.02)
+        pages.gap()
+        pages.text("Summary", size=11, bold=True)
+        pages.table(["Quantity", "Value", "Unit", "Definition"],
+                    [list(r) for r in rows], [0.0, 0.33, 0.47, 0.54])
+        _fill_charts(pages, charts)
+        _save(path, pages, heading, date, f"Shot report: {heading[0]}")
+
+
 def write_verdict_pdf(path: str | Path, verdict: Any, about: list[tuple[str, str]],
                       pulse: dict[str, Any], spectra: dict[str, Any], warnings: list[str],
                       heading: tuple[str, str, str], reproducible: bool = False) -> None:
@@ -251,7 +408,6 @@ def write_verdict_pdf(path: str | Path, verdict: Any, about: list[tuple[str, str
         No date in the footer or the metadata.
     """
     import matplotlib
-    from matplotlib.backends.backend_pdf import PdfPages
 
     date = None if reproducible else datetime.datetime.now(datetime.UTC)
     with matplotlib.rc_context({"pdf.fonttype": 42, "font.family": "DejaVu Sans",
@@ -260,21 +416,5 @@ def write_verdict_pdf(path: str | Path, verdict: Any, about: list[tuple[str, str
         _text_pages(pages, verdict, about, warnings)
         _chart_page(pages, verdict, pulse, spectra)
         shot, recording, source = heading
-        stamp = (f"printed {date:%Y-%m-%d %H:%M} UTC" if date is not None
-                 else "date left out (--reproducible)")
-        total = len(pages.figures)
-        for n, fig in enumerate(pages.figures, start=1):
-            said = {"fontsize": 7.5, "parse_math": False}
-            fig.text(LEFT, 0.975, f"Shot: {shot}", va="top", **said)
-            fig.text(RIGHT, 0.975, f"Recording: {recording}", va="top", ha="right",
-                     **said)
-            fig.text(LEFT, 0.962, textwrap.shorten(f"Specification: {source}", 150),
-                     va="top", **said)
-            fig.text(LEFT, 0.03, f"airgun-xl {__version__}, {stamp}", **said)
-            fig.text(RIGHT, 0.03, f"page {n} of {total}", ha="right", **said)
-        metadata = {"Title": f"Shock test report: {shot}", "Creator": "airgun-xl",
-                    "Producer": f"airgun-xl {__version__} (matplotlib)",
-                    "CreationDate": date, "ModDate": date}
-        with PdfPages(path, metadata=metadata) as pdf:
-            for fig in pages.figures:
-                pdf.savefig(fig)
+        _save(path, pages, (f"Shot: {shot}", f"Recording: {recording}",
+                            f"Specification: {source}"), date, f"Shock test report: {shot}")

@@ -197,7 +197,7 @@ def variant_name(result):
     return f"{result.model} model"
 
 
-def _summary_rows(result, summary, prov):
+def summary_rows(result, summary, prov):
     """(label, value in SI, quantity code of :data:`~airgun_xl.xlsx.report.QUANTITIES`
     or "" for text, definition) per Summary row."""
     p = result.params
@@ -322,7 +322,7 @@ def write_summary(wb, result, summary, prov, name="Summary"):
     text = style.get(align="left")
     for col, heading in enumerate(("Quantity", "Value", "Unit", "Definition")):
         ws.write_string(0, col, heading, style.bold)
-    rows = _summary_rows(result, summary, prov)
+    rows = summary_rows(result, summary, prov)
     flags = flagged_figures(list(prov.warnings))
     for row, (label, value, code, definition) in enumerate(rows, 1):
         ws.write_string(row, 0, label)
