@@ -496,9 +496,11 @@ def fill(shot: str | os.PathLike[str], *, output: str | os.PathLike[str] | None 
          integrator: str = "legacy", allow_unstable: bool = False, model: str = "4-mass",
          crush_law: str = "workbook", unloading: str = "macro", compare_models: bool = False,
          archive: str | os.PathLike[str] | None = None, name: str | None = None,
-         reproducible: bool = False, **spec: Unpack[SpecKeywords]) -> FillOutcome:
+         reproducible: bool = False, pdf: str | os.PathLike[str] | None = None,
+         **spec: Unpack[SpecKeywords]) -> FillOutcome:
     """Run the shot in a workbook and write a new filled workbook, as ``airgun-xl fill``
-    does (``output`` defaults to SHOT.out.xlsx beside the shot; the shot is never changed).
+    does (``output`` defaults to SHOT.out.xlsx beside the shot; the shot is never changed;
+    ``pdf`` also writes its report as a PDF, which needs matplotlib).
 
     The keywords are the command's options (``only="summary,charts"``, ``every=10``); the
     specification fields (``peak="12kG:10%"``, ``profile=``) judge the prediction, over the
@@ -524,8 +526,8 @@ def fill(shot: str | os.PathLike[str], *, output: str | os.PathLike[str] | None 
         "max_sheet_rows": None if max_sheet_rows is None else str(max_sheet_rows),
         "sidecar": sidecar, "integrator": integrator, "allow_unstable": allow_unstable,
         "model": model, "crush_law": crush_law, "unloading": unloading,
-        "compare_models": compare_models, "name": name, "reproducible": reproducible},
-        dict(spec))
+        "compare_models": compare_models, "name": name, "reproducible": reproducible,
+        "pdf": None if pdf is None else os.fspath(_path("--pdf", pdf))}, dict(spec))
     return run(FillRequest(os.fspath(shot), settings))
 
 
