@@ -188,7 +188,8 @@ def design(shot: str | os.PathLike[str], *, target_peak: str | None = None,
            output: str | os.PathLike[str] | None = None, force: bool = False,
            crush_law: str = "workbook", archive: str | os.PathLike[str] | None = None,
            scheduler: str | None = None, workers: int | None = None,
-           chunk: int | None = None, **spec: Unpack[SpecKeywords]) -> DesignOutcome:
+           chunk: int | None = None, pdf: str | os.PathLike[str] | None = None,
+           **spec: Unpack[SpecKeywords]) -> DesignOutcome:
     """Design a shot, as ``airgun-xl design`` does: to ``target_peak`` (with
     ``target_duration``, two cells in ``vary``) or ``target_srs``; without a target, to the
     middle of the specification (the profile's, the shot's sheet's, then the fields given
@@ -233,7 +234,7 @@ def design(shot: str | os.PathLike[str], *, target_peak: str | None = None,
         _whole("--shots", shots), _whole("--seed", seed), integrator, model,
         Path(output) if output is not None else None, force, crush_law,
         Path(archive) if archive is not None else None, scheduler, workers, chunk,
-        ("design",)))
+        ("design",), None if pdf is None else _path("--pdf", pdf)))
 
 
 def srs(shot: str | os.PathLike[str], *, q: float | str = 10.0, cfc: int | str | None = None,
@@ -604,6 +605,7 @@ def next_shot(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *
               accel_unit: str | None = None, integrator: str = "legacy",
               vary: str | None = None, scheduler: str | None = None,
               workers: int | None = None, chunk: int | None = None,
+              pdf: str | os.PathLike[str] | None = None,
               **spec: Unpack[SpecKeywords]) -> NextOutcome:
     """The closed loop, as ``airgun-xl next`` runs it: judge the fired ``shot``'s
     ``recording``, update ``lot``'s law in ``archive`` on every shot of the lot, choose the
@@ -639,7 +641,8 @@ def next_shot(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *
         Path(output) if output is not None else None, force, ("next",),
         None if vary is None else str(vary), None if scheduler is None else str(scheduler),
         None if workers is None else _whole("--workers", workers),
-        None if chunk is None else _whole("--chunk", chunk)))
+        None if chunk is None else _whole("--chunk", chunk),
+        None if pdf is None else _path("--pdf", pdf)))
 
 
 __all__ = [

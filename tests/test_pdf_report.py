@@ -210,3 +210,32 @@ def test_fill_pdf_is_refused_for_a_campaign_and_a_wrong_name(tmp_path, capsys):
     assert len(err) == 1 and "r.txt: has the extension .txt, expected .pdf" in err[0]
     assert sorted(p.name for p in day.iterdir()) == ["a.xlsx", "b.xlsx"]
     assert not (tmp_path / "r.pdf").exists()
+
+
+@needs_poppler
+def test_design_and_next_put_their_study_on_the_pdf(fired, tmp_path):
+    """design --confidence --pdf: the P(PASS) found and the setting, on the PDF as on the
+    Summary; next --pdf: the proposal with its P(PASS), where the law and the gun's scatter
+    came from; both files listed with the workbook."""
+    folder, shot, rec = fired
+    found = airgun_xl.design(TEMPLATE, peak="12kG:10%", duration="5ms:10%", confidence=0.5,
+                             sd="A28=1.5%", shots=200, output=tmp_path / "d.xlsx",
+                             pdf=tmp_path / "d.pdf")
+    assert found.files == (tmp_path / "d.xlsx", tmp_path / "d.pdf")
+    flat = " ".join(_text(tmp_path / "d.pdf").split())
+    assert "The study behind this shot" in flat
+    assert re.search(r"design --confidence 0\.5: P\(PASS\) = \d\.\d{4} \(95 % interval", flat)
+    proposal = airgun_xl.next_shot(shot, rec, archive=tmp_path / "arch", lot="LOT-P",
+                                   new_lot=True, sd="A28=1.5%", shots=100,
+                                   output=tmp_path / "n.xlsx", pdf=tmp_path / "n.pdf",
+                                   peak="8.5kG:5%", duration="4.5ms:15%")
+    assert proposal.files == (tmp_path / "n.xlsx", tmp_path / "n.pdf")
+    flat = " ".join(_text(tmp_path / "n.pdf").split())
+    assert f"next shot of lot LOT-P: A28 = {proposal.setting:.6g} m/s" in flat
+    assert " ".join(proposal.gun.split()) in flat
+
+
+def test_design_pdf_without_a_workbook_is_refused_before_the_study(tmp_path):
+    with pytest.raises(airgun_xl.OptionError, match="--pdf: found without a workbook"):
+        airgun_xl.design(TEMPLATE, target_peak="12kG", pdf=tmp_path / "d.pdf")
+    assert list(tmp_path.iterdir()) == []

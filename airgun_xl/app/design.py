@@ -65,6 +65,7 @@ class DesignRequest:
     workers: int | None = None
     chunk: int | None = None
     argv: tuple[str, ...] = ()  # the command, as the workbook's provenance records it
+    pdf: Path | None = None  # the designed shot's report as a PDF too (needs an output)
 
 
 @dataclass(frozen=True)
@@ -143,6 +144,7 @@ def run(request: DesignRequest, warn: Say | None = None, note: Say | None = None
     airgun_xl.errors.AirgunXlError
         Bad input, named; nothing is written.
     """
+    _check_pdf(request)
     if request.target_srs is not None:
         mode, study = "srs", _solve_srs
     elif request.target_peak is None:
@@ -154,6 +156,21 @@ def run(request: DesignRequest, warn: Say | None = None, note: Say | None = None
     else:
         shot, design, lines, extra = study(request)
     return _fill(request, mode, shot, design, lines, extra, warn, note, progress_for)
+
+
+def _check_pdf(request: DesignRequest) -> None:
+    """``--pdf``: a file it may write, beside a workbook, before any study."""
+    if request.pdf is None:
+        return
+    from ..reports.pdf_report import require_matplotlib
+    from ..transaction import check_output
+
+    if request.output is None:
+        raise OptionError("--pdf: found without a workbook to fill, expected an output too "
+                          "(the PDF is the designed shot's report)")
+    require_matplotlib()
+    check_output(request.pdf, request.force, inputs=[request.shot, request.output],
+                 suffixes=(".pdf",))
 
 
 def _solve_target(request: DesignRequest) -> tuple[Shot, Design, list[str], dict[str, Any]]:
@@ -357,7 +374,7 @@ def _fill(request: DesignRequest, mode: str, shot: Shot, design: Design, lines: 
         spec: Specification | None = extra.get("spec")
         options = Options(request.integrator, "excel", request.model, False, request.force,
                           command=request.argv, srs_requirement=extra.get("requirement"),
-                          spec=spec, study_notes=extra.get("notes", ()))
+                          spec=spec, study_notes=extra.get("notes", ()), pdf=request.pdf)
 
         def warned(messages: list[str]) -> None:
             said.extend(messages)
@@ -373,7 +390,8 @@ def _fill(request: DesignRequest, mode: str, shot: Shot, design: Design, lines: 
             if close is not None:
                 close()
     warnings = tuple(dict.fromkeys([*said, *map(str, designed.warnings)]))
-    files = (request.output,) if request.output is not None else ()
+    files = tuple(p for p in (request.output, request.pdf if filled is not None else None)
+                  if p is not None)
     return DesignOutcome(mode, design, designed, bool(extra.get("reached", True)),
                          tuple(lines), filled, request.output, files, warnings,
                          extra.get("confidence"))

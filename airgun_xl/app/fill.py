@@ -343,6 +343,7 @@ def _write_pdf(shot: Shot, filled: Filled, path: Path, info: Provenance, options
     from ..reports.pdf_report import summary_text, write_fill_pdf
     from ..untrusted_json import printable
     from ..xlsx.charts import CHARTS, series_data
+    from ..xlsx.sheets import flagged_figures
 
     result = filled.result
     summary = filled.summary if filled.summary is not None else summarize(result)
@@ -360,7 +361,8 @@ def _write_pdf(shot: Shot, filled: Filled, path: Path, info: Provenance, options
     write_fill_pdf(path, rows, filled.verdict, [printable(w) for w in record], charts,
                    (f"Shot: {printable(name)}", f"{result.model} model, {result.integrator} "
                     "integrator", f"Specification: {printable(source or 'none given')}"),
-                   options.reproducible)
+                   options.reproducible, tuple(printable(n) for n in options.study_notes),
+                   tuple(flagged_figures(record).get("Peak acceleration (raw)", [])))
 
 
 # -- the command -------------------------------------------------------------------------

@@ -65,6 +65,7 @@ class NextRequest:
     scheduler: str | None = None  # the draws on a Dask cluster (its scheduler's address)
     workers: int | None = None  # or on a local one of this many processes
     chunk: int | None = None  # shots a cluster task
+    pdf: Path | None = None  # the next shot's report as a PDF too
 
 
 #: The second knobs ``next --vary`` takes: the mitigator's geometry and the exchange mass
@@ -188,6 +189,12 @@ def _checked(request: NextRequest) -> Path:
         second_knob(request.vary)
     output = request.output if request.output is not None else default_output(request.shot)
     check_output(output, request.force, inputs=[request.shot, input_file(request.recording)])
+    if request.pdf is not None:
+        from ..reports.pdf_report import require_matplotlib
+
+        require_matplotlib()
+        check_output(request.pdf, request.force, suffixes=(".pdf",),
+                     inputs=[request.shot, input_file(request.recording), output])
     Archive(request.archive, create=True, dry_run=True)  # a folder that is not one: refused
     return output
 
@@ -404,7 +411,7 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
                                       f"v{version:04d}.json", Archive(request.archive)))
         law = CrushLaw(update.law.coefficients, update.law.v_range, "fitted", source=ref)
         _write(request, output, shot, spec, verdict, update, best, law, ref, warnings, gun)
-        done.append(output)
+        done += [output] + ([request.pdf] if request.pdf is not None else [])
         with signals_held():
             done.append(store_verdict(request.archive, shot, verdict, request.recording,
                                       output, request.argv))
@@ -438,8 +445,9 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
         raise
     proposal = f"{request.lot}@{int(stored.path.stem[1:])}"
     knob = second_knob(request.vary) if request.vary is not None else None
+    files = (output,) + ((request.pdf,) if request.pdf is not None else ())
     return NextOutcome(verdict, update, ref, best.setting, best, request.confidence, reached,
-                       counted_once, output, proposal, (output,), tuple(warnings),
+                       counted_once, output, proposal, files, tuple(warnings),
                        (knob.cell, knob.unit, best.second) if knob is not None else None,
                        gun)
 
@@ -477,7 +485,7 @@ def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: V
              f"from {request.shot} ({verdict.word}), recording {request.recording}")
     assert designed.source is not None
     options = Options(request.integrator, force=request.force, command=request.argv,
-                      spec=spec, study_notes=notes)
+                      spec=spec, study_notes=notes, pdf=request.pdf)
     said: list[str] = []
     fill_workbook(designed, output, from_sheet(designed.source.outputs_block), options,
                   said.extend)

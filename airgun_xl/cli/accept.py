@@ -4,7 +4,7 @@ Exit 0 on PASS, 3 on FAIL (:data:`FAIL_EXIT`), 2 for bad input."""
 from pathlib import Path
 
 from .recording_options import RECORDING_HELP, add_recording_options
-from .run_options import SHOT_HELP, add_crush_law, add_force, add_json, add_output
+from .run_options import SHOT_HELP, add_crush_law, add_force, add_json, add_output, add_pdf
 from .spec_options import RECORD_HELP, add_spec_options
 from .vocabulary import One
 
@@ -23,10 +23,8 @@ def add_parser(sub):
     p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
     p.add_argument("recording", metavar="RECORDING", help="the recorded pulse: " + RECORDING_HELP)
     add_output(p, "verdict workbook", "SHOT.accept.xlsx")
-    p.add_argument("--pdf", metavar="FILE.pdf", action=One,
-                   help="also write the client's test report as a PDF (the verdict, the "
-                        "criteria, the warnings, the sources, the charts and a signature "
-                        "block; needs matplotlib: pip install 'airgun-xl[plots]')")
+    add_pdf(p, "the client's test report (the verdict, the criteria, the warnings, the "
+               "sources, the charts and a signature block)")
     p.add_argument("--reproducible", action="store_true",
                    help="leave the date out of the PDF: the same run gives the same bytes")
     add_force(p)

@@ -4,7 +4,15 @@ from pathlib import Path
 from ..choices import DESIGN_VARIABLES
 from .cluster_options import add_cluster_options
 from .fill import print_summary
-from .run_options import SHOT_HELP, add_crush_law, add_force, add_json, add_output, add_run_options
+from .run_options import (
+    SHOT_HELP,
+    add_crush_law,
+    add_force,
+    add_json,
+    add_output,
+    add_pdf,
+    add_run_options,
+)
 from .spec_options import add_spec_options
 from .vocabulary import Alias
 
@@ -26,6 +34,8 @@ def add_parser(sub):
     _add_targets(p)
     add_run_options(p)
     add_output(p, "designed shot, filled", "SHOT.design.xlsx")
+    add_pdf(p, "the designed shot's report (the design, the Summary, the predicted verdict, "
+               "the warnings and the charts)")
     add_force(p)
     add_cluster_options(p)
     add_spec_options(p)
@@ -83,7 +93,7 @@ def request_of(args):
         args.confidence, tuple(args.sd or ()), args.shots, args.seed, args.integrator,
         args.model, design_output(args), args.force, args.crush_law,
         Path(args.archive) if args.archive else None, args.scheduler, args.workers,
-        args.chunk, tuple(args.argv))
+        args.chunk, tuple(args.argv), Path(args.pdf) if args.pdf else None)
 
 
 def run(args):

@@ -5,7 +5,7 @@ from ..app.archive import archive_root, prestart
 from ..choices import ARCHIVE_ENV, HOSTS, SIDECAR_MODES, UNLOADINGS
 from ..outputs import GROUPS
 from ..untrusted_json import printable
-from .run_options import add_crush_law, add_force, add_integrator, add_json, add_model
+from .run_options import add_crush_law, add_force, add_integrator, add_json, add_model, add_pdf
 from .spec_options import add_spec_options
 from .vocabulary import One
 
@@ -75,10 +75,8 @@ def _add_run(p):
     p.add_argument("--reproducible", action="store_true",
                    help="leave run times out of the Summary (and the date out of --pdf), so "
                         "equal inputs give equal bytes")
-    p.add_argument("--pdf", metavar="FILE.pdf", action=One,
-                   help="one shot: also write its report as a PDF (the Summary, the predicted "
-                        "verdict, the warnings and the charts; needs matplotlib: pip install "
-                        "'airgun-xl[plots]')")
+    add_pdf(p, "one shot's report (the Summary, the predicted verdict, the warnings and the "
+               "charts)")
 
 
 def print_summary(output, filled):

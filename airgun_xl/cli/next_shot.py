@@ -5,7 +5,7 @@ from pathlib import Path
 
 from .cluster_options import add_cluster_options
 from .recording_options import RECORDING_HELP, add_recording_options
-from .run_options import SHOT_HELP, add_force, add_integrator, add_json, add_output
+from .run_options import SHOT_HELP, add_force, add_integrator, add_json, add_output, add_pdf
 from .spec_options import RECORD_HELP, add_spec_options
 from .vocabulary import One
 
@@ -45,6 +45,8 @@ def add_parser(sub):
                    help="Monte Carlo draws a setting (default 2,000)")
     p.add_argument("--seed", type=int, default=1, help="of the draws (default 1)")
     add_output(p, "next shot's workbook", "SHOT.next.xlsx")
+    add_pdf(p, "the next shot's report (the proposal and its P(PASS), the Summary, the "
+               "warnings and the charts)")
     add_force(p)
     add_recording_options(p, anti_alias=False, cfc_help=RECORD_HELP)
     add_spec_options(p, cfc=False)
@@ -64,7 +66,7 @@ def request_of(args):
                        args.time_unit, args.accel_unit, args.integrator,
                        Path(args.output) if args.output else None, args.force,
                        tuple(args.argv), args.vary, args.scheduler, args.workers,
-                       args.chunk)
+                       args.chunk, Path(args.pdf) if args.pdf else None)
 
 
 def run(args):

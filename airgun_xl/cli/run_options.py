@@ -76,6 +76,15 @@ def add_output(p, what, default, metavar="OUT.xlsx"):
                    help=f"{what} (default: {default})")
 
 
+def add_pdf(p, what):
+    """``--pdf FILE.pdf``: ``what`` the report holds (it needs matplotlib)."""
+    from .vocabulary import One
+
+    p.add_argument("--pdf", metavar="FILE.pdf", action=One,
+                   help=f"also write {what} as a PDF (needs matplotlib: pip install "
+                        "'airgun-xl[plots]')")
+
+
 def add_crush_law(p, archive=True):
     """``--crush-law``, for every command that runs a shot; with ``archive``, the
     ``--archive DIR`` its library laws are read from (a command whose ``--archive`` already

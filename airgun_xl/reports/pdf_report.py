@@ -359,9 +359,12 @@ def _fill_charts(pages: _Pages, charts: list[tuple[Any, dict[str, Any], tuple[fl
 def write_fill_pdf(path: str | Path, rows: list[tuple[str, str, str, str]],
                    verdict: Any, warnings: list[str],
                    charts: list[tuple[Any, dict[str, Any], tuple[float, float]]],
-                   heading: tuple[str, str, str], reproducible: bool = False) -> None:
+                   heading: tuple[str, str, str], reproducible: bool = False,
+                   notes: tuple[str, ...] = (), doubted: tuple[str, ...] = ()) -> None:
     """A fill's report at ``path``: ``rows`` the Summary's (quantity, value as shown, unit,
-    definition), the predicted ``verdict`` (or None), the warnings, and ``charts``
+    definition), the predicted ``verdict`` (or None; ``doubted`` the cells whose warnings
+    put it in doubt), what the study behind the shot found (``notes``: a design's, the
+    closed loop's P(PASS)), the warnings, and ``charts``
     (:class:`~airgun_xl.xlsx.charts.ChartSpec`, its series' data, its x range)."""
     import matplotlib
 
@@ -374,9 +377,17 @@ def write_fill_pdf(path: str | Path, rows: list[tuple[str, str, str, str]],
         if verdict is not None:
             pages.text(f"Predicted verdict: {verdict.word}", size=13, bold=True,
                        colour=PASS_COLOUR if verdict.passed else FAIL_COLOUR)
+            if doubted:
+                pages.text(f"DOUBTED: see the warnings on {', '.join(doubted)}",
+                           bold=True, colour=FAIL_COLOUR)
             criteria, colours = _criteria_rows(verdict)
             pages.table(["Criterion", "Value", "Unit", "Limits", "Margin", "Result"],
                         criteria, [0.0, 0.17, 0.29, 0.37, 0.67, 0.80], colours)
+            pages.gap()
+        if notes:
+            pages.text("The study behind this shot", size=11, bold=True)
+            for note in notes:
+                pages.text(f"- {note}", indent=0.02)
             pages.gap()
         pages.text(f"Warnings ({len(warnings)})" if warnings else "Warnings: none",
                    size=11, bold=True, colour=FAIL_COLOUR if warnings else "black")
