@@ -13,17 +13,19 @@ from .vocabulary import One
 NOT_REACHED = 3
 
 
+#: What ``next --help`` says the command does.
+DESCRIPTION = ("Judge the fired shot as accept does; update the lot's crush law (its scale, with "
+               "its standard error) on every shot of the lot in the archive and this one; "
+               "choose the A28 most likely to pass with the gun's scatter (--sd) and the law "
+               "drawn from its update; write NEXT.xlsx (fill runs it as it is) and keep the "
+               "verdict, the law's new version and the proposal in the archive. Exit 0 when "
+               "P(PASS) reaches --confidence, 3 when not (the best is written).")
+
+
 def add_parser(sub):
     p = sub.add_parser("next", help="the closed loop: judge the fired shot, update the lot's "
                                     "law, and write the next shot most likely to pass",
-                       description="Judge the fired shot as accept does; update the lot's "
-                                   "crush law (its scale, with its standard error) on every "
-                                   "shot of the lot in the archive and this one; choose the A28 "
-                                   "most likely to pass with the gun's scatter (--sd) and the "
-                                   "law drawn from its update; write NEXT.xlsx (fill runs it as "
-                                   "it is) and keep the verdict, the law's new version and the "
-                                   "proposal in the archive. Exit 0 when P(PASS) reaches "
-                                   "--confidence, 3 when not (the best is written).")
+                       description=DESCRIPTION)
     p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP + " (the shot fired)")
     p.add_argument("recording", metavar="RECORDING", help="its recorded pulse: "
                    + RECORDING_HELP)
