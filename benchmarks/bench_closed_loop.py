@@ -3,6 +3,7 @@ fired until PASS or 5 shots, once with `airgun-xl next` and once with the rule l
 hand; how soon each passes, and whether next's predicted P(PASS) came true.
 
     python benchmarks/bench_closed_loop.py [--lots N] [--draws N] [--vary CELL] [--quick]
+    python benchmarks/bench_closed_loop.py --call [--quick]
 
 The lab, on shot A (the template):
 - a lot's true law is the report's times a scale drawn with a 10 % spread, tilted with speed
@@ -21,6 +22,10 @@ this recorder's noise would be). Then:
 - **by hand**: the velocity scaled by (target / measured peak) ^ (1 / gamma), gamma the
   model's own d ln(peak) / d ln(v) on the nominal law at the velocity fired.
 Both meet the same lots and the same draws of the gun, zeta and the recorder's noise.
+
+`--call` times one `airgun-xl next` as a whole process on a lot of 5 recorded shots (the
+fifth, with the default 2,000 draws a setting; alone and with `--vary E13`): its wall time
+(median of 5, after a warm-up) and peak RSS, against the issue's 10 s and 1 GB.
 
 It prints, for both, the share of lots passed by the first, second and third shot and the
 mean shots to the first PASS (a lot not passed in 5 counts as 6), and, for next, the observed
@@ -156,14 +161,82 @@ def first_setting(n_draws):
     return found.best.setting, found.best.probability
 
 
+#: A child that runs ``next`` and prints its exit status and peak RSS [kB] (POSIX getrusage:
+#: the benchmarks' machine, not the package's platforms); 3 (P(PASS) not reached) is a run.
+NEXT_RSS = (
+    "import resource, subprocess, sys\n"
+    "code = subprocess.run(sys.argv[1:], capture_output=True).returncode\n"
+    "print(code, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)\n"
+)
+
+
+def timed(cmd, times):
+    """One warm-up, then ``times`` runs of ``cmd``: wall times [s] and peak RSS [MB]."""
+    import subprocess
+
+    walls, rss = [], []
+    for k in range(times + 1):
+        started = time.perf_counter()
+        done = subprocess.run([sys.executable, "-c", NEXT_RSS, *cmd], capture_output=True,
+                              text=True, check=True)
+        code, peak = done.stdout.split()
+        if code not in ("0", "3"):
+            raise SystemExit(f"next exited {code}")
+        if k:
+            walls.append(time.perf_counter() - started)
+            rss.append(int(peak) / 1024)
+    return walls, rss
+
+
+def call(quick):
+    """``next`` on a lot of 5 recorded shots, as a whole process: (label, wall [s], peak RSS
+    [MB]) alone and with --vary E13."""
+    rng = np.random.default_rng(7)
+    law = true_law(rng)
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        shot = with_velocity(work / "s0.xlsx", 240.0)
+        for k in range(4):  # four shots of the lot recorded through next
+            rec = fire(shot, law, (rng.normal(), rng.normal(), k), work / f"r{k}.csv")
+            shot = airgun_xl.next_shot(shot, rec, archive=work / "archive", lot="LOT-T",
+                                       new_lot=k == 0, sd=f"A28={GUN:.1%}", shots=200,
+                                       output=work / f"s{k + 1}.xlsx", **SPEC).output
+        rec = fire(shot, law, (rng.normal(), rng.normal(), 4), work / "r4.csv")
+        base = [sys.executable, "-m", "airgun_xl", "next", str(shot), str(rec), "--archive",
+                str(work / "archive"), "--lot", "LOT-T", "--sd", f"A28={GUN:.1%}", "--sd",
+                f"E43={ZETA:.0%}",
+                "--peak", SPEC["peak"], "--duration", SPEC["duration"], "-o",
+                str(work / "n.xlsx"), "--force", "--quiet"]
+        if quick:
+            base += ["--shots", "200"]
+        for label, extra in (("next, a lot of 5 shots", []),
+                             ("next --vary E13, a lot of 5 shots", ["--vary", "E13"])):
+            walls, rss = timed(base + extra, 1 if quick else 5)
+            rows.append((label, statistics.median(walls), max(rss)))
+    return rows
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--lots", type=int, default=200)
     parser.add_argument("--draws", type=int, default=1000, help="next's draws a setting")
     parser.add_argument("--vary", metavar="CELL", help="next's second knob (E13, E16, A2)")
+    parser.add_argument("--call", action="store_true",
+                        help="time one next on a lot of 5 shots as a whole process")
     parser.add_argument("--quick", action="store_true",
                         help="two lots, 200 draws: shows the benchmark runs, measures nothing")
     args = parser.parse_args()
+    if args.call:
+        rows = call(args.quick)
+        print(f"machine: {machine()}")
+        print("--quick: one repeat on a small case; these figures measure nothing\n"
+              if args.quick else "median of 5 runs after a warm-up, 2,000 draws a setting\n")
+        for label, wall, rss in rows:
+            judged = ("not judged (--quick)" if args.quick else
+                      "met" if wall <= 10 and rss <= 1024 else "NOT met")
+            print(f"{label:<36} {wall:6.2f} s  {rss:6.0f} MB  (target 10 s, 1 GB: {judged})")
+        return 0
     lots, n_draws = (2, 200) if args.quick else (args.lots, args.draws)
     started = time.perf_counter()
     first, p_first = first_setting(max(n_draws, 400))
