@@ -3,6 +3,7 @@ score and the reliability bands, against hand-computed cases, and the law's post
 scatter entry."""
 import math
 
+import numpy as np
 import pytest
 
 from airgun_xl.crush_law import LEGACY_LAW
@@ -60,3 +61,32 @@ def test_design_confidence_says_when_its_probability_holds_for_a_quiet_recording
     named = airgun_xl.design(TEMPLATE, confidence=0.9, sd=["A28=1.5%"], shots=200, cfc="1000",
                              **spec)
     assert QUIET_RECORD_WARNING not in named.warnings
+
+
+def test_the_guns_scatter_is_the_factors_spread_less_the_fits_errors():
+    """gun_scatter against the formula written out: s^2 = var(f, ddof 1) - mean(se^2), its
+    95 % interval from the chi-square quantiles (scipy.stats.chi2) with n - 1 degrees of
+    freedom; none under GUN_SHOTS; a factor at the fit's bound named in a warning."""
+    from types import SimpleNamespace
+
+    from scipy.stats import chi2
+
+    from airgun_xl.studies.calibrate import VELOCITY_REACH
+    from airgun_xl.studies.closed_loop import GUN_SHOTS, gun_scatter
+
+    factors = np.array([1.012, 0.991, 1.004, 0.978, 1.021, 0.999, 1.008, 0.985])
+    errors = np.full(8, 0.004)
+    update = SimpleNamespace(launch=tuple((230.0, f, e) for f, e in zip(factors, errors,
+                                                                        strict=True)))
+    gun = gun_scatter(update)
+    var = np.var(factors, ddof=1)
+    assert gun.sd == pytest.approx(np.sqrt(var - 0.004 ** 2), rel=1e-12)
+    assert gun.interval[0] == pytest.approx(np.sqrt(7 * var / chi2.ppf(0.975, 7) - 0.004 ** 2),
+                                            rel=1e-12)
+    assert gun.interval[1] == pytest.approx(np.sqrt(7 * var / chi2.ppf(0.025, 7) - 0.004 ** 2),
+                                            rel=1e-12)
+    assert gun.bias == pytest.approx(factors.mean() - 1, abs=1e-15) and not gun.warnings
+    assert gun_scatter(SimpleNamespace(launch=update.launch[:GUN_SHOTS - 1])) is None
+    off = SimpleNamespace(launch=(*update.launch[:7], (230.0, 1 + VELOCITY_REACH, 0.004)))
+    said = gun_scatter(off).warnings
+    assert len(said) == 1 and "shot 8 of the lot fitted a launch velocity 15%" in said[0]

@@ -267,7 +267,7 @@ def _gun(update: LawUpdate, sds: list[Any], shots: int,
     cell, fields, _sd, _rel = given if given is not None else (
         address("v31"), ("v31", "v32", "v33"), 0.0, True)
     words = found.words()
-    warnings = []
+    warnings = list(found.warnings)
     if given is not None:
         value = given[2] if given[3] else given[2] / abs(velocity)  # relative to the set A28
         words += f"; the {shown} given is not used"

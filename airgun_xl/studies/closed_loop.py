@@ -133,6 +133,19 @@ class GunScatter:
     shots: int
     bias: float
     bias_error: float
+    at_bound: tuple[int, ...] = ()  # shots (from 1) whose launch velocity met its bound
+
+    @property
+    def warnings(self) -> list[str]:
+        from .calibrate import VELOCITY_REACH
+
+        if not self.at_bound:
+            return []
+        return [f"the gun's scatter: shot{'s' * (len(self.at_bound) > 1)} "
+                f"{', '.join(map(str, self.at_bound))} of the lot fitted a launch velocity "
+                f"{VELOCITY_REACH:.0%} from the one set (the fit's bound): not a gun's scatter "
+                "(a wrong setting or recording?); the scatter estimated from them is not to be "
+                "trusted"]
 
     def words(self) -> str:
         lo, hi = self.interval
@@ -163,7 +176,11 @@ def gun_scatter(update):
     lo = math.sqrt(max(dof * spread / chi2.ppf(0.975, dof) - noise, 0.0))
     hi = math.sqrt(max(dof * spread / chi2.ppf(0.025, dof) - noise, 0.0))
     bias = float(np.mean(factors) - 1.0)
-    return GunScatter(sd, (lo, hi), n, bias, math.sqrt(spread / n))
+    from .calibrate import VELOCITY_REACH
+
+    at_bound = tuple(k + 1 for k, f in enumerate(factors)
+                     if abs(f - 1.0) >= VELOCITY_REACH * (1 - 1e-3))
+    return GunScatter(sd, (lo, hi), n, bias, math.sqrt(spread / n), at_bound)
 
 
 def law_scatter(update):
