@@ -51,6 +51,25 @@ def _text(pdf):
                           text=True, check=True).stdout
 
 
+def _pages(pdf):
+    return int(re.search(r"Pages:\s+(\d+)", subprocess.run(
+        ["pdfinfo", str(pdf)], capture_output=True, text=True).stdout).group(1))
+
+
+def _rows_of_colour(pdf, folder, rgb, tolerance):
+    """The rows (a fraction of the page's height, from the top) of the last page, rendered
+    by pdftoppm at 60 dpi, that hold a pixel of colour ``rgb`` (each channel within
+    ``tolerance``: anti-aliased thin lines are lighter)."""
+    from PIL import Image
+
+    last = str(_pages(pdf))
+    subprocess.run(["pdftoppm", "-r", "60", "-png", "-singlefile", "-f", last, "-l", last,
+                    str(pdf), str(folder / "p")], check=True)
+    pixels = np.asarray(Image.open(folder / "p.png").convert("RGB")).astype(int)
+    found = np.all(np.abs(pixels - list(rgb)) < tolerance, axis=2)
+    return np.flatnonzero(found.any(axis=1)) / len(pixels)
+
+
 @needs_poppler
 @pytest.mark.parametrize("case", ["PASS", "FAIL"])
 def test_the_pdf_reads_back_the_verdict_criteria_warnings_and_sources(fired, case, capsys):
@@ -75,8 +94,7 @@ def test_the_pdf_reads_back_the_verdict_criteria_warnings_and_sources(fired, cas
         assert " ".join(warning.split()) in flat, warning
     for source in outcome.verdict.sources():
         assert " ".join(source.split()) in flat, source
-    pages = int(re.search(r"Pages:\s+(\d+)", subprocess.run(
-        ["pdfinfo", str(pdf)], capture_output=True, text=True).stdout).group(1))
+    pages = _pages(pdf)
     assert f"page 1 of {pages}" in flat and f"page {pages} of {pages}" in flat
     # a file's name is text: "$x^2$" is not typeset as mathematics
     assert "Recording: rec$x^2$.csv" in flat  # the header names the file
@@ -87,17 +105,9 @@ def test_the_pdf_reads_back_the_verdict_criteria_warnings_and_sources(fired, cas
 def test_the_charts_page_renders_with_its_curves(fired, tmp_path):
     """The last page (pdftoppm at 60 dpi): the record's colour (#1f4e79) drawn in each of
     its three charts' bands of the page, not a blank page."""
-    from PIL import Image
-
     code, pdf = _accept(fired, FAILING, "charts", "--reproducible")
     assert code == 3
-    last = re.search(r"Pages:\s+(\d+)", subprocess.run(
-        ["pdfinfo", str(pdf)], capture_output=True, text=True).stdout).group(1)
-    subprocess.run(["pdftoppm", "-r", "60", "-png", "-singlefile", "-f", last, "-l", last,
-                    str(pdf), str(tmp_path / "p")], check=True)
-    pixels = np.asarray(Image.open(tmp_path / "p.png").convert("RGB")).astype(int)
-    curve = np.all(np.abs(pixels - [31, 78, 121]) < 40, axis=2)
-    rows = np.flatnonzero(curve.any(axis=1)) / len(pixels)
+    rows = _rows_of_colour(pdf, tmp_path, (31, 78, 121), 40)
     # the pulse (top), the SRS and the pseudo-velocity (below): curve pixels in each third
     for lo, hi in ((0.05, 0.4), (0.4, 0.68), (0.68, 0.95)):
         assert np.any((rows > lo) & (rows < hi)), (lo, hi)
@@ -129,7 +139,6 @@ def test_a_corridor_and_an_srs_requirement_are_on_the_pdf(tmp_path):
     an SRS requirement with its dB tolerance: the corridor and SRS criteria read back, and
     the charts page draws the corridor's limits and the requirement's lines (in the
     failure colour, #9C0006) beside the record."""
-    from PIL import Image
 
     requirement = tmp_path / "req.csv"
     requirement.write_text("frequency [Hz],srs [g]\n200,150\n1000,1500\n4000,6000\n")
@@ -144,13 +153,7 @@ def test_a_corridor_and_an_srs_requirement_are_on_the_pdf(tmp_path):
     flat = " ".join(_text(pdf).split())
     assert re.search(r"corridor \S+ % the record inside the band", flat), flat
     assert re.search(r"\bSRS \S+ dB -40 to 40 dB ", flat), flat
-    last = re.search(r"Pages:\s+(\d+)", subprocess.run(
-        ["pdfinfo", str(pdf)], capture_output=True, text=True).stdout).group(1)
-    subprocess.run(["pdftoppm", "-r", "60", "-png", "-singlefile", "-f", last, "-l", last,
-                    str(pdf), str(tmp_path / "p")], check=True)
-    pixels = np.asarray(Image.open(tmp_path / "p.png").convert("RGB")).astype(int)
-    limits = np.all(np.abs(pixels - [156, 0, 6]) < 50, axis=2)
-    rows = np.flatnonzero(limits.any(axis=1)) / len(pixels)
+    rows = _rows_of_colour(pdf, tmp_path, (156, 0, 6), 50)
     assert np.any(rows < 0.4) and np.any((rows > 0.4) & (rows < 0.68))  # corridor, SRS
 
 
@@ -159,7 +162,6 @@ def test_a_fills_pdf_holds_the_summarys_figures_the_verdict_and_the_charts(tmp_p
     """fill --pdf: the Summary's figures as the sheet shows them (its number format: 11.994
     kG, 0.2885 ms...), the predicted verdict's criteria, the warnings (none here), and a
     charts page whose six charts are drawn; the same bytes twice with --reproducible."""
-    from PIL import Image
 
     from airgun_xl.reports.pdf_report import excel_number
 
@@ -178,13 +180,7 @@ def test_a_fills_pdf_holds_the_summarys_figures_the_verdict_and_the_charts(tmp_p
         value, fmt, unit = sheet[label]
         assert f"{label} {excel_number(value, fmt)} {unit}" in flat, (label, value, fmt)
     assert re.search(r"peak 11\.994 kG 10\.8 to 13\.2 kG \+9\.95 % PASS", flat), flat
-    last = re.search(r"Pages:\s+(\d+)", subprocess.run(
-        ["pdfinfo", str(tmp_path / "f0.pdf")], capture_output=True, text=True).stdout).group(1)
-    subprocess.run(["pdftoppm", "-r", "60", "-png", "-singlefile", "-f", last, "-l", last,
-                    str(tmp_path / "f0.pdf"), str(tmp_path / "p")], check=True)
-    pixels = np.asarray(Image.open(tmp_path / "p.png").convert("RGB")).astype(int)
-    curve = np.all(np.abs(pixels - [31, 78, 121]) < 40, axis=2)
-    rows = np.flatnonzero(curve.any(axis=1)) / len(pixels)
+    rows = _rows_of_colour(tmp_path / "f0.pdf", tmp_path, (31, 78, 121), 40)
     for lo, hi in ((0.1, 0.35), (0.38, 0.62), (0.66, 0.92)):  # the three rows of charts
         assert np.any((rows > lo) & (rows < hi)), (lo, hi)
 
