@@ -129,15 +129,20 @@ def test_every_shrinks_chartdata_and_keeps_the_peak(tmp_path):
 
 
 def test_spectrum_chart_from_the_lobe_end_with_its_dominant_and_natural_marks(tmp_path):
-    """Issue 18.9: the chart starts where the pulse's own lobe ends (shot A: 1.83 kHz, past
-    the 1.33 kHz shoulder that used to be its tallest peak) and marks the Summary's dominant
-    frequencies, the same numbers as the Summary's rows."""
+    """Issue 18.9: the chart's curve starts where the pulse's own lobe ends (shot A: 1.83 kHz,
+    past the 1.33 kHz shoulder that used to be its tallest peak), its axis at the whole kHz
+    below (issue 46: ticks on round kHz, 1, 3, 5..., not 1.8, 3.8, 5.8), and it marks the
+    Summary's dominant frequencies, the same numbers as the Summary's rows."""
     out = tmp_path / "o.xlsx"
     assert main(["fill", str(TEMPLATE), "-o", str(out)]) == 0
     with zipfile.ZipFile(out) as z:
         xml = next(z.read(n).decode() for n in z.namelist()
                    if n.startswith("xl/charts/chart") and b"FFT" in z.read(n))
-    assert '<c:min val="1800.0"/>' in xml and '<c:max val="15000.0"/>' in xml
+    assert '<c:min val="1000.0"/>' in xml and '<c:max val="15000.0"/>' in xml
+    spectrum = summarize(airgun_xl.load(TEMPLATE).run()).spectrum
+    first = 1 + int(np.searchsorted(spectrum.frequency, spectrum.band_start))  # its sheet row
+    assert f"<c:f>Spectrum!$A${first + 1}:" in xml  # the curve from the lobe's end
+    assert spectrum.frequency[first - 2] < spectrum.band_start <= spectrum.frequency[first - 1]
     assert "OBR chain natural frequencies (initial masses)" in xml
     assert "Dominant frequencies (the Summary's)" in xml
     summary = {r[0]: r[1] for r in openpyxl.load_workbook(out, read_only=True)[

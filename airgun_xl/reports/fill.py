@@ -24,6 +24,7 @@ ChartData). Sheet 1 prints its parameter block; each data sheet prints by itself
 rows one page wide. A run longer than the sheets may hold writes every
 N-th row (N in the Summary) and, by default, its full history to a sidecar file.
 """
+import dataclasses
 import math
 
 import numpy as np
@@ -291,6 +292,12 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
     if charts_ws is not None:
         compared = info.compared
         data = series_data(result, summary.spectrum, compared, summary.natural_initial)
+        if "spectrum" in refs:  # the chart's curve from the lobe's end, as its data
+            skipped = int(np.searchsorted(summary.spectrum.frequency,
+                                          summary.spectrum.band_start))
+            refs["spectrum"] = dataclasses.replace(
+                refs["spectrum"], first_row=refs["spectrum"].first_row + skipped,
+                total=refs["spectrum"].total - skipped)
         placed = write_chart_data(wb, data, refs, ColumnsWorksheet, names["ChartData"],
                                   budget=len(keep),  # --every N thins the copies too
                                   time_ms=result.history.time[keep] * 1e3, shot=shot)

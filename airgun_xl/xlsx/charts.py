@@ -103,7 +103,9 @@ def series_data(result, spectrum, compared=None, natural=()):
         # below one row AB holds no acceleration (the sub-row filter quirk): not charted
         "filtered_kg": ((t[f_rows], f_vals / KG) if result.params.samplerate >= 1 else
                         (t[:0], f_vals[:0])),
-        "spectrum": (spectrum.frequency, spectrum.amplitude),
+        # from the end of the pulse's own lobe (its axis starts at the whole kHz below)
+        "spectrum": (spectrum.frequency[spectrum.frequency >= spectrum.band_start],
+                     spectrum.amplitude[spectrum.frequency >= spectrum.band_start]),
         "y1": (t, h.y1), "y31": (t, h.y31),
         "y32_rel": (t, (h.y32 - h.y31) * 1e3), "y33_rel": (t, (h.y33 - h.y31) * 1e3),
     }
