@@ -235,3 +235,19 @@ def test_design_pdf_without_a_workbook_is_refused_before_the_study(tmp_path):
     with pytest.raises(airgun_xl.OptionError, match="--pdf: found without a workbook"):
         airgun_xl.design(TEMPLATE, target_peak="12kG", pdf=tmp_path / "d.pdf")
     assert list(tmp_path.iterdir()) == []
+
+
+@needs_poppler
+def test_a_name_the_font_cannot_draw_is_written_by_code_point_without_a_library_warning(
+        fired, tmp_path, capsys):
+    """A recording named in CJK: DejaVu Sans has no glyph for it, so matplotlib would draw
+    empty boxes and warn on the user's terminal; the PDF writes each such character as its
+    code point instead (exact, readable), and stderr holds no library warning."""
+    folder, shot, rec = fired
+    named = tmp_path / "测试.csv"
+    named.write_bytes(rec.read_bytes())
+    code = main(["accept", str(shot), str(named), "--pdf", str(tmp_path / "r.pdf"),
+                 "--peak", "9.3kG:5%", "--duration", "4.74ms:15%", "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 0 and "from a library" not in err and "Glyph" not in err, err
+    assert "Recording: \\u6d4b\\u8bd5.csv" in " ".join(_text(tmp_path / "r.pdf").split())

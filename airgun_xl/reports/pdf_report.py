@@ -46,6 +46,26 @@ LINE = 0.0135
 PASS_COLOUR, FAIL_COLOUR = "#006100", "#9C0006"
 
 
+#: The font every text is drawn in (matplotlib's own: on every platform matplotlib runs).
+FONT = "DejaVu Sans"
+
+_font: list[Any] = []
+
+
+def drawable(text: str) -> str:
+    """``text`` with each character the font has no glyph for written as its code point
+    (``\\u6d4b``): a name in another script stays readable and exact, where the font would
+    draw an empty box and matplotlib warn (a library's warning, on the user's terminal)."""
+    if text.isascii():
+        return text
+    if not _font:
+        from matplotlib import font_manager, ft2font
+
+        _font.append(ft2font.FT2Font(font_manager.findfont(FONT)))
+    return "".join(c if c.isascii() or _font[0].get_char_index(ord(c)) else
+                   f"\\u{ord(c):04x}" for c in text)
+
+
 def require_matplotlib(option: str = "--pdf") -> None:
     """One line naming the option when matplotlib (the ``plots`` extra) is not installed."""
     try:
@@ -81,7 +101,7 @@ class _Pages:
     def text(self, text: str, size: float = 9.0, bold: bool = False, colour: str = "black",
              indent: float = 0.0, width: int = LINE_CHARS) -> None:
         """``text`` wrapped to the page's width, line by line."""
-        lines = textwrap.wrap(text, width - int(indent * 120)) or [""]
+        lines = textwrap.wrap(drawable(text), width - int(indent * 120)) or [""]
         for line in lines:
             height = LINE * size / 9.0
             self.room(height)
@@ -101,8 +121,8 @@ class _Pages:
         widths = [max(8, int((b - a) * 125)) for a, b in zip(edges[:-1], edges[1:],
                                                                strict=True)]
         for k, row in enumerate([header, *rows]):
-            wrapped = [textwrap.wrap(cell, w) or [""] for cell, w in zip(row, widths,
-                                                                         strict=True)]
+            wrapped = [textwrap.wrap(drawable(cell), w) or [""]
+                       for cell, w in zip(row, widths, strict=True)]
             height = LINE * max(len(w) for w in wrapped)
             self.room(height)
             for x, lines, col in zip(columns, wrapped, range(len(row)), strict=True):
@@ -260,12 +280,12 @@ def _save(path: str | Path, pages: _Pages, heading: tuple[str, str, str],
     total = len(pages.figures)
     for n, fig in enumerate(pages.figures, start=1):
         said = {"fontsize": 7.5, "parse_math": False}
-        fig.text(LEFT, 0.975, left, va="top", **said)
-        fig.text(RIGHT, 0.975, right, va="top", ha="right", **said)
-        fig.text(LEFT, 0.962, textwrap.shorten(source, 150), va="top", **said)
+        fig.text(LEFT, 0.975, drawable(left), va="top", **said)
+        fig.text(RIGHT, 0.975, drawable(right), va="top", ha="right", **said)
+        fig.text(LEFT, 0.962, textwrap.shorten(drawable(source), 150), va="top", **said)
         fig.text(LEFT, 0.03, f"airgun-xl {__version__}, {stamp}", **said)
         fig.text(RIGHT, 0.03, f"page {n} of {total}", ha="right", **said)
-    metadata = {"Title": title, "Creator": "airgun-xl",
+    metadata = {"Title": drawable(title), "Creator": "airgun-xl",
                 "Producer": f"airgun-xl {__version__} (matplotlib)",
                 "CreationDate": date, "ModDate": date}
     with PdfPages(path, metadata=metadata) as pdf:
@@ -369,7 +389,7 @@ def write_fill_pdf(path: str | Path, rows: list[tuple[str, str, str, str]],
     import matplotlib
 
     date = None if reproducible else datetime.datetime.now(datetime.UTC)
-    with matplotlib.rc_context({"pdf.fonttype": 42, "font.family": "DejaVu Sans",
+    with matplotlib.rc_context({"pdf.fonttype": 42, "font.family": FONT,
                                 "path.simplify": False}):
         pages = _Pages()
         pages.text("Shot report: the prediction", size=16, bold=True)
@@ -421,7 +441,7 @@ def write_verdict_pdf(path: str | Path, verdict: Any, about: list[tuple[str, str
     import matplotlib
 
     date = None if reproducible else datetime.datetime.now(datetime.UTC)
-    with matplotlib.rc_context({"pdf.fonttype": 42, "font.family": "DejaVu Sans",
+    with matplotlib.rc_context({"pdf.fonttype": 42, "font.family": FONT,
                                 "path.simplify": False}):
         pages = _Pages()
         _text_pages(pages, verdict, about, warnings)
