@@ -193,6 +193,10 @@ def law_scatter(update):
         scaled = cov * np.array([[1 / update.scale ** 2, 1 / update.scale],
                                  [1 / update.scale, 1.0]])
         if update.scale > 0 and np.all(np.isfinite(scaled)):
+            # symmetric and positive semi-definite to the last bit (the sandwich's rounding
+            # would make numpy's multivariate normal warn, or draw NaN)
+            values, vectors = np.linalg.eigh((scaled + scaled.T) / 2)
+            scaled = (vectors * np.clip(values, 0.0, None)) @ vectors.T
             return (LAW_SCALE, LAW_FIELDS, (scaled, update.v_ref), JOINT)
     relative = update.error / update.scale if update.scale > 0 else math.nan
     if not (math.isfinite(relative) and relative >= 0):
