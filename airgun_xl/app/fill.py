@@ -339,10 +339,9 @@ def _write_pdf(shot: Shot, filled: Filled, path: Path, info: Provenance, options
                record: list[str]) -> None:
     """The shot's report as a PDF: its Summary's figures as the sheet shows them, the
     predicted verdict, every warning, and the Charts page's charts."""
-    from ..engine.summary import SPECTRUM_MAX_HZ
     from ..reports.pdf_report import summary_text, write_fill_pdf
     from ..untrusted_json import printable
-    from ..xlsx.charts import CHARTS, series_data
+    from ..xlsx.charts import CHARTS, series_data, spectrum_range
     from ..xlsx.sheets import flagged_figures
 
     result = filled.result
@@ -354,8 +353,8 @@ def _write_pdf(shot: Shot, filled: Filled, path: Path, info: Provenance, options
             for a, b, c, d in summary_text(result, summary, written)]
     data = series_data(result, summary.spectrum, filled.compared, summary.natural_initial)
     end = float(result.history.time[-1]) * 1e3
-    charts = [(spec, data, (float(math.floor(summary.spectrum.band_start / 1000) * 1000),
-                            SPECTRUM_MAX_HZ) if spec.key == "spectrum" else (0.0, end))
+    charts = [(spec, data, spectrum_range(summary.spectrum) if spec.key == "spectrum"
+               else (0.0, end))
               for spec in CHARTS if any(s.key in data for s in spec.series)]
     source = filled.verdict.spec.source if filled.verdict is not None else ""
     write_fill_pdf(path, rows, filled.verdict, [printable(w) for w in record], charts,

@@ -31,13 +31,13 @@ import numpy as np
 from xlsxwriter.utility import xl_rowcol_to_cell
 
 from ..cells import PARAMETER_COLUMNS
-from ..engine.summary import SPECTRUM_MAX_HZ, summarize
+from ..engine.summary import summarize
 from ..outputs import SHEET_NAME, Outputs
 from ..provenance import Provenance
 from ..readers.formula_eval import Evaluator, FormulaFailure
 from ..readers.law_sheet import SHEET_NAME as LAW_SHEET
 from ..transaction import atomic_path, check_output, display
-from ..xlsx.charts import add_charts, series_data
+from ..xlsx.charts import add_charts, series_data, spectrum_range
 from ..xlsx.columns_sheet import ColumnsWorksheet
 from ..xlsx.law_sheet import write_law_sheet
 from ..xlsx.report import Style, data_pages
@@ -308,8 +308,6 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
                       if compared.params.unloading == "continuous" else
                       f"Acceleration, {variant_name(result)}"}
         add_charts(wb, charts_ws, placed, data, float(result.history.time[-1]) * 1e3, labels,
-                   # from a whole kHz below the lobe's end: the ticks fall on round kHz
-                   {"spectrum": (np.floor(summary.spectrum.band_start / 1000) * 1000,
-                                 SPECTRUM_MAX_HZ)}, shot)
+                   {"spectrum": spectrum_range(summary.spectrum)}, shot)
     close_workbook(wb, shown if shown is not None else tmp)
     return warnings

@@ -89,6 +89,13 @@ def natural_marks(frequencies, top):
     return np.array(x[:-1], dtype=float), np.array(y[:-1], dtype=float)
 
 
+def spectrum_range(spectrum):
+    """(min, max) [Hz] of the spectrum chart's axis: from the whole kHz below the end of the
+    pulse's own lobe (its ticks on round kHz; its curve starts at the lobe's end) to
+    :data:`SPECTRUM_MAX_HZ`."""
+    return float(np.floor(spectrum.band_start / 1000) * 1000), SPECTRUM_MAX_HZ
+
+
 def series_data(result, spectrum, compared=None, natural=()):
     """Full-resolution ``(x, y)`` arrays of every chart series key.
 
