@@ -5,10 +5,13 @@ LibreOffice: one page per report sheet, then each data sheet by itself (issue 35
 rows, one page wide, its header row on every page, no blank print area), no float shown as a
 General number of more than 7 significant digits, a header naming the shot and the version,
 and a grid sweep's charts with one series per level."""
+import json
+import os
 import re
 import shutil
 import subprocess
 import zipfile
+from pathlib import Path
 
 import openpyxl
 import pytest
@@ -185,12 +188,18 @@ def test_the_diff_reports_value_axes_name_the_columns_unit(workbooks):
     assert xml.count("<c:tx><c:strRef>") >= 3
 
 
-#: Workbooks in the macro's layout: their parameter sheet stays first and active (the macro
-#: reads the active sheet, diff and fill the first one).
+#: Workbooks in the macro's layout: their parameter sheet stays first (fill and diff read the
+#: first sheet; the legacy macro reads the active one, and docs/output.md says to click its tab
+#: before running the macro on them); they open on their Summary (issue 46).
 MACRO_LAYOUT = {"fill", "design_srs", "design_confidence"}
 
 #: Every kind make_all writes.
 ALL_KINDS = set(KINDS) | {"accept", "accept_corridor", "design_confidence"}
+
+#: The kinds whose first sheet is the shot's own in the macro's layout: its raw parameter
+#: block prints on one page when printed by itself, and is not in the report's print (the
+#: Parameters page, or the Calibration page, shows it readably).
+SHOT_FIRST = MACRO_LAYOUT | {"calibrate_law", "calibrate_fit"}
 
 
 @pytest.mark.parametrize("kind", sorted(ALL_KINDS - MACRO_LAYOUT))
@@ -205,7 +214,7 @@ def test_a_study_workbook_opens_on_its_first_report_page(workbooks, kind):
     assert active.title in printed, (kind, active.title, printed)
     assert active.sheet_properties.pageSetUpPr.fitToPage
     data = [ws.title for ws in wb.worksheets if ws.title not in printed]
-    shot_sheets = {wb.worksheets[0].title} if kind.startswith("calibrate") else set()
+    shot_sheets = {wb.worksheets[0].title} if kind in SHOT_FIRST else set()
     last_report = max(wb.sheetnames.index(t) for t in printed)
     assert all(wb.sheetnames.index(t) > last_report for t in data if t not in shot_sheets), \
         (kind, wb.sheetnames)
@@ -218,18 +227,80 @@ def test_a_study_workbook_opens_on_its_first_report_page(workbooks, kind):
 
 
 @pytest.mark.parametrize("kind", sorted(MACRO_LAYOUT))
-def test_a_workbook_in_the_macros_layout_opens_on_its_parameter_sheet(workbooks, kind):
-    """Sheet 1 stays first and active; it prints its parameter block on one page, and no
+def test_a_workbook_in_the_macros_layout_opens_on_its_summary(workbooks, kind):
+    """Issue 46: it opens on its Summary (it opened on the raw parameter block, '5E-06',
+    '-6.084E+09'); Sheet 1 stays first and prints its parameter block on one page, and no
     number on it, the macro's result columns included, is a General number past 7 digits."""
     path = workbooks[kind]
     wb = openpyxl.load_workbook(path)
-    assert wb.active.title == wb.sheetnames[0] == "Sheet1"
+    assert wb.active.title == "Summary" and wb.sheetnames[0] == "Sheet1"
     assert "Sheet1" in [ws.title for ws, _ in report_sheets(path)]
     long, numbers = [], 0
-    for row in wb.active.iter_rows():
+    for row in wb["Sheet1"].iter_rows():
         for c in row:
             if isinstance(c.value, (int, float)) and not isinstance(c.value, bool):
                 numbers += 1
                 if c.number_format == "General" and significant_digits(c.value) > MAX_DIGITS:
                     long.append((c.coordinate, c.value))
     assert numbers > 10_000 and long == [], (kind, long[:5])
+
+
+#: Debian's python3, the one python3-uno is built for (the venv's cannot import it).
+UNO_PYTHON = "/usr/bin/python3"
+
+
+def _has_uno():
+    if not (shutil.which("soffice") and os.path.exists(UNO_PYTHON)):
+        return False
+    return subprocess.run([UNO_PYTHON, "-c", "import uno"], capture_output=True,
+                          check=False).returncode == 0
+
+
+@pytest.mark.skipif(not _has_uno(), reason="needs LibreOffice and python3-uno")
+def test_the_default_print_is_the_report_pages_and_no_data(workbooks, tmp_path):
+    """Issue 46: printed as a user prints it (open, Ctrl+P, OK), every workbook gives its
+    report pages, each once, in tab order, and no data page: LibreOffice itself counts the
+    pages of its default print (tests/lo_default_print.py). The fill's gave 688 pages (5
+    report pages, then Tracked, Spectrum and ChartData); each data sheet still prints all its
+    pages when printed by itself, and each report page one page."""
+    kinds = sorted(ALL_KINDS)
+    done = subprocess.run([UNO_PYTHON, str(Path(__file__).with_name("lo_default_print.py")),
+                           str(tmp_path / "lo"), *(str(workbooks[k]) for k in kinds)],
+                          capture_output=True, text=True, timeout=600, check=False)
+    assert done.returncode == 0, done.stderr[-2000:]
+    printed = [json.loads(line) for line in done.stdout.splitlines()]
+    assert [r["path"] for r in printed] == [str(workbooks[k]) for k in kinds]
+    for kind, r in zip(kinds, printed, strict=True):
+        path = workbooks[kind]
+        # the print dialog's default is "Selected sheets" while this setting is false, as
+        # LibreOffice ships it (docs/output.md says how to check it)
+        assert r["all_sheets_default"] is False
+        sheets = openpyxl.load_workbook(path, read_only=True).sheetnames
+        report = [ws.title for ws, _ in report_sheets(path)]
+        if kind in SHOT_FIRST:
+            report.remove(sheets[0])
+        data = [ws.title for ws, _ in data_sheets(path)]
+        assert r["default"] == report, (kind, r["default"], report)
+        assert r["active"] in report, (kind, r["active"])
+        assert r["active"] == ("Summary" if kind in MACRO_LAYOUT else
+                               "Calibration" if kind.startswith("calibrate") else report[0])
+        assert all(r["alone"][t] == 1 for t in report), (kind, r["alone"])
+        assert all(r["alone"][t] >= 1 for t in data), (kind, r["alone"])
+        assert r["every_sheet"] == sum(r["alone"].values()), kind
+    fill = printed[kinds.index("fill")]
+    # shot A's data sheets print hundreds of pages (Tracked and ChartData, 12,000 rows each)
+    assert fill["every_sheet"] > 100 * len(fill["default"]), fill
+
+
+def test_the_template_opens_on_sheet1_alone(tmp_path):
+    """The template is the macro's input and the user's form: it opens on sheet 1 and no
+    other sheet is selected with it (grouped, what a user types on sheet 1 would be written
+    on the Specification sheet too, and the legacy macro, which reads the active sheet, would
+    not read sheet 1)."""
+    from airgun_xl.cli import main
+
+    path = tmp_path / "t.xlsx"
+    assert main(["template", str(path)]) == 0
+    wb = openpyxl.load_workbook(path)
+    assert wb.active.title == wb.sheetnames[0] == "Sheet1"
+    assert [ws.title for ws in wb.worksheets if ws.sheet_view.tabSelected] == ["Sheet1"]

@@ -273,6 +273,10 @@ def render_workbook(result, tmp, outputs=Outputs(), summary=None, info=None, sho
     if "summary" in outputs:
         write_parameters(wb, result.params, shot, names["Parameters"])
         write_summary(wb, result, summary, info, names["Summary"])
+        # the workbook opens on its Summary, the page its figures are read from; sheet 1
+        # stays first, where fill and diff read it (the legacy macro reads the active sheet:
+        # docs/output.md says to click sheet 1's tab before running it on this workbook)
+        wb.get_worksheet_by_name(names["Summary"]).activate()
     charts_ws = wb.add_worksheet(names["Charts"]) if "charts" in outputs else None
     if info.srs_requirement is not None:
         _write_srs_sheets(wb, result, info.srs_requirement, shot, names["SRS"],

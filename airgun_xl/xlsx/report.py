@@ -7,12 +7,17 @@ calibrate) goes through this module:
   the factor from the unit the writer holds it in, and its number format (kG or g, ms, kHz,
   MPa, %). :class:`Style` makes the formats once per workbook and writes numbers with them.
 - :func:`one_page` prints a report sheet on one landscape A4 page with a header naming the
-  shot, the input file, the version and the print date. :func:`data_pages` prints a data
-  sheet by itself: all its rows, one page wide, its header row repeated on every page and
-  each page numbered. Every workbook puts its report pages first and its data sheets after
-  them, so a print of the whole workbook (LibreOffice's PDF export prints every sheet) starts
-  with the report, and a print of the active sheet (Excel's and LibreOffice's default) is a
-  report page.
+  shot, the input file, the version and the print date, and groups it with the workbook's
+  other report pages. :func:`data_pages` prints a data sheet by itself: all its rows, one
+  page wide, its header row repeated on every page and each page numbered. Every workbook
+  puts its report pages first and its data sheets after them, so a print of the whole
+  workbook (LibreOffice's PDF export prints every sheet) starts with the report.
+- The default print is the report: the report pages are the workbook's selected (grouped)
+  sheets and it opens on one of them (:meth:`~airgun_xl.xlsx.workbook.new_workbook`'s close).
+  Excel's default print ("Print Active Sheets") and LibreOffice's ("Print only selected
+  sheets", on unless a user turned it off) print the selected sheets, so Ctrl+P gives the
+  report pages and no data; a click on a data sheet's tab ends the group and prints that
+  sheet alone.
 - :func:`axis` gives a chart axis its explicit limits and the number format of its quantity;
   :func:`chart_size` sizes a chart to the printed columns.
 
@@ -161,10 +166,14 @@ def _header_text(text):
 
 
 def one_page(ws, last_row, last_col, first_row=0, first_col=0, landscape=True, shot=None,
-             title=None):
+             title=None, report=True):
     """Print ``ws``'s range (0-based, inclusive) on one A4 page: a header with ``shot`` (the
     input file's name), ``title`` (the sheet's name by default), the version and the print
-    date; the file and sheet names in the footer."""
+    date; the file and sheet names in the footer. A ``report`` page is selected, so the
+    workbook's default print gives it (the module's notes); ``report=False`` keeps a page
+    that prints on its own out of that print (sheet 1's raw parameter block)."""
+    if report:
+        ws.select()
     ws.print_area(first_row, first_col, last_row, last_col)
     if landscape:
         ws.set_landscape()
@@ -235,10 +244,12 @@ def axis(title, lo, hi, code=None, log=False, gridlines=True, num_format=None):
 
 
 @contextlib.contextmanager
-def report_workbook(path, force=False, inputs=()):
+def report_workbook(path, force=False, inputs=(), publication=None):
     """The one way a command writes a workbook: refuse an output it may not write
     (:func:`~airgun_xl.transaction.check_output`), write into a temp file beside it, and
-    publish it whole when the block ends without an error (nothing is left otherwise).
+    publish it whole when the block ends without an error (nothing is left otherwise). With
+    a ``publication``, the temp file is staged in it and published with its other files at
+    the caller's commit.
 
     Yields
     ------
@@ -250,6 +261,11 @@ def report_workbook(path, force=False, inputs=()):
     from .workbook import close_workbook, new_workbook
 
     check_output(path, force, inputs=inputs)
+    if publication is not None:
+        wb = new_workbook(publication.stage(path))
+        yield wb
+        close_workbook(wb, path)
+        return
     with atomic_path(path, force) as tmp:
         wb = new_workbook(tmp)
         yield wb

@@ -70,9 +70,11 @@ def write_cells(ws, cells, values=None, style=None):
 def print_parameter_block(ws, block, shot, title):
     """Sheet 1's parameter block on one page, its columns (A to G, where the labels overflow)
     wide enough for the numbers as :func:`write_cells` shows them; its result columns from H
-    are data, printed from the Tracked sheet and summed up on the Summary."""
+    are data, printed from the Tracked sheet and summed up on the Summary. It prints when
+    printed by itself, not in the report's print: the Parameters page shows it readably."""
     ws.set_column(0, PARAMETER_COLUMNS - 1, VALUE_COLUMN_CHARS)
-    one_page(ws, max(r for r, _ in block) - 1, PARAMETER_COLUMNS - 1, shot=shot, title=title)
+    one_page(ws, max(r for r, _ in block) - 1, PARAMETER_COLUMNS - 1, shot=shot, title=title,
+             report=False)
 
 
 def print_outputs_block(ws, block, shot):

@@ -28,5 +28,7 @@ def write_spec_sheet(wb, shot=None):
     ws.write_string(note_row, 0, "fill, design and accept read this sheet over a --profile; "
                     "their options (--peak 12kG:10%...) override it field by field. A number "
                     "is in the row's unit; text carries its own (12kG, 0.3ms, -3dB).")
-    one_page(ws, note_row, 6, shot=shot, title=SHEET_NAME)
+    # an input form, not a report page: the template opens on sheet 1, the macro's, alone
+    # (grouped with it, what a user types on sheet 1 would be written here too)
+    one_page(ws, note_row, 6, shot=shot, title=SHEET_NAME, report=False)
     return ws

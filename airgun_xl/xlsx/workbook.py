@@ -30,6 +30,17 @@ class _Workbook(xlsxwriter.Workbook):
         ws.boolean_format = self._boolean_format
         return ws
 
+    def close(self):
+        """Open on a report page: when the report pages are selected (grouped, by
+        :func:`~airgun_xl.xlsx.report.one_page`) and the active sheet is not one of them, the
+        first of them becomes active, so the default print is the group and nothing else
+        (xlsxwriter would otherwise select sheet 1 with them)."""
+        sheets = self.worksheets()
+        grouped = [ws for ws in sheets if ws.selected]
+        if grouped and not sheets[self.worksheet_meta.activesheet].selected:
+            grouped[0].activate()
+        return super().close()
+
 
 def new_workbook(path):
     """An xlsxwriter Workbook with the project's fixed options and properties; strings are
