@@ -251,3 +251,66 @@ def test_a_name_the_font_cannot_draw_is_written_by_code_point_without_a_library_
     err = capsys.readouterr().err
     assert code == 0 and "from a library" not in err and "Glyph" not in err, err
     assert "Recording: \\u6d4b\\u8bd5.csv" in " ".join(_text(tmp_path / "r.pdf").split())
+
+
+@pytest.mark.parametrize("command", ["fill", "accept", "design", "next"])
+def test_a_pdf_in_another_folder_than_its_workbook_is_one_line_before_any_work(
+        fired, command, tmp_path, capsys):
+    """The workbook and its PDF are published together, under one folder's lock and journal:
+    a PDF elsewhere is refused in one line, exit 2, nothing written (it was a ValueError's
+    traceback once the fill had run)."""
+    folder, shot, rec = fired
+    (tmp_path / "w").mkdir()
+    (tmp_path / "p").mkdir()
+    out, pdf = tmp_path / "w" / "r.xlsx", tmp_path / "p" / "r.pdf"
+    argv = {"fill": ["fill", str(shot)],
+            "accept": ["accept", str(shot), str(rec), "--peak", "9.3kG:5%"],
+            "design": ["design", str(shot), "--target-peak", "12kG"],
+            "next": ["next", str(shot), str(rec), "--archive", str(tmp_path / "w" / "a"),
+                     "--lot", "L", "--peak", "9.3kG:5%"]}[command]
+    code = main([*argv, "-o", str(out), "--pdf", str(pdf)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert err[0] == (f"airgun-xl: error: --pdf: found {pdf}, in another folder than {out}, "
+                      "expected a file beside it (the two are published together, or "
+                      "neither)"), err
+    assert list((tmp_path / "w").iterdir()) == list((tmp_path / "p").iterdir()) == []
+
+
+def test_one_folder_named_two_ways_is_one_folder(tmp_path, monkeypatch):
+    """``-o w/r.xlsx --pdf /abs/w/r.pdf`` (and a symlinked folder) name one folder: both are
+    published."""
+    (tmp_path / "w").mkdir()
+    (tmp_path / "link").symlink_to(tmp_path / "w", target_is_directory=True)
+    monkeypatch.chdir(tmp_path)
+    assert main(["fill", str(TEMPLATE), "-o", "w/r.xlsx", "--pdf", str(tmp_path / "link" / "r.pdf"),
+                 "--only", "summary", "--quiet"]) == 0
+    assert sorted(p.name for p in (tmp_path / "w").iterdir()) == ["r.pdf", "r.xlsx"]
+
+
+def test_accepts_workbook_and_pdf_are_replaced_together_or_not_at_all(fired, tmp_path,
+                                                                       monkeypatch):
+    """With --force, a verdict workbook that fails to be written leaves the PDF and the
+    workbook the user had as they were (the PDF was published first, then removed: the
+    user's earlier PDF was lost); a run that succeeds replaces both."""
+    folder, shot, rec = fired
+    out, pdf = tmp_path / "v.xlsx", tmp_path / "v.pdf"
+    out.write_bytes(b"the user's workbook")
+    pdf.write_bytes(b"the user's pdf")
+    import airgun_xl.reports.acceptance as acceptance
+
+    real = acceptance.write_acceptance
+
+    def failing(*args, **kwargs):
+        real(*args, **kwargs)  # staged whole, then the disk fills
+        raise airgun_xl.OutputError("v.xlsx: cannot be written (No space left on device)")
+
+    monkeypatch.setattr(acceptance, "write_acceptance", failing)
+    with pytest.raises(airgun_xl.OutputError, match="No space left"):
+        airgun_xl.accept(shot, rec, peak="9.3kG:5%", output=out, pdf=pdf, force=True)
+    assert out.read_bytes() == b"the user's workbook" and pdf.read_bytes() == b"the user's pdf"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["v.pdf", "v.xlsx"]  # no temp left
+    monkeypatch.setattr(acceptance, "write_acceptance", real)
+    done = airgun_xl.accept(shot, rec, peak="9.3kG:5%", output=out, pdf=pdf, force=True)
+    assert done.files == (out, pdf)
+    assert out.read_bytes()[:2] == b"PK" and pdf.read_bytes()[:4] == b"%PDF"

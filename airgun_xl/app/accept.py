@@ -144,13 +144,10 @@ def run(request: AcceptRequest) -> AcceptOutcome:
         check_output(request.output, request.force,
                      inputs=[request.shot, input_file(request.recording)])
     if request.pdf is not None:
-        from ..reports.pdf_report import require_matplotlib
+        from ..reports.pdf_report import check_pdf
 
-        require_matplotlib()
-        check_output(request.pdf, request.force,
-                     inputs=[request.shot, input_file(request.recording),
-                             *([request.output] if request.output is not None else [])],
-                     suffixes=(".pdf",))
+        check_pdf(request.pdf, request.force, [request.shot, input_file(request.recording)],
+                  beside=request.output)
     if request.archive is not None:  # a folder that is not an archive: refused before work
         if request.output is None:
             raise OptionError("--archive: found no verdict workbook to name, expected an "
@@ -178,15 +175,8 @@ def run(request: AcceptRequest) -> AcceptOutcome:
     time, kg = verdict.record
     pulse, spectra = report_data(time, kg, spec, verdict)
     archived = None
-    if request.pdf is not None:  # first: a workbook that fails after it takes it back
-        _write_pdf(request, verdict, trace, rec, pulse, spectra)
-    try:
-        if request.output is not None:
-            archived = _write(request, shot, verdict, trace, rec, pulse, spectra)
-    except BaseException:
-        if request.pdf is not None:
-            request.pdf.unlink(missing_ok=True)
-        raise
+    if request.output is not None or request.pdf is not None:
+        archived = _write(request, shot, verdict, trace, rec, pulse, spectra)
     eq = spectra["equivalent"]
     files = tuple(p for p in (archived, request.output, request.pdf) if p is not None)
     record = verdict_record(verdict, shot, request.recording,
@@ -206,42 +196,45 @@ def _about(request: AcceptRequest, verdict: Verdict, trace: Any, rec: Any) -> li
 
 
 def _write_pdf(request: AcceptRequest, verdict: Verdict, trace: Any, rec: Any,
-               pulse: dict[str, Any], spectra: dict[str, Any]) -> None:
-    """The client's test report (``--pdf``), published whole or not at all."""
+               pulse: dict[str, Any], spectra: dict[str, Any], path: Path) -> None:
+    """The client's test report (``--pdf``), written at ``path`` (a staged temp file)."""
     from ..reports.pdf_report import write_verdict_pdf
-    from ..transaction import atomic_path
     from ..untrusted_json import printable
 
-    assert request.pdf is not None
     about = [(label, printable(text)) for label, text in _about(request, verdict, trace, rec)]
     heading = (printable(Path(request.shot).name), printable(Path(trace.name).name),
                printable(verdict.spec.source or "options"))  # the names: a page's width
-    with atomic_path(request.pdf, request.force) as tmp:
-        write_verdict_pdf(tmp, verdict, about, pulse, spectra,
-                          [printable(w) for w in verdict.warnings], heading,
-                          request.reproducible)
+    write_verdict_pdf(path, verdict, about, pulse, spectra,
+                      [printable(w) for w in verdict.warnings], heading, request.reproducible)
 
 
 def _write(request: AcceptRequest, shot: Shot, verdict: Verdict, trace: Any, rec: Any,
            pulse: dict[str, Any], spectra: dict[str, Any]) -> Path | None:
-    """The verdict's record first (if asked), taken back if the workbook is not published: a
-    failure or a signal leaves neither (the archive, if this made it, included). The
+    """The verdict's record first (if asked), then the workbook and the PDF staged and
+    published together: a failure or a signal leaves none of them (the record taken back,
+    the archive too if this made it), and ``--force`` replaces both or neither. The
     record's path."""
     from ..reports.acceptance import write_acceptance
-    from ..transaction import signals_held
+    from ..transaction import Publication, signals_held
 
-    assert request.output is not None
-    about = _about(request, verdict, trace, rec)
     stored = None
     try:
-        if request.archive is not None:
-            from ..archive.verdicts import store_verdict
+        with Publication(request.force) as pub:
+            if request.output is not None:
+                if request.archive is not None:
+                    from ..archive.verdicts import store_verdict
 
-            with signals_held():  # a signal comes once the record is whole, and assigned
-                stored = store_verdict(request.archive, shot, verdict, request.recording,
-                                       request.output, request.argv)
-        write_acceptance(request.output, verdict, about, pulse, spectra, request.force,
-                         shot=Path(request.shot).name)
+                    with signals_held():  # a signal comes once the record is whole
+                        stored = store_verdict(request.archive, shot, verdict,
+                                               request.recording, request.output,
+                                               request.argv)
+                write_acceptance(request.output, verdict,
+                                 _about(request, verdict, trace, rec), pulse, spectra,
+                                 request.force, shot=Path(request.shot).name, publication=pub)
+            if request.pdf is not None:
+                _write_pdf(request, verdict, trace, rec, pulse, spectra,
+                           pub.stage(request.pdf))
+            pub.commit()
     except BaseException:
         if stored is not None:
             stored.take_back()

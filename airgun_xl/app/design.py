@@ -162,15 +162,12 @@ def _check_pdf(request: DesignRequest) -> None:
     """``--pdf``: a file it may write, beside a workbook, before any study."""
     if request.pdf is None:
         return
-    from ..reports.pdf_report import require_matplotlib
-    from ..transaction import check_output
+    from ..reports.pdf_report import check_pdf
 
     if request.output is None:
         raise OptionError("--pdf: found without a workbook to fill, expected an output too "
                           "(the PDF is the designed shot's report)")
-    require_matplotlib()
-    check_output(request.pdf, request.force, inputs=[request.shot, request.output],
-                 suffixes=(".pdf",))
+    check_pdf(request.pdf, request.force, [request.shot], beside=request.output)
 
 
 def _solve_target(request: DesignRequest) -> tuple[Shot, Design, list[str], dict[str, Any]]:

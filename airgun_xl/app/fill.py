@@ -211,11 +211,10 @@ def _check_outputs(shot: Shot, output: Path, outputs: Outputs, options: Options)
     if options.archive is not None:
         Archive(options.archive.root, create=True, dry_run=True)  # a foreign folder: now
     if options.pdf is not None:
-        from ..reports.pdf_report import require_matplotlib
+        from ..reports.pdf_report import check_pdf
 
-        require_matplotlib()
-        check_output(options.pdf, options.force, inputs=[*inputs, output],
-                     suffixes=(".pdf",), force_word=options.force_word)
+        check_pdf(options.pdf, options.force, inputs, beside=output,
+                  force_word=options.force_word)
     return sidecar
 
 

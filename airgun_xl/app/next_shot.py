@@ -190,11 +190,10 @@ def _checked(request: NextRequest) -> Path:
     output = request.output if request.output is not None else default_output(request.shot)
     check_output(output, request.force, inputs=[request.shot, input_file(request.recording)])
     if request.pdf is not None:
-        from ..reports.pdf_report import require_matplotlib
+        from ..reports.pdf_report import check_pdf
 
-        require_matplotlib()
-        check_output(request.pdf, request.force, suffixes=(".pdf",),
-                     inputs=[request.shot, input_file(request.recording), output])
+        check_pdf(request.pdf, request.force, [request.shot, input_file(request.recording)],
+                  beside=output)
     Archive(request.archive, create=True, dry_run=True)  # a folder that is not one: refused
     return output
 

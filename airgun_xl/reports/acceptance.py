@@ -136,9 +136,11 @@ def _pv_chart(wb, n, frequencies, pv, col):
     return chart
 
 
-def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=None):
+def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=None,
+                     publication=None):
     """Write the Verdict page, the Pulse page (chart), the SRS page (chart and the shaker's
-    figures) and their data sheets at ``path``.
+    figures) and their data sheets at ``path`` (staged in ``publication`` when given, which
+    the caller commits; published alone otherwise).
 
     Parameters
     ----------
@@ -149,7 +151,7 @@ def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=Non
         ``frequencies`` [Hz], ``srs`` [kG], ``pv`` [m/s], optional ``required``, ``lower``,
         ``upper`` [kG]; ``equivalent`` (peak [kG], duration [s], governing [Hz]).
     """
-    with report_workbook(path, force) as wb:
+    with report_workbook(path, force, publication=publication) as wb:
         bold = wb.add_format({"bold": True})
         # the report pages first (the workbook opens on the Verdict), their data after them
         ws = wb.add_worksheet("Verdict")

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import datetime
 import textwrap
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -73,6 +74,21 @@ def require_matplotlib(option: str = "--pdf") -> None:
     except ImportError:
         raise OptionError(f"{option}: needs matplotlib, expected it installed (pip install "
                           "'airgun-xl[plots]')") from None
+
+
+def check_pdf(pdf: Path, force: bool, inputs: Sequence[Any] = (), beside: Path | None = None,
+              force_word: str = "--force") -> None:
+    """``--pdf``: refused before any work when matplotlib is missing, when ``pdf`` is a file
+    the command may not write (:func:`~airgun_xl.transaction.check_output`), or when it is
+    not in the folder of ``beside``, the workbook published with it
+    (:func:`~airgun_xl.transaction.check_beside`)."""
+    from ..transaction import check_beside, check_output
+
+    require_matplotlib()
+    check_output(pdf, force, inputs=[*inputs, *([beside] if beside is not None else [])],
+                 suffixes=(".pdf",), force_word=force_word)
+    if beside is not None:
+        check_beside(pdf, beside, "--pdf")
 
 
 class _Pages:

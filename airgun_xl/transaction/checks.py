@@ -5,7 +5,7 @@ import os
 import stat
 from pathlib import Path
 
-from ..errors import OutputError
+from ..errors import OptionError, OutputError
 
 
 def display(path):
@@ -67,3 +67,23 @@ def check_output(path, force=False, inputs=(), suffixes=(".xlsx",), force_word="
     if not os.access(folder, os.W_OK | os.X_OK):
         raise OutputError(f"{shown}: its folder {display(folder)} is not writable, expected a "
                           "writable folder")
+
+
+def same_folder(a, b):
+    """Whether files ``a`` and ``b`` name one folder, by whatever path (``x/`` and
+    ``/abs/x/``, a symlinked folder): two missing folders compare by their names."""
+    first, second = Path(a).parent, Path(b).parent
+    try:
+        return os.path.samefile(first, second)
+    except OSError:
+        return os.path.abspath(first) == os.path.abspath(second)
+
+
+def check_beside(path, other, option):
+    """Refuse ``option``'s file ``path`` outside the folder of ``other``, a file published
+    with it: a command's files are published together, under one folder's lock and journal
+    (:class:`~airgun_xl.transaction.Publication`)."""
+    if not same_folder(path, other):
+        raise OptionError(f"{option}: found {display(path)}, in another folder than "
+                          f"{display(other)}, expected a file beside it (the two are "
+                          "published together, or neither)")

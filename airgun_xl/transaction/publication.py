@@ -32,7 +32,7 @@ import secrets
 from pathlib import Path
 
 from ..errors import OutputError
-from .checks import display
+from .checks import display, same_folder
 from .locks import folder_lock, fsync
 from .owners import OWNER_PATTERN, owner_alive, owner_token
 from .signals import SIGNALS, Interrupted, signals_held
@@ -73,8 +73,10 @@ class Publication:
     def stage(self, final):
         """A new empty temp file for ``final``, to be written by the caller."""
         final = Path(final)
-        if self.files and final.parent != self.files[0][1].parent:
-            raise ValueError("a publication's files share one folder")
+        if self.files and not same_folder(final, self.files[0][1]):
+            raise ValueError("a publication's files share one folder")  # check_beside first
+        if self.files:  # one folder by one path: the journal names its files in it
+            final = self.files[0][1].parent / final.name
         temp = self._name(final, "tmp")
         try:
             os.close(os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644))
