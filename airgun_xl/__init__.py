@@ -43,6 +43,7 @@ if TYPE_CHECKING:
     from .app.diff import DiffOutcome
     from .app.fill import FillOutcome
     from .app.next_shot import NextOutcome
+    from .app.recording import RecordingOutcome
     from .app.settings import FillSettings
     from .app.specifying import SpecKeywords
     from .app.srs import SrsOutcome
@@ -380,6 +381,22 @@ def diff(legacy: str | os.PathLike[str], new: str | os.PathLike[str], *,
                _number("--atol", atol), None if report is None else os.fspath(report), force)
 
 
+def recording(path: str | os.PathLike[str]) -> RecordingOutcome:
+    """What a recording file holds, as ``airgun-xl recording`` lists it: its ``format`` and
+    its ``channels`` (each one's ``name``, ``unit`` as the file states it, ``rate`` [Hz],
+    ``samples`` and ``start`` [s]), in the file's order: ``channel="2"`` in the reading
+    functions is the second, ``channel=NAME`` the one of that name. No samples judged.
+
+    Raises
+    ------
+    AirgunXlError
+        A file that cannot be read as a recording, named.
+    """
+    from .app.recording import run
+
+    return run(os.fspath(path))
+
+
 def template(output: str | os.PathLike[str], *, force: bool = False) -> os.PathLike[str]:
     """Write a fresh shot A workbook in the report's layout, as ``airgun-xl template``
     does; the path written."""
@@ -674,6 +691,7 @@ __all__ = [
     "history",
     "load",
     "next_shot",
+    "recording",
     "show",
     "srs",
     "sweep",

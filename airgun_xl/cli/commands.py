@@ -16,6 +16,7 @@ from . import (
     diff,
     fill,
     next_shot,
+    recording,
     srs,
     sweep,
     template,
@@ -23,7 +24,7 @@ from . import (
 from .spec_options import PLAIN_OPTIONS, QUANTITY_OPTIONS
 
 COMMANDS = (fill, diff, archive, check, convergence, design, sweep, srs, compare_measured,
-            calibrate, accept, next_shot, template)
+            calibrate, accept, next_shot, recording, template)
 
 
 class _Parser(argparse.ArgumentParser):

@@ -96,15 +96,17 @@ def anti_alias_value(text):
 
 #: The help of a command's recording argument (compare-measured, accept).
 RECORDING_HELP = ("a CSV (time, acceleration, units in the header), a workbook's columns "
-                  "(trace.xlsx:Sheet1!A:B) or a LabVIEW TDMS file")
+                  "(trace.xlsx:Sheet1!A:B), a LabVIEW TDMS file or a MATLAB .mat file")
 
 
-def add_recording_options(p, channel_help="TDMS only: the channel (default: the first "
-                                          "waveform channel)", anti_alias=True,
+def add_recording_options(p, channel_help="the channel of a file of several (TDMS, .mat): "
+                                          "its name, or its number as 'airgun-xl recording "
+                                          "FILE' lists it (default: the first)",
+                          anti_alias=True,
                           cfc_help=None):
     """The recording's options; ``anti_alias`` False for a command with no prediction to put
     through the recorder's filter (accept: the option would be accepted and ignored)."""
-    p.add_argument("--channel", metavar="GROUP/CHANNEL", help=channel_help)
+    p.add_argument("--channel", metavar="NAME|N", help=channel_help)
     p.add_argument("--cfc", type=cfc_value, default=None, metavar="N|none", action=CfcOption,
                    help=cfc_help or "filter both pulses: SAE J211 class 60, 180, 600 or 1000, "
                         "or none (the default) "

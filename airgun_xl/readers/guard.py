@@ -39,8 +39,9 @@ def _mib(n):
     return f"{n / 2**20:,.1f} MB"
 
 
-def read_bytes(path, expected=EXPECTED, what="workbook"):
-    """The bytes of a regular file, read without blocking and capped at MAX_INPUT_BYTES.
+def read_bytes(path, expected=EXPECTED, what="workbook", head=None):
+    """The bytes of a regular file, read without blocking and capped at MAX_INPUT_BYTES; with
+    ``head``, its first ``head`` bytes only, whatever its size (a format told by content).
 
     Raises
     ------
@@ -65,6 +66,9 @@ def read_bytes(path, expected=EXPECTED, what="workbook"):
         kind = special_kind(st.st_mode)
         if kind is not None:
             raise WorkbookError(f"{shown}: is {kind}, expected a regular {what} file")
+        if head is not None:
+            with os.fdopen(os.dup(fd), "rb") as fh:
+                return fh.read(head)
         if st.st_size > limits.MAX_INPUT_BYTES:
             raise WorkbookError(f"{shown}: is {_mib(st.st_size)}, expected a {what} of at most "
                                 f"{_mib(limits.MAX_INPUT_BYTES)}")

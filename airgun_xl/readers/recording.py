@@ -19,6 +19,7 @@ import numpy as np
 from .. import limits, units
 from ..errors import AirgunXlError, OptionError, WorkbookError
 from ..transaction import display
+from . import formats
 from .guard import read_bytes
 
 #: Time units [s per unit]: the one table's (:data:`airgun_xl.units.TIME_UNITS`).
@@ -222,7 +223,6 @@ RANGE = re.compile(r"^(?P<file>.+\.(?:xlsx|xlsm|xls)):(?P<sheet>[^!]+)!(?P<a>[A-
 
 EXPECTED_RANGE = ("expected a column range of time and acceleration with a header row, "
                   "e.g. trace.xlsx:Sheet1!A:B")
-EXPECTED_TDMS = "expected a LabVIEW TDMS file with a waveform channel of acceleration"
 
 
 def input_file(spec):
@@ -240,12 +240,33 @@ def _source_table(path, channel=None):
             raise OptionError("--channel: found with a workbook range, expected it only "
                               "with a TDMS file")
         return _range_table(found)
-    if text.lower().endswith(".tdms"):
-        return _tdms_table(path, channel)
+    fmt = formats.detect(path)
+    if fmt is not None:
+        return fmt.read(path, read_bytes(path, fmt.EXPECTED, fmt.NAME), channel)
     if channel is not None:
-        raise OptionError("--channel: found with a CSV file, expected it only with a TDMS "
-                          "file")
+        raise OptionError("--channel: found with a CSV file, expected it only with a file of "
+                          "several channels (TDMS, MATLAB .mat)")
     return _table(path, EXPECTED, ("time", "acceleration"))
+
+
+def list_channels(path):
+    """The channels of the recording at ``path`` (:class:`~.formats.ChannelInfo`): a CSV or
+    a workbook range has one, its second column."""
+    text = str(path)
+    found = RANGE.match(text)
+    fmt = None if found and not Path(text).exists() else formats.detect(path)
+    if fmt is not None:
+        return fmt.channels(path, read_bytes(path, fmt.EXPECTED, fmt.NAME))
+    shown, header, values = (_range_table(found) if found and not Path(text).exists()
+                             else _table(path, EXPECTED, ("time", "acceleration")))
+    unit = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]", header[1])
+    t_unit = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]", header[0])
+    scale = TIME_UNITS.get(t_unit.group(1).strip()) if t_unit else None
+    time = values[:, 0]
+    rate = ((len(time) - 1) / ((time[-1] - time[0]) * scale)
+            if scale and len(time) > 1 and time[-1] > time[0] else None)
+    return [formats.ChannelInfo(header[1], unit.group(1).strip() if unit else "", rate,
+                                len(values), float(time[0]) * scale if scale else None)]
 
 
 def _column(letters):
@@ -303,68 +324,6 @@ def _range_table(found):
                                 "numbers (time, acceleration)")
         values[i - 2] = cells
     return shown, header, values
-
-
-def _tdms_table(path, channel):
-    try:
-        from nptdms import TdmsFile
-    except ImportError:
-        raise OptionError(f"{display(Path(path))}: reading TDMS needs npTDMS, expected it "
-                          "installed: pip install 'airgun-xl[tdms]'") from None
-    import logging
-
-    from nptdms.log import log_manager
-
-    # npTDMS gives each of its modules a logger of its own level and a console handler: its
-    # lines would come before our one (23.23, 32.17); all of them, and any made later, quiet
-    log_manager.set_level(logging.CRITICAL + 1)
-    logging.getLogger("nptdms").setLevel(logging.CRITICAL + 1)
-    shown = display(Path(path))
-    data = read_bytes(path, EXPECTED_TDMS, "TDMS")
-    try:
-        tdms = TdmsFile.read(io.BytesIO(data))
-        channels = [c for g in tdms.groups() for c in g.channels()]
-    except Exception as exc:  # noqa: BLE001 - any parser failure on untrusted bytes: one line
-        raise WorkbookError(f"{shown}: is not a readable TDMS file ({type(exc).__name__}), "
-                            f"{EXPECTED_TDMS}") from None
-    waves = [c for c in channels if "wf_increment" in c.properties]
-    names = [f"{c.group_name}/{c.name}" for c in waves]
-    if channel is not None:
-        if channel not in names:
-            raise OptionError(f"--channel: found {channel!r}, expected one of the file's "
-                              f"waveform channels: {', '.join(names[:8]) or 'none'}")
-        chosen = waves[names.index(channel)]
-    elif waves:
-        chosen = waves[0]
-    else:
-        raise WorkbookError(f"{shown}: has no waveform channel (wf_increment), "
-                            f"{EXPECTED_TDMS}")
-    if len(chosen) > limits.MAX_SAMPLES:  # before the samples are read
-        raise WorkbookError(f"{shown}: channel {chosen.name!r} holds {len(chosen):,} samples, "
-                            f"expected at most {limits.MAX_SAMPLES:,} samples")
-    try:  # a string, a timestamp or a complex channel is the file's fault: one line
-        raw = np.asarray(chosen[:])
-        if not np.issubdtype(raw.dtype, np.number) or np.iscomplexobj(raw):
-            raise TypeError(f"{raw.dtype} samples")
-        accel = raw.astype(float)
-        dt = float(chosen.properties["wf_increment"])
-        start = float(chosen.properties.get("wf_start_offset", 0.0))
-    except (TypeError, ValueError, OverflowError) as exc:
-        raise WorkbookError(f"{shown}: channel {chosen.name!r} is not a waveform of numbers "
-                            f"({exc}), {EXPECTED_TDMS}") from None
-    if not (math.isfinite(dt) and dt > 0):
-        raise WorkbookError(f"{shown}: channel {chosen.name!r} has wf_increment {dt!r}, "
-                            "expected a positive sample step [s]")
-    bad = ~np.isfinite(accel)
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise WorkbookError(f"{shown}: channel {chosen.name!r} sample {k} is {accel[k]}, "
-                            "expected finite numbers (no NaN or inf)")
-    unit = str(chosen.properties.get("unit_string", ""))
-    # the header is built for the unit alone: a channel named 'accel (z)' or 'accel [z]' must
-    # not lend its brackets to the unit parser
-    header = ["time [s]", f"acceleration [{unit}]" if unit else "acceleration"]
-    return shown, header, np.column_stack([start + dt * np.arange(len(accel)), accel])
 
 
 #: Frequency units [Hz per unit] of a required spectrum.

@@ -1,0 +1,70 @@
+"""Recording: what a recording file holds, as the reading commands would read it (its format
+and its channels, with their names, units, rates, lengths and starts); no samples judged.
+
+:func:`run` takes the file and returns a :class:`RecordingOutcome`; the CLI (``airgun-xl
+recording``) is this."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+
+@dataclass(frozen=True)
+class RecordingOutcome:
+    """The file's ``format`` (its name in messages) and its ``channels``
+    (:class:`airgun_xl.readers.formats.ChannelInfo`, in the file's order: ``--channel N`` is
+    the N-th)."""
+
+    path: Path
+    format: str
+    channels: tuple[Any, ...]
+
+    def lines(self) -> list[str]:
+        """What ``recording`` prints: a line for the file, then a row per channel."""
+        from ..transaction import display
+        from ..untrusted_json import printable
+
+        def number(x: float | None, fmt: str) -> str:
+            return "unknown" if x is None or not math.isfinite(x) else format(x, fmt)
+
+        count = len(self.channels)
+        out = [f"{printable(display(self.path))}: {self.format}, {count} channel"
+               f"{'' if count == 1 else 's'}",
+               f"{'#':>3}  {'name':<24} {'unit':<8} {'rate [Hz]':>12} {'samples':>12} "
+               f"{'start [s]':>12}"]
+        for k, c in enumerate(self.channels, start=1):
+            out.append(f"{k:>3}  {printable(c.name):<24} {printable(c.unit) or '-':<8} "
+                       f"{number(c.rate, ',.6g'):>12} {c.samples:>12,} "
+                       f"{number(c.start, '.6g'):>12}")
+        return out
+
+    def to_json(self) -> str:
+        """The listing as JSON (the channels' rates in Hz and starts in s; null unknown)."""
+        from .documents import dumps
+
+        return dumps({"file": self.path, "format": self.format, "channels": [
+            {"number": k, "name": c.name, "unit": c.unit, "rate_hz": c.rate,
+             "samples": c.samples, "start_s": c.start}
+            for k, c in enumerate(self.channels, start=1)]})
+
+
+def run(path: str | Path) -> RecordingOutcome:
+    """List the channels of the recording at ``path``.
+
+    Raises
+    ------
+    airgun_xl.errors.WorkbookError
+        The file is missing, not a regular file, too large, or not a readable recording.
+    """
+    from ..readers import formats
+    from ..readers.recording import RANGE, list_channels
+
+    text = str(path)
+    if RANGE.match(text) and not Path(text).exists():
+        kind = "workbook range"
+    else:
+        fmt = formats.detect(path)
+        kind = fmt.NAME if fmt is not None else "CSV"
+    return RecordingOutcome(Path(text), kind, tuple(list_channels(path)))

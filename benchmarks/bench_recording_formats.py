@@ -1,0 +1,88 @@
+"""Reading a recording in each format (issue 47): a 1 s channel at 1 MHz (1,000,000 samples
+of a 5 ms half-sine with noise, seed 0, in g, beside a second channel), read as the reading
+commands read it (`read_trace`: the file's bytes, its format told, the channel and its time
+checked), as a fresh process.
+
+    python benchmarks/bench_recording_formats.py [--repeat N] [--quick]
+
+Formats: CSV (time and acceleration, repr), LabVIEW TDMS (npTDMS writes it), MATLAB v5
+uncompressed and v7 compressed (scipy's savemat writes them, airgun-xl's reader reads them)
+and v7.3 (h5py writes it, with MATLAB's header). Reports each one's file size, the median wall
+time over N runs after a warm-up and the peak RSS; the process's import of airgun-xl is in
+every figure (the first row, a process that reads nothing, is that floor). --quick: 100,000
+samples.
+"""
+import statistics
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from bench_fill import measured_process, quick, run_table  # noqa: E402
+
+
+def _pulse(n):
+    t = np.arange(n) / 1e6
+    a = np.where((t > 0.1) & (t < 0.105), 1000 * np.sin(np.pi * (t - 0.1) / 0.005), 0.0)
+    return t, a + np.random.default_rng(0).normal(0, 5, n)
+
+
+def files(tmp, n):
+    """{format: path} of the same channel in each format."""
+    from scipy.io import savemat
+
+    t, a = _pulse(n)
+    out = {"CSV": tmp / "r.csv"}
+    out["CSV"].write_text("time [s],acceleration [g]\n" + "".join(
+        f"{x!r},{y!r}\n" for x, y in zip(t.tolist(), a.tolist(), strict=True)))
+    try:
+        import nptdms
+
+        with nptdms.TdmsWriter(str(tmp / "r.tdms")) as writer:
+            writer.write_segment([
+                nptdms.ChannelObject("Recorder", "accel", a, properties={
+                    "wf_increment": 1e-6, "wf_start_offset": 0.0, "unit_string": "g"}),
+                nptdms.ChannelObject("Recorder", "strain", a * 0.5, properties={
+                    "wf_increment": 1e-6, "wf_start_offset": 0.0})])
+        out["TDMS"] = tmp / "r.tdms"
+    except ImportError:
+        pass
+    variables = {"time": t, "time_unit": "s", "accel": a, "accel_unit": "g", "strain": a * 0.5}
+    savemat(tmp / "v5.mat", variables, format="5", oned_as="column")
+    savemat(tmp / "v7.mat", variables, do_compression=True, oned_as="column")
+    out["MATLAB v5"] = tmp / "v5.mat"
+    out["MATLAB v7 (compressed)"] = tmp / "v7.mat"
+    try:
+        from test_recording_formats import _write_v73
+
+        out["MATLAB v7.3 (HDF5)"] = _write_v73(tmp / "v73.mat", variables)
+    except ImportError:
+        pass
+    return out
+
+
+def bench_formats(repeat, tmp):
+    n = 100_000 if quick() else 1_000_000
+    rows = []
+    floor = [sys.executable, "-c", "import airgun_xl.readers.recording"]
+    walls, rss = measured_process(floor, repeat)
+    rows.append(("import only (the floor)", "", f"{statistics.median(walls):.2f} s",
+                 f"peak RSS {max(rss):.0f} MB"))
+    for name, path in files(tmp, n).items():
+        cmd = [sys.executable, "-c", "import sys; from airgun_xl.readers.recording import "
+               "read_trace; read_trace(sys.argv[1])", str(path)]
+        walls, rss = measured_process(cmd, repeat)
+        rows.append((f"{name}, {n:,} samples at 1 MHz",
+                     f"{path.stat().st_size / 2**20:.1f} MB",
+                     f"{statistics.median(walls):.2f} s", f"peak RSS {max(rss):.0f} MB"))
+    return rows
+
+
+def main():
+    run_table(__doc__, bench_formats)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,301 @@
+"""Issue 47: recordings in the formats labs export, each fixture written by the format's own
+writer (scipy's savemat for MATLAB v5, h5py for v7.3 with MATLAB's header and classes), hold
+the pulse of a reference CSV: accept, compare-measured and calibrate give the same verdicts
+and figures from each; the channels are listed, chosen by name or number; a file that lies is
+one line, exit 2, nothing written."""
+import io
+import json
+
+import numpy as np
+import pytest
+from conftest import TEMPLATE, write_trace_csv
+from scipy.io import savemat
+
+import airgun_xl
+from airgun_xl.cli import main
+from airgun_xl.crush_law import LEGACY_LAW
+from airgun_xl.studies.calibrate import synthetic_measurement
+from airgun_xl.units import G
+
+#: kG per g: the recorder's g is standard gravity, the macro's kG 9,800 m/s^2.
+KG_PER_G = G / 9800.0
+
+#: A specification the pulse passes on peak and duration (tests/test_pdf_report.py's).
+SPEC = {"peak": "9.3kG:5%", "duration": "4.74ms:15%"}
+
+
+@pytest.fixture(scope="module")
+def pulse(tmp_path_factory):
+    """Shot A fired on a lot 10 % stronger, recorded at 51.2 kHz with 1 % noise, as a CSV
+    in kG (the reference) and as the same samples in each format."""
+    folder = tmp_path_factory.mktemp("formats")
+    p = airgun_xl.load(TEMPLATE).params.replace(crush_law=LEGACY_LAW.scaled(1.10))
+    trace = synthetic_measurement(p, dt=1 / 51_200, seed=3)
+    files = {"csv": write_trace_csv(folder / "ref.csv", trace)}
+    # v5, compressed, as a recorder's export: a time vector in ms, the channel in kG beside a
+    # second one, units as text variables
+    savemat(folder / "v5.mat", {"time": trace.time * 1e3, "time_unit": "ms",
+                                "accel": trace.accel_kg, "accel_unit": "kG",
+                                "strain": np.linspace(0, 1, len(trace.time)),
+                                "note": "shot 1"},
+            do_compression=True, oned_as="column")
+    # v5 without a time vector: the rate and the start, the channel in g
+    savemat(folder / "fs.mat", {"fs": 51_200.0, "t0": float(trace.time[0]),
+                                "accel": trace.accel_kg / KG_PER_G, "accel_unit": "g"})
+    files.update(v5=folder / "v5.mat", fs=folder / "fs.mat")
+    if _h5py() is not None:
+        files["v73"] = _write_v73(folder / "v73.mat", {"time": trace.time, "time_unit": "s",
+                                                       "accel": trace.accel_kg / KG_PER_G,
+                                                       "accel_unit": "g"})
+    return folder, trace, files
+
+
+def _h5py():
+    try:
+        import h5py
+    except ImportError:
+        return None
+    return h5py
+
+
+def _write_v73(path, variables):
+    """A MATLAB v7.3 file as MATLAB writes one: a 512-byte user block holding the v7.3 text
+    header, then HDF5 datasets with their MATLAB_class (a column vector stored 1 x n, text as
+    UTF-16 code units)."""
+    h5py = _h5py()
+    with h5py.File(path, "w", userblock_size=512) as f:
+        for name, value in variables.items():
+            if isinstance(value, str):
+                data = np.array([[ord(c) for c in value]], dtype=np.uint16).T
+                ds = f.create_dataset(name, data=data)
+                ds.attrs["MATLAB_class"] = np.bytes_("char")
+                ds.attrs["MATLAB_int_decode"] = np.int32(2)
+            else:
+                ds = f.create_dataset(name, data=np.asarray(value, dtype=float)[None, :])
+                ds.attrs["MATLAB_class"] = np.bytes_("double")
+    header = (b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Fri Nov 27 00:00:00 2026 "
+              b"HDF5 schema 1.00 .").ljust(116) + bytes(8) + b"\x00\x02IM"
+    with open(path, "r+b") as fh:
+        fh.write(header.ljust(512, b"\x00"))
+    return path
+
+
+def test_scipy_reads_our_v73_header_as_v73(pulse):
+    """The v7.3 fixture is what MATLAB writes, by scipy's own reading of its header."""
+    from scipy.io.matlab import matfile_version
+
+    if "v73" not in pulse[2]:
+        pytest.skip("needs h5py")
+    with open(pulse[2]["v73"], "rb") as fh:
+        assert matfile_version(fh) == (2, 0)
+
+
+@pytest.mark.parametrize("kind", ["v5", "fs", "v73"])
+def test_accept_gives_the_csvs_verdict_and_figures(pulse, kind, tmp_path):
+    """Every criterion's value from the file equals the CSV's: bit for bit where the file
+    holds the CSV's numbers (kG and the time vector); within 1e-12 relative where it holds
+    them in g or its time as fs and t0 (a product's rounding)."""
+    folder, trace, files = pulse
+    if kind not in files:
+        pytest.skip("needs h5py")
+    reference = airgun_xl.accept(TEMPLATE, files["csv"], **SPEC)
+    found = airgun_xl.accept(TEMPLATE, files[kind], **SPEC)
+    assert found.verdict.word == reference.verdict.word == "PASS"
+    for mine, theirs in zip(found.verdict.criteria, reference.verdict.criteria, strict=True):
+        assert (mine.name, mine.unit, mine.passed) == (theirs.name, theirs.unit, theirs.passed)
+        if kind == "v5":
+            assert mine.value == theirs.value, mine.name
+        else:
+            assert mine.value == pytest.approx(theirs.value, rel=1e-12), mine.name
+
+
+def test_compare_measured_and_calibrate_give_the_csvs_figures(pulse):
+    folder, trace, files = pulse
+    ref = airgun_xl.compare_measured(TEMPLATE, files["csv"]).comparison
+    mat = airgun_xl.compare_measured(TEMPLATE, files["v5"]).comparison
+    # the time vector in ms, read back in s: the figures within a rounding of the time
+    for field in ("peak_kg", "time_of_peak", "pulse_duration", "delta_v"):
+        assert getattr(mat.measured, field) == pytest.approx(getattr(ref.measured, field),
+                                                             rel=1e-12), field
+    assert mat.correlation == pytest.approx(ref.correlation, rel=1e-12)
+    calibrations = [airgun_xl.calibrate(TEMPLATE, files[k], fit="scale").calibration
+                    for k in ("csv", "v5")]
+    fitted = [c.fitted for c in calibrations]
+    errors = calibrations[0].errors
+    # the time read back from ms differs from the CSV's in its last bits, and the fit's
+    # optimiser stops on a tolerance: the same fit, to a thousandth of its standard error
+    assert fitted[0].keys() == fitted[1].keys() and fitted[0]
+    for key in fitted[0]:
+        assert abs(fitted[1][key] - fitted[0][key]) < 1e-3 * errors[key], key
+
+
+def test_the_channels_are_listed_and_chosen_by_name_or_number(pulse, capsys):
+    """``airgun-xl recording FILE`` lists each channel's name, unit, rate (the measured one,
+    from the time vector), samples and start; --channel takes a name or a number."""
+    folder, trace, files = pulse
+    assert main(["recording", str(files["v5"]), "--json"]) == 0
+    listed = json.loads(capsys.readouterr().out)["channels"]
+    assert [c["name"] for c in listed] == ["accel", "strain"]
+    accel = listed[0]
+    assert accel["unit"] == "kG" and accel["samples"] == len(trace.time)
+    assert accel["rate_hz"] == pytest.approx(51_200, rel=1e-9)
+    assert accel["start_s"] == pytest.approx(trace.time[0], abs=1e-15)
+    by_name = airgun_xl.compare_measured(TEMPLATE, files["v5"], channel="accel")
+    by_number = airgun_xl.compare_measured(TEMPLATE, files["v5"], channel="1")
+    assert by_name.comparison.measured == by_number.comparison.measured
+    assert main(["recording", str(files["csv"])]) == 0
+    text = capsys.readouterr().out
+    assert "acceleration [kG]" in text and "51,200" in text
+
+
+@pytest.mark.parametrize("variables, message", [
+    ({"accel": np.ones(100)}, "channel 'accel' has no time base (a vector 'time' or 't' of "
+                              "its 100 samples, or a scalar fs or dt)"),
+    ({"accel": np.ones(100), "fs": -5.0}, "fs is -5.0, expected a positive rate [Hz]"),
+    ({"note": "text only"}, "holds no numeric vector"),
+    ({"accel": np.ones(100) + 1j, "fs": 1e4}, "holds complex128 values, expected real"),
+    ({"accel": np.r_[np.ones(50), np.nan, np.ones(49)], "fs": 1e4},
+     "channel 'accel' sample 51 is nan, expected finite numbers"),
+])
+def test_a_mat_file_that_cannot_be_a_recording_is_one_line(tmp_path, capsys, variables,
+                                                           message):
+    path = tmp_path / "r.mat"
+    savemat(path, variables)
+    out = tmp_path / "c.xlsx"
+    assert main(["compare-measured", str(TEMPLATE), str(path), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.mat"]
+
+
+def test_a_mat_file_cut_short_or_lying_about_its_length_is_one_line(pulse, tmp_path, capsys):
+    """A file cut at each tenth of its length, and a variable whose header declares 2 x 10^9
+    samples (16 GB), are one line each (refused before any allocation of that size)."""
+    folder, trace, files = pulse
+    data = files["fs"].read_bytes()
+    for cut in range(1, 10):
+        path = tmp_path / f"cut{cut}.mat"
+        path.write_bytes(data[: len(data) * cut // 10])
+        assert main(["accept", str(TEMPLATE), str(path), "--peak", "9kG:10%"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and str(path) in err, err
+    path = tmp_path / "lying.mat"
+    for compressed in (True, False):  # the dimensions inside a zlib stream, or in the open
+        path.write_bytes(_declaring(1, 2_000_000_000, compressed))  # int32 dims: 16 GB
+        assert main(["accept", str(TEMPLATE), str(path), "--peak", "9kG:10%"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "holds 2,000,000,000 samples, expected at most" in err
+
+
+def _declaring(rows, columns, compressed=True):
+    """A v5 file by savemat whose 1000-sample ``accel`` declares ``rows`` x ``columns``:
+    in a compressed file the dimensions are inside each variable's zlib stream, so the
+    stream is inflated, patched and deflated again (its byte count rewritten)."""
+    import zlib
+
+    buffer = io.BytesIO()
+    savemat(buffer, {"fs": 1e4, "accel": np.ones(1000)}, do_compression=compressed)
+    data = buffer.getvalue()
+    old = np.array([1, 1000], dtype="<i4").tobytes()  # savemat writes a vector as 1 x n
+    new = np.array([rows, columns], dtype="<i4").tobytes()
+    if not compressed:
+        assert data.count(old) == 1
+        return data.replace(old, new)
+    out, at = bytearray(data[:128]), 128
+    while at < len(data):
+        kind, size = np.frombuffer(data[at:at + 8], dtype="<i4")
+        body = data[at + 8:at + 8 + size]
+        if kind == 15:  # miCOMPRESSED
+            inner = zlib.decompress(body)
+            if old in inner:
+                body = zlib.compress(inner.replace(old, new))
+        out += np.array([kind, len(body)], dtype="<i4").tobytes() + body
+        at += 8 + size
+    return bytes(out)
+
+
+def test_a_wrong_channel_lists_the_files_channels(pulse, capsys):
+    folder, trace, files = pulse
+    assert main(["accept", str(TEMPLATE), str(files["v5"]), "--peak", "9kG:10%", "--channel",
+                 "3"]) == 2
+    assert ("--channel: found '3', expected one of the file's channels: accel, strain (or its "
+            "number, 1 to 2)") in capsys.readouterr().err
+
+
+def _mutations():
+    from hypothesis import strategies as st
+
+    return st.lists(st.tuples(st.integers(0, 10**6), st.integers(0, 255)), min_size=1,
+                    max_size=12), st.integers(0, 10**6)
+
+
+@pytest.mark.parametrize("kind", ["v5", "fs", "v73"])
+def test_any_damage_to_a_mat_file_is_a_trace_or_one_error(pulse, kind):
+    """Bytes overwritten anywhere, and the file cut anywhere (hypothesis, derandomized): the
+    reader gives a Trace or one AirgunXlError, never another exception or a warning."""
+    import warnings
+
+    from hypothesis import HealthCheck, given, settings
+
+    from airgun_xl.readers.recording import read_trace
+
+    folder, trace, files = pulse
+    if kind not in files:
+        pytest.skip("needs h5py")
+    good = files[kind].read_bytes()
+    flips, cuts = _mutations()
+    target = folder / f"damaged_{kind}.mat"
+
+    @settings(max_examples=120, deadline=None, derandomize=True, database=None,
+              suppress_health_check=list(HealthCheck))
+    @given(flips=flips, cut=cuts)
+    def check(flips, cut):
+        data = bytearray(good)
+        for at, value in flips:
+            data[at % len(data)] = value
+        target.write_bytes(bytes(data[: max(1, len(data) - cut % len(data))]))
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            try:
+                read_trace(target)
+            except airgun_xl.AirgunXlError as exc:
+                assert "\n" not in str(exc)
+
+    check()
+
+
+@pytest.mark.parametrize("compressed", [True, False])
+@pytest.mark.parametrize("oned_as", ["row", "column"])
+def test_our_mat5_reader_reads_what_scipy_writes_as_scipy_reads_it(tmp_path, compressed,
+                                                                  oned_as):
+    """airgun_xl.readers.formats.mat5 (ours, bounded: scipy's reader crashes on damaged
+    files) against scipy.io's whosmat and loadmat on a file savemat writes: every variable's
+    shape and class, every numeric and text variable's values bit for bit; a cell and a
+    structure listed and skipped."""
+    from scipy.io import loadmat, whosmat
+
+    from airgun_xl.readers.formats.mat5 import Mat5
+
+    rng = np.random.default_rng(5)
+    variables = {"f64": rng.normal(size=300), "f32": rng.normal(size=7).astype(np.float32),
+                 "i16": rng.integers(-300, 300, 40).astype(np.int16),
+                 "u8": rng.integers(0, 255, 9).astype(np.uint8),
+                 "i64": rng.integers(-2**40, 2**40, 5), "z": rng.normal(size=6) + 1j,
+                 "scalar": 51_200.0, "unit": "m/s²", "grid": rng.normal(size=(3, 4)),
+                 "cell": np.array([1, "a"], dtype=object), "s": {"a": 1.0, "b": "x"}}
+    path = tmp_path / "all.mat"
+    savemat(path, variables, do_compression=compressed, oned_as=oned_as)
+    data = path.read_bytes()
+    ours = Mat5(data, 10**6)
+    theirs = {name: (shape, kind) for name, shape, kind in whosmat(path)}
+    # whosmat gives a text's shape as a string's, (1,); ours is as stored, 1 x 4 characters
+    assert {n: (v.shape if v.kind != "char" else (1,), v.kind)
+            for n, v in ours.variables.items()} == theirs
+    assert ours.variables["unit"].shape == (1, 4)
+    loaded = loadmat(path)
+    for name in ("f64", "f32", "i16", "u8", "i64", "z", "scalar", "grid"):
+        expected = loaded[name]
+        got = ours.values(name)
+        assert got.dtype == expected.dtype and np.array_equal(
+            got, expected.ravel(order="F")), name
+    assert str(ours.values("unit")) == "m/s²" == loaded["unit"][0]
