@@ -6,11 +6,12 @@ checked), as a fresh process.
     python benchmarks/bench_recording_formats.py [--repeat N] [--quick]
 
 Formats: CSV (time and acceleration, repr), LabVIEW TDMS (npTDMS writes it), MATLAB v5
-uncompressed and v7 compressed (scipy's savemat writes them, airgun-xl's reader reads them)
-and v7.3 (h5py writes it, with MATLAB's header). Reports each one's file size, the median wall
-time over N runs after a warm-up and the peak RSS; the process's import of airgun-xl is in
-every figure (the first row, a process that reads nothing, is that floor). --quick: 100,000
-samples.
+uncompressed and v7 compressed (scipy's savemat writes them, airgun-xl's reader reads them),
+v7.3 (h5py writes it, with MATLAB's header), and UFF dataset 58 binary and ASCII (pyuff
+writes and reads them; pyuff parses every dataset of the file, both channels here).
+Reports each one's file size, the median wall time over N runs after a warm-up and the peak
+RSS; the process's import of airgun-xl is in every figure (the first row, a process that
+reads nothing, is that floor). --quick: 100,000 samples.
 """
 import statistics
 import sys
@@ -58,6 +59,14 @@ def files(tmp, n):
         from test_recording_formats import _write_v73
 
         out["MATLAB v7.3 (HDF5)"] = _write_v73(tmp / "v73.mat", variables)
+    except ImportError:
+        pass
+    try:
+        from test_recording_formats import _write_uff58
+
+        for binary, name in ((1, "UFF 58b (binary)"), (0, "UFF 58 (ASCII)")):
+            out[name] = _write_uff58(tmp / f"r{binary}.uff", binary,
+                                     [("accel", a, "g", t), ("strain", a * 0.5, "g", t)])
     except ImportError:
         pass
     return out

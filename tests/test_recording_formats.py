@@ -43,6 +43,18 @@ def pulse(tmp_path_factory):
     savemat(folder / "fs.mat", {"fs": 51_200.0, "t0": float(trace.time[0]),
                                 "accel": trace.accel_kg / KG_PER_G, "accel_unit": "g"})
     files.update(v5=folder / "v5.mat", fs=folder / "fs.mat")
+    if _pyuff() is not None:
+        t, g = trace.time, trace.accel_kg / KG_PER_G
+        for binary, name in ((0, "ascii.uff"), (1, "binary.uff")):
+            files[name.split(".")[0]] = _write_uff58(folder / name, binary, [
+                ("temperature", np.full(len(t), 21.0), "C", t),
+                ("accel", g, "g", t)])
+        # an even abscissa keeps its start and increment as E13.5 (6 significant digits):
+        # the same samples on that time base, as a CSV, are what the UFF files hold
+        stored = float(f"{t[0]:.5E}") + np.arange(len(t)) * float(f"{t[1] - t[0]:.5E}")
+        files["uff_csv"] = folder / "uff_ref.csv"
+        files["uff_csv"].write_text("time [s],acceleration [g]\n" + "".join(
+            f"{x!r},{y!r}\n" for x, y in zip(stored.tolist(), g.tolist(), strict=True)))
     if _h5py() is not None:
         files["v73"] = _write_v73(folder / "v73.mat", {"time": trace.time, "time_unit": "s",
                                                        "accel": trace.accel_kg / KG_PER_G,
@@ -56,6 +68,38 @@ def _h5py():
     except ImportError:
         return None
     return h5py
+
+
+def _pyuff():
+    try:
+        import pyuff
+    except ImportError:
+        return None
+    return pyuff
+
+
+def _write_uff58(path, binary, channels):
+    """Time responses written by pyuff's own writer (dataset 58, or 58b when ``binary``):
+    each (name, values, unit, time [s]) on an even abscissa."""
+    pyuff = _pyuff()
+    uff = pyuff.UFF(str(path))
+    for node, (name, values, unit, t) in enumerate(channels, start=1):
+        dataset = pyuff.prepare_58(
+            binary=binary, id1=name, id2="airgun-xl test", id3="NONE", id4="NONE", id5="NONE",
+            func_type=1, ver_num=0, load_case_id=0, rsp_ent_name="BIRD", rsp_node=node,
+            rsp_dir=3, ref_ent_name="NONE", ref_node=0, ref_dir=0, ord_data_type=4,
+            num_pts=len(values), abscissa_spacing=1, abscissa_min=float(t[0]),
+            abscissa_inc=float(t[1] - t[0]), z_axis_value=0.0, abscissa_spec_data_type=17,
+            abscissa_len_unit_exp=0, abscissa_force_unit_exp=0, abscissa_temp_unit_exp=0,
+            abscissa_axis_units_lab="s", ordinate_spec_data_type=12,
+            ordinate_len_unit_exp=1, ordinate_force_unit_exp=0, ordinate_temp_unit_exp=0,
+            ordinate_axis_units_lab=unit, orddenom_spec_data_type=0,
+            orddenom_len_unit_exp=0, orddenom_force_unit_exp=0, orddenom_temp_unit_exp=0,
+            orddenom_axis_units_lab="NONE", z_axis_spec_data_type=0, z_axis_len_unit_exp=0,
+            z_axis_force_unit_exp=0, z_axis_temp_unit_exp=0, z_axis_axis_units_lab="NONE",
+            data=np.asarray(values, dtype=float), x=np.asarray(t, dtype=float))
+        uff.write_sets(dataset, mode="add")
+    return path
 
 
 def _write_v73(path, variables):
@@ -90,23 +134,30 @@ def test_scipy_reads_our_v73_header_as_v73(pulse):
         assert matfile_version(fh) == (2, 0)
 
 
-@pytest.mark.parametrize("kind", ["v5", "fs", "v73"])
+@pytest.mark.parametrize("kind", ["v5", "fs", "v73", "ascii", "binary"])
 def test_accept_gives_the_csvs_verdict_and_figures(pulse, kind, tmp_path):
     """Every criterion's value from the file equals the CSV's: bit for bit where the file
     holds the CSV's numbers (kG and the time vector); within 1e-12 relative where it holds
-    them in g or its time as fs and t0 (a product's rounding)."""
+    them in g or its time as fs and t0 (a product's rounding); for UFF's ASCII dataset 58,
+    within its stored precision (4E20.12: 13 significant digits, so 1e-11 relative). A UFF
+    file's time base is its header's start and increment, stored as E13.5: its reference is
+    the CSV of the same samples on that time base. Its second time response is chosen by its
+    name."""
     folder, trace, files = pulse
     if kind not in files:
-        pytest.skip("needs h5py")
-    reference = airgun_xl.accept(TEMPLATE, files["csv"], **SPEC)
-    found = airgun_xl.accept(TEMPLATE, files[kind], **SPEC)
+        pytest.skip("needs h5py or pyuff")
+    uff = kind in ("ascii", "binary")
+    channel = {"channel": "accel"} if uff else {}
+    reference = airgun_xl.accept(TEMPLATE, files["uff_csv" if uff else "csv"], **SPEC)
+    found = airgun_xl.accept(TEMPLATE, files[kind], **SPEC, **channel)
     assert found.verdict.word == reference.verdict.word == "PASS"
     for mine, theirs in zip(found.verdict.criteria, reference.verdict.criteria, strict=True):
         assert (mine.name, mine.unit, mine.passed) == (theirs.name, theirs.unit, theirs.passed)
-        if kind == "v5":
+        if kind in ("v5", "binary"):
             assert mine.value == theirs.value, mine.name
         else:
-            assert mine.value == pytest.approx(theirs.value, rel=1e-12), mine.name
+            rel = 1e-11 if kind == "ascii" else 1e-12
+            assert mine.value == pytest.approx(theirs.value, rel=rel), mine.name
 
 
 def test_compare_measured_and_calibrate_give_the_csvs_figures(pulse):
@@ -229,8 +280,8 @@ def _mutations():
                     max_size=12), st.integers(0, 10**6)
 
 
-@pytest.mark.parametrize("kind", ["v5", "fs", "v73"])
-def test_any_damage_to_a_mat_file_is_a_trace_or_one_error(pulse, kind):
+@pytest.mark.parametrize("kind", ["v5", "fs", "v73", "ascii", "binary"])
+def test_any_damage_to_a_recording_is_a_trace_or_one_error(pulse, kind):
     """Bytes overwritten anywhere, and the file cut anywhere (hypothesis, derandomized): the
     reader gives a Trace or one AirgunXlError, never another exception or a warning."""
     import warnings
@@ -241,10 +292,10 @@ def test_any_damage_to_a_mat_file_is_a_trace_or_one_error(pulse, kind):
 
     folder, trace, files = pulse
     if kind not in files:
-        pytest.skip("needs h5py")
+        pytest.skip("needs h5py or pyuff")
     good = files[kind].read_bytes()
     flips, cuts = _mutations()
-    target = folder / f"damaged_{kind}.mat"
+    target = folder / f"damaged_{kind}{files[kind].suffix}"
 
     @settings(max_examples=120, deadline=None, derandomize=True, database=None,
               suppress_health_check=list(HealthCheck))
@@ -299,3 +350,45 @@ def test_our_mat5_reader_reads_what_scipy_writes_as_scipy_reads_it(tmp_path, com
         assert got.dtype == expected.dtype and np.array_equal(
             got, expected.ravel(order="F")), name
     assert str(ours.values("unit")) == "m/s²" == loaded["unit"][0]
+
+
+def test_a_uffs_time_responses_are_listed_and_a_lying_point_count_is_one_line(pulse, tmp_path,
+                                                                              capsys):
+    """``recording`` lists a UFF file's time responses (name from ID line 1, unit from the
+    ordinate's label, the rate of its stored increment); a header whose point count is not
+    what the dataset holds, a file with no time response, and one cut short are one line."""
+    folder, trace, files = pulse
+    if "binary" not in files:
+        pytest.skip("needs pyuff")
+    for kind in ("ascii", "binary"):
+        assert main(["recording", str(files[kind]), "--json"]) == 0
+        listed = json.loads(capsys.readouterr().out)
+        assert listed["format"] == "UFF dataset 58"
+        assert [(c["name"], c["unit"]) for c in listed["channels"]] == [
+            ("temperature", "C"), ("accel", "g")]
+        step = float(f"{trace.time[1] - trace.time[0]:.5E}")
+        assert listed["channels"][1]["rate_hz"] == pytest.approx(1 / step, rel=1e-12)
+    text = files["ascii"].read_text()
+    header = f"{4:10d}{len(trace.time):10d}{1:10d}"
+    assert text.count(header) == 2
+    lying = tmp_path / "lying.uff"
+    lying.write_text(text.replace(header, f"{4:10d}{len(trace.time) + 7:10d}{1:10d}"))
+    assert main(["accept", str(TEMPLATE), str(lying), "--peak", "9kG:10%", "--channel",
+                 "2"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and (f"time response 'accel' declares {len(trace.time) + 7:,} "
+                                     f"points and holds {len(trace.time):,}") in err, err
+    none = tmp_path / "none.uff"
+    none.write_text(text.replace(f"{1:5d}{0:10d}{0:5d}{0:10d}       BIRD",
+                                 f"{2:5d}{0:10d}{0:5d}{0:10d}       BIRD"))
+    assert main(["accept", str(TEMPLATE), str(none), "--peak", "9kG:10%"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "has no dataset 58 time response" in err, err
+    data = files["binary"].read_bytes()
+    for cut in range(1, 10):
+        short = tmp_path / f"cut{cut}.uff"
+        short.write_bytes(data[: len(data) * cut // 10])
+        code = main(["accept", str(TEMPLATE), str(short), "--peak", "9kG:10%", "--channel",
+                     "accel"])
+        err = capsys.readouterr().err
+        assert code == 2 and err.count("\n") == 1, (cut, err)

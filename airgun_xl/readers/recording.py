@@ -1,6 +1,7 @@
-"""A measured pulse from a CSV file, a workbook's column range or a LabVIEW TDMS file: time and
-acceleration, with units from the header (``time [ms]``, ``accel (g)``, a TDMS channel's
-``unit_string``) or given, every row checked; and a required shock response spectrum (CSV).
+"""A measured pulse from a CSV file, a workbook's column range or a recorder's file (TDMS,
+MATLAB, UFF: :mod:`.formats`): time and acceleration, with units from the header (``time
+[ms]``, ``accel (g)``, a channel's unit as its file states it) or given, every row checked;
+and a required shock response spectrum (CSV).
 
 The file is read like any untrusted input (:func:`airgun_xl.readers.guard.read_bytes`: a
 regular file, size capped). Each fault is one line naming the row: a row that is not two
@@ -245,7 +246,7 @@ def _source_table(path, channel=None):
         return fmt.read(path, read_bytes(path, fmt.EXPECTED, fmt.NAME), channel)
     if channel is not None:
         raise OptionError("--channel: found with a CSV file, expected it only with a file of "
-                          "several channels (TDMS, MATLAB .mat)")
+                          "several channels (TDMS, MATLAB .mat, UFF)")
     return _table(path, EXPECTED, ("time", "acceleration"))
 
 
