@@ -392,3 +392,52 @@ def test_a_uffs_time_responses_are_listed_and_a_lying_point_count_is_one_line(pu
                      "accel"])
         err = capsys.readouterr().err
         assert code == 2 and err.count("\n") == 1, (cut, err)
+
+
+def test_a_unit_given_over_the_files_is_named_where_the_figures_go(pulse, tmp_path):
+    """--accel-unit over a file that states another unit reads the values in the given unit
+    and says so: the warning is in the verdict (and so on its pages and its record); the same
+    unit spelled another way (m/s2 for m/s^2, µs for us) is no conflict."""
+    folder, trace, files = pulse
+    given = airgun_xl.accept(TEMPLATE, files["csv"], **SPEC, accel_unit="g")
+    note = (f"{files['csv']}: --accel-unit g replaces the unit the file states (kG): its "
+            "values are read as g")
+    assert note in given.verdict.warnings
+    assert given.verdict.word == "FAIL"  # a thousandth of the pulse: the peak far below
+    same = airgun_xl.accept(TEMPLATE, files["csv"], **SPEC, accel_unit="kG")
+    assert not [w for w in same.verdict.warnings if "replaces the unit" in w]
+    spelled = tmp_path / "us.csv"
+    spelled.write_text(files["csv"].read_text().replace("time [s]", "time [µs]").replace(
+        "acceleration [kG]", "acceleration [m/s2]"))
+    from airgun_xl.readers.recording import read_trace
+
+    assert read_trace(spelled, time_unit="us", accel_unit="m/s^2").notes == []
+    compared = airgun_xl.compare_measured(TEMPLATE, files["v5"], accel_unit="g")
+    assert any("--accel-unit g replaces the unit the file states (kG)" in w
+               for w in compared.warnings)
+
+
+@pytest.mark.parametrize("unit, per_g", [("G", 1.0), ("g's", 1.0), ("m/s**2", G),
+                                         ("mm/ms^2", G / 1000), ("mm/ms²", G / 1000),
+                                         ("m/sec^2", G)])
+def test_a_files_unit_in_a_recorders_spelling_is_read(tmp_path, unit, per_g):
+    """The spellings recorders write (G, mm/ms^2, m/s**2) read as the unit they mean: the
+    same pulse in each gives the same accelerations as in g, to a product's rounding."""
+    from airgun_xl.readers.recording import read_trace
+
+    t = np.arange(64) / 1e4
+    g = 100 * np.sin(np.pi * t / t[-1])
+    path = tmp_path / "r.mat"
+    savemat(path, {"fs": 1e4, "accel": g * per_g, "accel_unit": unit})
+    reference = tmp_path / "g.mat"
+    savemat(reference, {"fs": 1e4, "accel": g, "accel_unit": "g"})
+    assert read_trace(path).accel_kg == pytest.approx(read_trace(reference).accel_kg,
+                                                      rel=1e-14)
+
+
+def test_a_unit_a_case_away_is_still_refused_from_a_file(tmp_path, capsys):
+    """KG is not kG (nor G): a file stating it is one line asking for the unit."""
+    path = tmp_path / "r.mat"
+    savemat(path, {"fs": 1e4, "accel": np.ones(64), "accel_unit": "KG"})
+    assert main(["accept", str(TEMPLATE), str(path), "--peak", "9kG:10%"]) == 2
+    assert "names 'KG', a case away from 'kG'" in capsys.readouterr().err

@@ -12,7 +12,7 @@ import csv
 import io
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +31,16 @@ TIME_UNITS = {unit: float(scale) for unit, scale in units.TIME_UNITS.items()}
 #: m/s^2 (its Acceleration (kG's) column), so 1 g is 1.000679e-3 kG. The macro's 9800
 #: applies to the macro's columns only.
 ACCEL_UNITS = dict(units.PEAK_UNITS)
+
+#: Spellings a recorder's file may state that the options do not take [kG per unit]: ``G``
+#: (a recorder's g, as shock labs write it; as an option it would sit a case away from kG),
+#: ``mm/ms^2`` (1,000 m/s^2), and ``**`` or ``sec`` for ``^`` and ``s``.
+FILE_ACCEL_UNITS = {**ACCEL_UNITS, "G": ACCEL_UNITS["g"],
+                    "mm/ms^2": 1e3 * ACCEL_UNITS["m/s^2"], "mm/ms**2": 1e3 * ACCEL_UNITS["m/s^2"],
+                    "m/s**2": ACCEL_UNITS["m/s^2"], "m/sec^2": ACCEL_UNITS["m/s^2"],
+                    "m/sec**2": ACCEL_UNITS["m/s^2"]}
+#: The time units a file may state [s per unit]: the options' and ``sec``, ``msec``.
+FILE_TIME_UNITS = {**TIME_UNITS, "sec": 1.0, "msec": 1e-3}
 
 #: A step may differ from the median step by this fraction before it is a gap.
 GAP_TOLERANCE = 0.01
@@ -57,6 +67,9 @@ class Trace:
         Where it came from.
     units : tuple
         (time unit, acceleration unit) as read or given.
+    notes : list of str
+        What the reading found that the figures depend on (a unit given over the one the
+        file states): warnings, carried into every report of this recording.
     """
 
     time: np.ndarray
@@ -64,6 +77,7 @@ class Trace:
     dt: float
     name: str
     units: tuple
+    notes: list = field(default_factory=list)
 
 
 def _unit(header, table, option, which):
@@ -382,12 +396,18 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
         if given is not None and given not in table:
             raise OptionError(f"{option}: found {given!r}, expected one of {', '.join(table)}")
     shown, header, values = _source_table(path, channel)
-    t_unit = time_unit or _unit(header[0], TIME_UNITS, "--time-unit", "time")
-    a_unit = accel_unit or _unit(header[1], ACCEL_UNITS, "--accel-unit", "acceleration")
+    t_unit = time_unit or _unit(header[0], FILE_TIME_UNITS, "--time-unit", "time")
+    a_unit = accel_unit or _unit(header[1], FILE_ACCEL_UNITS, "--accel-unit", "acceleration")
+    notes = [_override(shown, option, given, stated, table)
+             for option, given, stated, table in (
+                 ("--time-unit", time_unit, header[0], FILE_TIME_UNITS),
+                 ("--accel-unit", accel_unit, header[1], FILE_ACCEL_UNITS))
+             if given is not None]
+    notes = [note for note in notes if note]
     if len(values) < MIN_SAMPLES:
         raise WorkbookError(f"{shown}: holds {len(values)} samples, expected at least "
                             f"{MIN_SAMPLES}")
-    time = values[:, 0] * TIME_UNITS[t_unit]
+    time = values[:, 0] * FILE_TIME_UNITS[t_unit]
     steps = np.diff(time)
     if not (steps > 0).all():
         k = int(np.argmax(steps <= 0))
@@ -399,4 +419,18 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
         k = int(np.argmax(off))
         raise WorkbookError(f"{shown}: row {k + 3}: a step of {steps[k]:.4g} s, expected the "
                             f"constant {dt:.4g} s of the other rows (a gap or a changed rate)")
-    return Trace(time, sign * values[:, 1] * ACCEL_UNITS[a_unit], dt, shown, (t_unit, a_unit))
+    return Trace(time, sign * values[:, 1] * FILE_ACCEL_UNITS[a_unit], dt, shown,
+                 (t_unit, a_unit),
+                 notes)
+
+
+def _override(shown, option, given, header, table):
+    """The warning when ``option``'s unit replaces a different one the file states in
+    ``header`` ('' when the file states none, or the same unit)."""
+    found = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]", header)
+    stated = (found.group(1) if found else "").strip()
+    key = stated.replace("'s", "").replace("²", "^2").replace(" ", "")
+    if not stated or (key in table and table[key] == table[given]):
+        return ""
+    return (f"{shown}: {option} {given} replaces the unit the file states ({stated}): its "
+            f"values are read as {given}")

@@ -195,7 +195,8 @@ def prepare(trace, cfc=None, anti_alias=None, dt_model=None, flat_top=False, exp
     """
     from .shock import check_cfc
 
-    warnings = check_cfc(cfc, trace.dt) if cfc else []
+    warnings = list(getattr(trace, "notes", ()))  # what the reading found (a unit given)
+    warnings += check_cfc(cfc, trace.dt) if cfc else []
     huge = np.flatnonzero(~(np.abs(np.asarray(trace.accel_kg, dtype=float))
                             <= limits.MAX_RECORD_KG))
     if len(huge):
