@@ -7,7 +7,8 @@ checked), as a fresh process.
 
 Formats: CSV (time and acceleration, repr), LabVIEW TDMS (npTDMS writes it), MATLAB v5
 uncompressed and v7 compressed (scipy's savemat writes them, airgun-xl's reader reads them),
-v7.3 (h5py writes it, with MATLAB's header), and UFF dataset 58 binary and ASCII (pyuff
+v7.3 (h5py writes it, with MATLAB's header), ASAM MDF 4.10 (asammdf writes it; read in a
+child process), and UFF dataset 58 binary and ASCII (pyuff
 writes and reads them; pyuff parses every dataset of the file, both channels here).
 Reports each one's file size, the median wall time over N runs after a warm-up and the peak
 RSS; the process's import of airgun-xl is in every figure (the first row, a process that
@@ -62,6 +63,12 @@ def files(tmp, n):
     except ImportError:
         pass
     try:
+        from test_recording_formats import _write_mdf
+
+        out["ASAM MDF 4.10 (asammdf, in a child process)"] = _write_mdf(tmp / "r.mf4", t, a)
+    except ImportError:
+        pass
+    try:
         from test_recording_formats import _write_uff58
 
         for binary, name in ((1, "UFF 58b (binary)"), (0, "UFF 58 (ASCII)")):
@@ -80,8 +87,10 @@ def bench_formats(repeat, tmp):
     rows.append(("import only (the floor)", "", f"{statistics.median(walls):.2f} s",
                  f"peak RSS {max(rss):.0f} MB"))
     for name, path in files(tmp, n).items():
+        channel = "accel" if path.suffix == ".mf4" else None  # its slow channel comes first
         cmd = [sys.executable, "-c", "import sys; from airgun_xl.readers.recording import "
-               "read_trace; read_trace(sys.argv[1])", str(path)]
+               "read_trace; read_trace(sys.argv[1], channel=sys.argv[2] or None)", str(path),
+               channel or ""]
         walls, rss = measured_process(cmd, repeat)
         rows.append((f"{name}, {n:,} samples at 1 MHz",
                      f"{path.stat().st_size / 2**20:.1f} MB",

@@ -5,6 +5,7 @@ and figures from each; the channels are listed, chosen by name or number; a file
 one line, exit 2, nothing written."""
 import io
 import json
+import os
 
 import numpy as np
 import pytest
@@ -55,6 +56,8 @@ def pulse(tmp_path_factory):
         files["uff_csv"] = folder / "uff_ref.csv"
         files["uff_csv"].write_text("time [s],acceleration [g]\n" + "".join(
             f"{x!r},{y!r}\n" for x, y in zip(stored.tolist(), g.tolist(), strict=True)))
+    if _asammdf() is not None:
+        files["mdf"] = _write_mdf(folder / "shot.mf4", trace.time, trace.accel_kg / KG_PER_G)
     if _h5py() is not None:
         files["v73"] = _write_v73(folder / "v73.mat", {"time": trace.time, "time_unit": "s",
                                                        "accel": trace.accel_kg / KG_PER_G,
@@ -68,6 +71,30 @@ def _h5py():
     except ImportError:
         return None
     return h5py
+
+
+def _asammdf():
+    try:
+        import asammdf
+    except ImportError:
+        return None
+    return asammdf
+
+
+def _write_mdf(path, t, g):
+    """An MDF 4.10 file by asammdf's own writer: a slow group (a temperature at 1 kHz) first,
+    then the pulse in g on its own time base, as a recorder of mixed rates writes them."""
+    from asammdf import MDF, Signal
+
+    mdf = MDF(version="4.10")
+    slow = np.arange(50) / 1000.0
+    mdf.append([Signal(np.full(50, 21.0), slow, name="temperature", unit="degC")],
+               comment="slow")
+    mdf.append([Signal(np.asarray(g, dtype=float), np.asarray(t, dtype=float), name="accel",
+                       unit="g")], comment="fast")
+    mdf.save(path, overwrite=True)
+    mdf.close()
+    return path
 
 
 def _pyuff():
@@ -134,7 +161,7 @@ def test_scipy_reads_our_v73_header_as_v73(pulse):
         assert matfile_version(fh) == (2, 0)
 
 
-@pytest.mark.parametrize("kind", ["v5", "fs", "v73", "ascii", "binary"])
+@pytest.mark.parametrize("kind", ["v5", "fs", "v73", "ascii", "binary", "mdf"])
 def test_accept_gives_the_csvs_verdict_and_figures(pulse, kind, tmp_path):
     """Every criterion's value from the file equals the CSV's: bit for bit where the file
     holds the CSV's numbers (kG and the time vector); within 1e-12 relative where it holds
@@ -147,13 +174,13 @@ def test_accept_gives_the_csvs_verdict_and_figures(pulse, kind, tmp_path):
     if kind not in files:
         pytest.skip("needs h5py or pyuff")
     uff = kind in ("ascii", "binary")
-    channel = {"channel": "accel"} if uff else {}
+    channel = {"channel": "accel"} if uff or kind == "mdf" else {}
     reference = airgun_xl.accept(TEMPLATE, files["uff_csv" if uff else "csv"], **SPEC)
     found = airgun_xl.accept(TEMPLATE, files[kind], **SPEC, **channel)
     assert found.verdict.word == reference.verdict.word == "PASS"
     for mine, theirs in zip(found.verdict.criteria, reference.verdict.criteria, strict=True):
         assert (mine.name, mine.unit, mine.passed) == (theirs.name, theirs.unit, theirs.passed)
-        if kind in ("v5", "binary"):
+        if kind in ("v5", "binary", "mdf"):
             assert mine.value == theirs.value, mine.name
         else:
             rel = 1e-11 if kind == "ascii" else 1e-12
@@ -441,3 +468,64 @@ def test_a_unit_a_case_away_is_still_refused_from_a_file(tmp_path, capsys):
     savemat(path, {"fs": 1e4, "accel": np.ones(64), "accel_unit": "KG"})
     assert main(["accept", str(TEMPLATE), str(path), "--peak", "9kG:10%"]) == 2
     assert "names 'KG', a case away from 'kG'" in capsys.readouterr().err
+
+
+def test_an_mdf_files_channels_keep_their_own_rates_and_damage_is_one_line(pulse, tmp_path,
+                                                                          capsys):
+    """``recording`` lists each MDF channel on its own group's time base (1 kHz and 51.2
+    kHz); a channel chosen by number; damaged copies (read in a child process: asammdf
+    crashed the process on such files) give a verdict or one line, never a traceback or the
+    library's own output."""
+    folder, trace, files = pulse
+    if "mdf" not in files:
+        pytest.skip("needs asammdf")
+    assert main(["recording", str(files["mdf"]), "--json"]) == 0
+    listed = json.loads(capsys.readouterr().out)
+    assert listed["format"] == "ASAM MDF"
+    assert [(c["name"], c["unit"], c["samples"]) for c in listed["channels"]] == [
+        ("temperature", "degC", 50), ("accel", "g", len(trace.time))]
+    assert listed["channels"][0]["rate_hz"] == pytest.approx(1000, rel=1e-12)
+    assert listed["channels"][1]["rate_hz"] == pytest.approx(51_200, rel=1e-9)
+    assert listed["channels"][1]["start_s"] == trace.time[0]
+    by_number = airgun_xl.accept(TEMPLATE, files["mdf"], **SPEC, channel="2")
+    assert by_number.verdict.word == "PASS"
+    good = files["mdf"].read_bytes()
+    rng = np.random.default_rng(1)
+    for k in range(6):
+        damaged = bytearray(good)
+        for at in rng.integers(0, len(good), 12):
+            damaged[at] = int(rng.integers(0, 256))
+        path = tmp_path / f"damaged{k}.mf4"
+        path.write_bytes(bytes(damaged[: len(good) - int(rng.integers(0, len(good) // 2))]))
+        code = main(["accept", str(TEMPLATE), str(path), "--peak", "9kG:10%", "--channel",
+                     "accel"])
+        err = capsys.readouterr().err
+        assert code in (0, 2, 3) and (code != 2 or err.count("\n") == 1), (k, err)
+        assert "Traceback" not in err and "Exception ignored" not in err, (k, err)
+
+
+@pytest.mark.skipif(os.name != "posix", reason="the stand-in interpreter is a shell script")
+@pytest.mark.parametrize("script, message", [
+    ("kill -SEGV $$", "the MDF reader (asammdf) stopped on this file (exit -11)"),
+    ("exec sleep 30", "the MDF reader (asammdf) took over 1 s on this file"),
+    ("echo 'not json'", "the MDF reader's reply is not readable"),
+])
+def test_the_mdf_childs_crash_hang_or_garbage_is_one_line(tmp_path, monkeypatch, script,
+                                                          message):
+    """The child process's end, whatever it is, is one WorkbookError line naming the file: a
+    crash (a stand-in interpreter that kills itself with SIGSEGV), a hang past the timeout
+    (killed), a reply that is not the protocol's."""
+    import sys
+
+    from airgun_xl.readers.formats import mdf
+
+    stand_in = tmp_path / "python"
+    stand_in.write_text(f"#!/bin/sh\ncat > /dev/null\n{script}\n")
+    stand_in.chmod(0o755)
+    monkeypatch.setattr(sys, "executable", str(stand_in))
+    monkeypatch.setattr(mdf, "TIMEOUT", 1.0)
+    path = tmp_path / "r.mf4"
+    path.write_bytes(b"MDF     4.10    " + bytes(64))
+    with pytest.raises(airgun_xl.WorkbookError) as caught:
+        mdf.read(path, path.read_bytes(), None)
+    assert str(caught.value).startswith(f"{path}: {message}"), str(caught.value)

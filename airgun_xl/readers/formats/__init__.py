@@ -28,7 +28,7 @@ from pathlib import Path
 from types import ModuleType
 
 from ..guard import read_bytes
-from . import mat, tdms, uff
+from . import mat, mdf, tdms, uff
 from .channels import ChannelInfo, choose
 
 #: Bytes read to tell a format by its content (a MATLAB v7.3 file's HDF5 signature is at 512).
@@ -36,9 +36,9 @@ HEAD = 1024
 
 #: The formats told by content, in the order they are tried; a file none of them claims is
 #: read as CSV.
-FORMATS: tuple[ModuleType, ...] = (tdms, mat, uff)
+FORMATS: tuple[ModuleType, ...] = (tdms, mat, mdf, uff)
 
-EXPECTED_RECORDING = "expected a recording (CSV, TDMS, MATLAB .mat or UFF 58)"
+EXPECTED_RECORDING = "expected a recording (CSV, TDMS, MATLAB .mat, MDF or UFF 58)"
 
 
 def detect(path: str | Path) -> ModuleType | None:
