@@ -56,6 +56,8 @@ def pulse(tmp_path_factory):
         files["uff_csv"] = folder / "uff_ref.csv"
         files["uff_csv"].write_text("time [s],acceleration [g]\n" + "".join(
             f"{x!r},{y!r}\n" for x, y in zip(stored.tolist(), g.tolist(), strict=True)))
+    test = _write_mme(folder / "mme", trace.time, trace.accel_kg / KG_PER_G)
+    files["mme"] = test.parent / "Channel" / "TEST.002"
     if _asammdf() is not None:
         files["mdf"] = _write_mdf(folder / "shot.mf4", trace.time, trace.accel_kg / KG_PER_G)
     if _h5py() is not None:
@@ -307,7 +309,7 @@ def _mutations():
                     max_size=12), st.integers(0, 10**6)
 
 
-@pytest.mark.parametrize("kind", ["v5", "fs", "v73", "ascii", "binary"])
+@pytest.mark.parametrize("kind", ["v5", "fs", "v73", "ascii", "binary", "mme"])
 def test_any_damage_to_a_recording_is_a_trace_or_one_error(pulse, kind):
     """Bytes overwritten anywhere, and the file cut anywhere (hypothesis, derandomized): the
     reader gives a Trace or one AirgunXlError, never another exception or a warning."""
@@ -322,7 +324,7 @@ def test_any_damage_to_a_recording_is_a_trace_or_one_error(pulse, kind):
         pytest.skip("needs h5py or pyuff")
     good = files[kind].read_bytes()
     flips, cuts = _mutations()
-    target = folder / f"damaged_{kind}{files[kind].suffix}"
+    target = folder / f"damaged_{kind}{files[kind].suffix}"  # an MME channel file: .002
 
     @settings(max_examples=120, deadline=None, derandomize=True, database=None,
               suppress_health_check=list(HealthCheck))
@@ -529,3 +531,105 @@ def test_the_mdf_childs_crash_hang_or_garbage_is_one_line(tmp_path, monkeypatch,
     with pytest.raises(airgun_xl.WorkbookError) as caught:
         mdf.read(path, path.read_bytes(), None)
     assert str(caught.value).startswith(f"{path}: {message}"), str(caught.value)
+
+
+def _write_mme(folder, t, g, encoding="utf-8-sig", explicit=False, unit="g", count=None):
+    """An ISO 13499 MME test in the standard's layout: TEST.mme, Channel/TEST.chn and a
+    channel file each (a temperature, then the pulse), header fields as ``Name :value``
+    with NOVALUE where a field is not given, the samples one a line (the time implicit) or
+    time and value a line (explicit)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "Channel").mkdir(exist_ok=True)
+    (folder / "TEST.mme").write_bytes(
+        "Data format edition number  :1.6\nLaboratory name             :Air gun lab\n"
+        "Title                       :Bird shot 17 (°C, ±)\nNumber of channels          :2\n"
+        .encode(encoding))
+    (folder / "Channel" / "TEST.chn").write_bytes(
+        "Instrumentation standard    :NOVALUE\nNumber of channels          :2\n"
+        "Name of channel 001         :Temperature\nName of channel 002         :Bird X\n"
+        .encode(encoding))
+
+    def channel(name, code, values, unit):
+        lines = ["Instrumentation standard    :NOVALUE",
+                 f"Name of the channel         :{name}",
+                 "Laboratory channel code     :NOVALUE",
+                 f"Channel code                :{code}",
+                 f"Unit                        :{unit}",
+                 f"Time of first sample        :{'NOVALUE' if explicit else repr(float(t[0]))}",
+                 f"Sampling interval           :"
+                 f"{'NOVALUE' if explicit else repr(float(t[1] - t[0]))}",
+                 f"Number of samples           :{len(values) if count is None else count}",
+                 "Channel frequency class     :NOVALUE"]
+        rows = ([f"{x!r} {y!r}" for x, y in zip(t.tolist(), values.tolist(), strict=True)]
+                if explicit else [repr(y) for y in values.tolist()])
+        return ("\n".join(lines + rows) + "\n").encode(encoding)
+
+    (folder / "Channel" / "TEST.001").write_bytes(
+        channel("Temperature °C", "00TEMP000000TE00", np.full(len(t), 21.0), "°C"))
+    (folder / "Channel" / "TEST.002").write_bytes(
+        channel("Bird X", "10BIRD0000XXACXP", g, unit))
+    return folder / "TEST.mme"
+
+
+@pytest.mark.parametrize("encoding", ["utf-8-sig", "cp1252", "latin-1"])
+@pytest.mark.parametrize("explicit", [False, True])
+def test_an_mme_test_gives_the_csvs_verdict(pulse, tmp_path, encoding, explicit):
+    """The pulse as an MME test, in each encoding, its time implicit (the header's first
+    sample and interval) or explicit: accept gives the CSV's verdict, every figure within a
+    product's rounding (the time t0 + k dt, the g to kG); chosen by name, channel code or
+    number alike."""
+    folder, trace, files = pulse
+    g = trace.accel_kg / KG_PER_G
+    mme = _write_mme(tmp_path / "t", trace.time, g, encoding, explicit, unit="m/s²"
+                     if encoding != "utf-8-sig" else "g")
+    if encoding != "utf-8-sig":  # the same pulse in m/s² (the unit's ² in the encoding)
+        mme = _write_mme(tmp_path / "t", trace.time, g * G, encoding, explicit, unit="m/s²")
+    reference = airgun_xl.accept(TEMPLATE, files["csv"], **SPEC)
+    verdicts = [airgun_xl.accept(TEMPLATE, mme, **SPEC, channel=c)
+                for c in ("Bird X", "10BIRD0000XXACXP", "2")]
+    for found in verdicts:
+        assert found.verdict.word == reference.verdict.word == "PASS"
+        for mine, theirs in zip(found.verdict.criteria, reference.verdict.criteria,
+                                strict=True):
+            assert mine.value == pytest.approx(theirs.value, rel=1e-12), mine.name
+    listed = airgun_xl.recording(mme)
+    assert listed.format == "ISO 13499 MME"
+    assert [(c.name, c.unit) for c in listed.channels] == [
+        ("Temperature °C", "°C"), ("Bird X", "m/s²" if encoding != "utf-8-sig" else "g")]
+    # one channel file named alone is that channel
+    alone = airgun_xl.accept(TEMPLATE, mme.parent / "Channel" / "TEST.002", **SPEC)
+    assert [c.value for c in alone.verdict.criteria] == [
+        c.value for c in verdicts[0].verdict.criteria]
+
+
+def test_an_mme_test_that_lies_or_links_out_is_one_line(pulse, tmp_path, capsys):
+    """A sample count that is not the lines there are, a channel file that is a symlink (to
+    a file outside the test) or a FIFO, and a Channel folder that is a symlink: one line
+    each, exit 2, and nothing outside the test's folder read."""
+    folder, trace, files = pulse
+    g = trace.accel_kg / KG_PER_G
+
+    def refused(mme, said):
+        assert main(["accept", str(TEMPLATE), str(mme), "--peak", "9kG:10%", "--channel",
+                     "Bird X"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and said in err, err
+
+    lying = _write_mme(tmp_path / "lying", trace.time, g, count=len(g) + 3)
+    refused(lying, f"declares {len(g) + 3:,} samples and holds {len(g):,}")
+    huge = _write_mme(tmp_path / "huge", trace.time, g, count=10**12)
+    refused(huge, "channel 'Bird X' declares 1,000,000,000,000 samples, expected at most")
+    linked = _write_mme(tmp_path / "linked", trace.time, g)
+    outside = tmp_path / "outside.002"
+    outside.write_bytes((linked.parent / "Channel" / "TEST.002").read_bytes())
+    (linked.parent / "Channel" / "TEST.002").unlink()
+    (linked.parent / "Channel" / "TEST.002").symlink_to(outside)
+    refused(linked, "TEST.002: is not a regular file (a symlink or a device)")
+    fifo = _write_mme(tmp_path / "fifo", trace.time, g)
+    (fifo.parent / "Channel" / "TEST.002").unlink()
+    os.mkfifo(fifo.parent / "Channel" / "TEST.002")
+    refused(fifo, "TEST.002: is not a regular file (a symlink or a device)")
+    moved = _write_mme(tmp_path / "moved", trace.time, g)
+    (moved.parent / "Channel").rename(tmp_path / "elsewhere")
+    (moved.parent / "Channel").symlink_to(tmp_path / "elsewhere", target_is_directory=True)
+    refused(moved, "its Channel folder is not a folder (a symlink or a file)")

@@ -97,11 +97,11 @@ def anti_alias_value(text):
 #: The help of a command's recording argument (compare-measured, accept).
 RECORDING_HELP = ("a CSV (time, acceleration, units in the header), a workbook's columns "
                   "(trace.xlsx:Sheet1!A:B), a LabVIEW TDMS file, a MATLAB .mat file, an "
-                  "ASAM MDF file or a Universal File (dataset 58)")
+                  "ASAM MDF file, a Universal File (dataset 58) or an ISO 13499 MME test")
 
 
 def add_recording_options(p, channel_help="the channel of a file of several (TDMS, .mat, .mf4, "
-                                          ".uff): "
+                                          ".uff, .mme): "
                                           "its name, or its number as 'airgun-xl recording "
                                           "FILE' lists it (default: the first)",
                           anti_alias=True,

@@ -1,5 +1,5 @@
 """A measured pulse from a CSV file, a workbook's column range or a recorder's file (TDMS,
-MATLAB, MDF, UFF: :mod:`.formats`): time and acceleration, with units from the header (``time
+MATLAB, MDF, UFF, MME: :mod:`.formats`): time and acceleration, with units from the header (``time
 [ms]``, ``accel (g)``, a channel's unit as its file states it) or given, every row checked;
 and a required shock response spectrum (CSV).
 
@@ -260,7 +260,7 @@ def _source_table(path, channel=None):
         return fmt.read(path, read_bytes(path, fmt.EXPECTED, fmt.NAME), channel)
     if channel is not None:
         raise OptionError("--channel: found with a CSV file, expected it only with a file of "
-                          "several channels (TDMS, MATLAB .mat, MDF, UFF)")
+                          "several channels (TDMS, MATLAB .mat, MDF, UFF, MME)")
     return _table(path, EXPECTED, ("time", "acceleration"))
 
 

@@ -28,7 +28,7 @@ from pathlib import Path
 from types import ModuleType
 
 from ..guard import read_bytes
-from . import mat, mdf, tdms, uff
+from . import mat, mdf, mme, tdms, uff
 from .channels import ChannelInfo, choose
 
 #: Bytes read to tell a format by its content (a MATLAB v7.3 file's HDF5 signature is at 512).
@@ -36,9 +36,10 @@ HEAD = 1024
 
 #: The formats told by content, in the order they are tried; a file none of them claims is
 #: read as CSV.
-FORMATS: tuple[ModuleType, ...] = (tdms, mat, mdf, uff)
+FORMATS: tuple[ModuleType, ...] = (tdms, mat, mdf, uff, mme)
 
-EXPECTED_RECORDING = "expected a recording (CSV, TDMS, MATLAB .mat, MDF or UFF 58)"
+EXPECTED_RECORDING = ("expected a recording (CSV, TDMS, MATLAB .mat, MDF, UFF 58 or ISO 13499 "
+                      "MME)")
 
 
 def detect(path: str | Path) -> ModuleType | None:
@@ -49,6 +50,8 @@ def detect(path: str | Path) -> ModuleType | None:
         if fmt.sniff(head):
             return fmt
     suffix = Path(path).suffix.lower()
+    if mme.channel_file(path):
+        return mme
     return next((fmt for fmt in FORMATS if suffix in fmt.SUFFIXES), None)
 
 
