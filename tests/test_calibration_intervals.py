@@ -266,3 +266,23 @@ def test_the_terminal_and_the_calibration_page_show_each_nodes_interval(tmp_path
     assert "Node velocity (m/s)" in cells and cells.count("WEAKLY") >= 1
     assert any(isinstance(c, str) and "weakly pinned" in c and "would pin it best" in c
                for c in cells)
+
+
+def test_a_tilt_not_pinned_is_named_as_the_laws_tilt_not_as_an_option():
+    """The tilt is fitted by next's law update, not by a --fit name: a tilt at its bound
+    or not pinned is named as the law's tilt with speed (it read '--fit tilt', an option
+    that does not exist), and a --fit parameter keeps its option's name."""
+    from types import SimpleNamespace
+
+    from airgun_xl.studies.calibrate import TILT_REACH, verdict
+
+    cal = SimpleNamespace(fitted={"tilt": TILT_REACH, "scale": 1.1},
+                          bounds={"tilt": (-TILT_REACH, TILT_REACH), "scale": (0.5, 2.0)},
+                          errors={"tilt": 0.01, "scale": 0.9}, law_calibration=None,
+                          before=[], after=[])
+    found, _ = verdict(cal, None, "l2", None)
+    assert found == [
+        f"the law's tilt with speed: {TILT_REACH:.6g} is at its bound "
+        f"({-TILT_REACH:.4g}..{TILT_REACH:.4g}): not identified by these pulses",
+        "--fit scale: 1.1 +/- 0.9 (1 standard error): the pulses do not pin it down (not "
+        "identified)"]
