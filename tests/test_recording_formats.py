@@ -3,9 +3,11 @@ writer (scipy's savemat for MATLAB v5, h5py for v7.3 with MATLAB's header and cl
 the pulse of a reference CSV: accept, compare-measured and calibrate give the same verdicts
 and figures from each; the channels are listed, chosen by name or number; a file that lies is
 one line, exit 2, nothing written."""
+import gc
 import io
 import json
 import os
+import warnings
 
 import numpy as np
 import pytest
@@ -77,7 +79,9 @@ def _h5py():
 
 def _asammdf():
     try:
-        import asammdf
+        with warnings.catch_warnings():  # asammdf 8.1's canmatrix import is deprecated
+            warnings.simplefilter("ignore", DeprecationWarning)
+            import asammdf
     except ImportError:
         return None
     return asammdf
@@ -127,7 +131,10 @@ def _write_uff58(path, binary, channels):
             orddenom_axis_units_lab="NONE", z_axis_spec_data_type=0, z_axis_len_unit_exp=0,
             z_axis_force_unit_exp=0, z_axis_temp_unit_exp=0, z_axis_axis_units_lab="NONE",
             data=np.asarray(values, dtype=float), x=np.asarray(t, dtype=float))
-        uff.write_sets(dataset, mode="add")
+        with warnings.catch_warnings():  # pyuff 2.5.0's writer leaves its file to the GC
+            warnings.simplefilter("ignore", ResourceWarning)
+            uff.write_sets(dataset, mode="add")
+            gc.collect()
     return path
 
 
@@ -165,10 +172,11 @@ def test_scipy_reads_our_v73_header_as_v73(pulse):
 
 @pytest.mark.parametrize("kind", ["v5", "fs", "v73", "ascii", "binary", "mdf"])
 def test_accept_gives_the_csvs_verdict_and_figures(pulse, kind, tmp_path):
-    """Every criterion's value from the file equals the CSV's: bit for bit where the file
-    holds the CSV's numbers (kG and the time vector); within 1e-12 relative where it holds
-    them in g or its time as fs and t0 (a product's rounding); for UFF's ASCII dataset 58,
-    within its stored precision (4E20.12: 13 significant digits, so 1e-11 relative). A UFF
+    """Every criterion's value from the file equals the CSV's within 1e-12 relative: the file
+    holds the samples in g or its time in ms, or as fs and t0, and a product's rounding is
+    in the last bits (the same on one numpy version, a few ulps apart on another, measured
+    on the lowest versions); for UFF's ASCII dataset 58, within its stored precision
+    (4E20.12: 13 significant digits, so 1e-11 relative). A UFF
     file's time base is its header's start and increment, stored as E13.5: its reference is
     the CSV of the same samples on that time base. Its second time response is chosen by its
     name."""
@@ -182,11 +190,8 @@ def test_accept_gives_the_csvs_verdict_and_figures(pulse, kind, tmp_path):
     assert found.verdict.word == reference.verdict.word == "PASS"
     for mine, theirs in zip(found.verdict.criteria, reference.verdict.criteria, strict=True):
         assert (mine.name, mine.unit, mine.passed) == (theirs.name, theirs.unit, theirs.passed)
-        if kind in ("v5", "binary", "mdf"):
-            assert mine.value == theirs.value, mine.name
-        else:
-            rel = 1e-11 if kind == "ascii" else 1e-12
-            assert mine.value == pytest.approx(theirs.value, rel=rel), mine.name
+        rel = 1e-11 if kind == "ascii" else 1e-12
+        assert mine.value == pytest.approx(theirs.value, rel=rel), mine.name
 
 
 def test_compare_measured_and_calibrate_give_the_csvs_figures(pulse):
