@@ -436,3 +436,19 @@ def test_shots_at_two_speeds_pin_the_laws_tilt_with_its_covariance():
     one = update_scale(params[:1], traces[:1], LEGACY_LAW)
     assert not one.tilted and "its shape over speed stays the prior's" in one.note
     assert law_scatter(one)[3] is True
+
+
+def test_chunk_without_a_cluster_is_refused_before_any_work(tmp_path, capsys):
+    """--chunk without --scheduler or --workers is one line before the shot is judged or the
+    law fitted (it came after the law's fit): no archive folder, no workbook."""
+    shot = tmp_path / "shot.xlsx"
+    shot.write_bytes(TEMPLATE.read_bytes())
+    recording = write_trace_csv(tmp_path / "rec.csv", synthetic_measurement(
+        airgun_xl.load(shot).params, dt=1 / 51_200, seed=3))
+    code = main(["next", str(shot), str(recording), "--archive", str(tmp_path / "arch"),
+                 "--lot", "L", "--new-lot", "--sd", "A28=1.5%", "--peak", "9.3kG:5%",
+                 "--chunk", "8"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and err == ["airgun-xl: error: --chunk: found it without --scheduler or "
+                                 "--workers, expected one of them (chunks are for a cluster)"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rec.csv", "shot.xlsx"]

@@ -187,6 +187,9 @@ def _checked(request: NextRequest) -> Path:
                           "digits, '-', '_' and '.' (such as LOT-2026-07)")
     if request.vary is not None:
         second_knob(request.vary)
+    from .running import check_cluster
+
+    check_cluster(request.scheduler, request.workers, request.chunk)  # before the law's fit
     output = request.output if request.output is not None else default_output(request.shot)
     check_output(output, request.force, inputs=[request.shot, input_file(request.recording)])
     if request.pdf is not None:

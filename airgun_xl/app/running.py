@@ -9,6 +9,15 @@ from typing import Any
 from ..errors import OptionError
 
 
+def check_cluster(scheduler: str | None = None, workers: int | None = None,
+                  chunk: int | None = None) -> None:
+    """Refuse ``chunk`` without a cluster: called before any work (and by
+    :func:`cluster_runner`)."""
+    if scheduler is None and workers is None and chunk is not None:
+        raise OptionError("--chunk: found it without --scheduler or --workers, expected one "
+                          "of them (chunks are for a cluster)")
+
+
 @contextlib.contextmanager
 def cluster_runner(scheduler: str | None = None, workers: int | None = None,
                    chunk: int | None = None) -> Iterator[Any]:
@@ -22,10 +31,8 @@ def cluster_runner(scheduler: str | None = None, workers: int | None = None,
     airgun_xl.errors.OptionError
         ``chunk`` without a cluster.
     """
+    check_cluster(scheduler, workers, chunk)
     if scheduler is None and workers is None:
-        if chunk is not None:
-            raise OptionError("--chunk: found it without --scheduler or --workers, expected "
-                              "one of them (chunks are for a cluster)")
         yield None
         return
     from ..studies.cluster import DEFAULT_CHUNK, ClusterRunner, connect
