@@ -231,7 +231,7 @@ def _write_warnings(wb, result, style, shot):
     ws.write_row(row + 1, 0, ["Shots", "Warning (as the first shot with it says it)"], bold)
     row += 2
     for text, n in sorted(counts.items(), key=lambda item: -item[1])[:40]:
-        ws.write_number(row, 0, n, style.of("count"))
+        ws.write_number(row, 0, n, style.of("count", valign="top"))  # beside its text's top
         ws.write_string(row, 1, text, style.wrap)
         fit_wrapped_row(ws, row, text, WARNING_CHARS)
         row += 1
