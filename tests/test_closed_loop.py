@@ -393,7 +393,8 @@ def test_next_draws_the_estimated_scatter_from_the_eighth_shot_and_says_so(tmp_p
                               output=tmp_path / "n7.xlsx", **SPEC)
     assert re.fullmatch(r"the gun's scatter \d\.\d\d% \(95 % interval \d\.\d\d%-\d\.\d\d%\), "
                         r"estimated from 8 shots' launch velocities fitted against their set "
-                        r"values", out.gun), out.gun
+                        r"values \(their mean [+-]\d\.\d\d% \+/- \d\.\d\d% off them\)",
+                        out.gun), out.gun
     assert out.update.shots == 8 and len(out.update.launch) == 8
     assert json.loads(out.to_json())["gun"] == out.gun
     again = airgun_xl.next_shot(shot, rec, archive=archive, lot="LOT-G", shots=100,
@@ -452,3 +453,18 @@ def test_chunk_without_a_cluster_is_refused_before_any_work(tmp_path, capsys):
     assert code == 2 and err == ["airgun-xl: error: --chunk: found it without --scheduler or "
                                  "--workers, expected one of them (chunks are for a cluster)"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["rec.csv", "shot.xlsx"]
+
+
+def test_a_gun_that_fires_off_its_setting_is_said_and_warned_of():
+    """The mean offset of the lot's launch velocities from their set values is printed with
+    the scatter; past two standard errors it is a warning (the draws assume none), within
+    them it is not."""
+    from airgun_xl.studies.closed_loop import GunScatter
+
+    off = GunScatter(0.015, (0.010, 0.030), 8, 0.031, 0.005)
+    assert off.words().endswith("(their mean +3.10% +/- 0.50% off them)")
+    assert off.warnings == [
+        "the gun fires +3.10% (+/- 0.50%) off its set velocity on average over the lot's 8 "
+        "shots: the setting proposed is the velocity to fire, which this gun reaches set that "
+        "much the other way; the draws assume no such offset"]
+    assert GunScatter(0.015, (0.010, 0.030), 8, -0.009, 0.005).warnings == []
