@@ -253,28 +253,47 @@ def test_a_name_the_font_cannot_draw_is_written_by_code_point_without_a_library_
     assert "Recording: \\u6d4b\\u8bd5.csv" in " ".join(_text(tmp_path / "r.pdf").split())
 
 
-@pytest.mark.parametrize("command", ["fill", "accept", "design", "next"])
-def test_a_pdf_in_another_folder_than_its_workbook_is_one_line_before_any_work(
+@pytest.mark.parametrize("command", ["fill", "accept"])
+def test_a_pdf_in_another_folder_than_its_workbook_is_published_after_it(
         fired, command, tmp_path, capsys):
-    """The workbook and its PDF are published together, under one folder's lock and journal:
-    a PDF elsewhere is refused in one line, exit 2, nothing written (it was a ValueError's
-    traceback once the fill had run)."""
+    """A PDF in another folder than its workbook (accept's default workbook is beside the
+    shot) is written: the workbook's publication first, then the PDF's in its own folder (it
+    was a ValueError's traceback once the fill had run). Beside each other they are published
+    together."""
     folder, shot, rec = fired
     (tmp_path / "w").mkdir()
     (tmp_path / "p").mkdir()
     out, pdf = tmp_path / "w" / "r.xlsx", tmp_path / "p" / "r.pdf"
-    argv = {"fill": ["fill", str(shot)],
-            "accept": ["accept", str(shot), str(rec), "--peak", "9.3kG:5%"],
-            "design": ["design", str(shot), "--target-peak", "12kG"],
-            "next": ["next", str(shot), str(rec), "--archive", str(tmp_path / "w" / "a"),
-                     "--lot", "L", "--peak", "9.3kG:5%"]}[command]
-    code = main([*argv, "-o", str(out), "--pdf", str(pdf)])
-    err = capsys.readouterr().err.strip().splitlines()
-    assert code == 2 and len(err) == 1, err
-    assert err[0] == (f"airgun-xl: error: --pdf: found {pdf}, in another folder than {out}, "
-                      "expected a file beside it (the two are published together, or "
-                      "neither)"), err
-    assert list((tmp_path / "w").iterdir()) == list((tmp_path / "p").iterdir()) == []
+    argv = {"fill": ["fill", str(shot), "--only", "summary"],
+            "accept": ["accept", str(shot), str(rec), "--peak", "9.3kG:5%"]}[command]
+    code = main([*argv, "-o", str(out), "--pdf", str(pdf), "--quiet"])
+    assert code == 0, capsys.readouterr().err
+    assert [p.name for p in (tmp_path / "w").iterdir()] == ["r.xlsx"]
+    assert [p.name for p in (tmp_path / "p").iterdir()] == ["r.pdf"]
+    assert pdf.read_bytes()[:4] == b"%PDF"
+
+
+def test_a_later_file_that_cannot_be_published_says_the_first_was(tmp_path):
+    """When the PDF's publication fails after the workbook's was committed (its name taken
+    meanwhile by another command), the one line says the workbook was written; the PDF's
+    temp file is gone and the other command's file untouched."""
+    from airgun_xl.transaction import Publication, commit_after, for_file
+
+    (tmp_path / "w").mkdir()
+    (tmp_path / "p").mkdir()
+    pub = Publication()
+    pub.stage(tmp_path / "w" / "r.xlsx").write_bytes(b"workbook")
+    later = for_file(pub, tmp_path / "p" / "r.pdf")
+    assert later is not pub and for_file(pub, tmp_path / "w" / "r.pdf") is pub
+    later.stage(tmp_path / "p" / "r.pdf").write_bytes(b"pdf")
+    pub.commit()
+    (tmp_path / "p" / "r.pdf").write_bytes(b"another command's")
+    with pytest.raises(airgun_xl.OutputError) as caught:
+        commit_after(pub, later)
+    assert str(caught.value).endswith(f"; {tmp_path / 'w' / 'r.xlsx'} was written")
+    assert (tmp_path / "w" / "r.xlsx").read_bytes() == b"workbook"
+    assert [p.name for p in (tmp_path / "p").iterdir()] == ["r.pdf"]
+    assert (tmp_path / "p" / "r.pdf").read_bytes() == b"another command's"
 
 
 def test_one_folder_named_two_ways_is_one_folder(tmp_path, monkeypatch):

@@ -306,10 +306,11 @@ def test_the_template_opens_on_sheet1_alone(tmp_path):
     assert [ws.title for ws in wb.worksheets if ws.sheet_view.tabSelected] == ["Sheet1"]
 
 
-@pytest.mark.parametrize("kind", ["grid", "montecarlo"])
-def test_a_sweeps_warning_counts_sit_at_their_texts_top(workbooks, kind):
+def test_a_sweeps_warning_counts_sit_at_their_texts_top(workbooks):
     """Each warning's count is top-aligned beside its wrapped text (it sat at the bottom of
-    a row several lines tall, beside the next warning's first line)."""
+    a row several lines tall, beside the next warning's first line); the grid's shots have
+    warnings (the Monte Carlo's here have none)."""
+    kind = "grid"
     ws = openpyxl.load_workbook(workbooks[kind])["Warnings"]
     rows = [r for r in range(1, ws.max_row + 1)
             if isinstance(ws.cell(r, 1).value, int) and isinstance(ws.cell(r, 2).value, str)]

@@ -215,11 +215,12 @@ def _write(request: AcceptRequest, shot: Shot, verdict: Verdict, trace: Any, rec
     the archive too if this made it), and ``--force`` replaces both or neither. The
     record's path."""
     from ..reports.acceptance import write_acceptance
-    from ..transaction import Publication, signals_held
+    from ..transaction import Publication, commit_after, for_file, signals_held
 
     stored = None
+    pub = later = Publication(request.force)
     try:
-        with Publication(request.force) as pub:
+        with pub:
             if request.output is not None:
                 if request.archive is not None:
                     from ..archive.verdicts import store_verdict
@@ -231,14 +232,18 @@ def _write(request: AcceptRequest, shot: Shot, verdict: Verdict, trace: Any, rec
                 write_acceptance(request.output, verdict,
                                  _about(request, verdict, trace, rec), pulse, spectra,
                                  request.force, shot=Path(request.shot).name, publication=pub)
-            if request.pdf is not None:
+            if request.pdf is not None:  # in another folder: published after the workbook
+                later = for_file(pub, request.pdf, request.force)
                 _write_pdf(request, verdict, trace, rec, pulse, spectra,
-                           pub.stage(request.pdf))
+                           later.stage(request.pdf))
             pub.commit()
     except BaseException:
+        if later is not pub:  # pub aborted itself on leaving its block
+            later.abort()
         if stored is not None:
             stored.take_back()
         raise
+    commit_after(pub, later)
     return stored.path if stored is not None else None
 
 

@@ -34,7 +34,14 @@ from ..reports.fill import render_workbook
 from ..reports.sidecar import SIDECAR_SUFFIXES, render_history, sidecar_path
 from ..specification import Specification, check, combine
 from ..studies.check import after_run, before_run, quirk_fired, unloading_diverged
-from ..transaction import Publication, check_output, display, signals_held
+from ..transaction import (
+    Publication,
+    check_output,
+    commit_after,
+    display,
+    for_file,
+    signals_held,
+)
 from ..version import __version__
 from ..xlsx.sheets import flagged_figures, variant_name
 from .settings import FillSettings, output_of
@@ -305,9 +312,11 @@ def _publish(shot: Shot, filled: Filled, output: Path, outputs: Outputs, info: P
                                       info, shown=output))
         filled = dataclasses.replace(filled, warnings=tuple(record))
         workbook = pub.files[0][0]
+        later = pub  # a PDF in another folder: published after the workbook (for_file)
         if options.pdf is not None:
             progress("writing the PDF")
-            _write_pdf(shot, filled, pub.stage(options.pdf), info, options, record)
+            later = for_file(pub, options.pdf, options.force, options.force_word)
+            _write_pdf(shot, filled, later.stage(options.pdf), info, options, record)
         if sidecar is not None:
             progress("writing the sidecar")
             render_history(result, pub.stage(sidecar), shown=sidecar)
@@ -328,9 +337,12 @@ def _publish(shot: Shot, filled: Filled, output: Path, outputs: Outputs, info: P
             pub.commit()
         except BaseException:
             pub.abort()  # the entry's scratch first, then the archive this fill created
+            if later is not pub:
+                later.abort()
             if archive is not None:
                 archive.remove_if_unused()
             raise
+    commit_after(pub, later)
     return dataclasses.replace(filled, entry=pending.entry if pending is not None else None)
 
 

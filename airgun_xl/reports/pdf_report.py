@@ -78,17 +78,15 @@ def require_matplotlib(option: str = "--pdf") -> None:
 
 def check_pdf(pdf: Path, force: bool, inputs: Sequence[Any] = (), beside: Path | None = None,
               force_word: str = "--force") -> None:
-    """``--pdf``: refused before any work when matplotlib is missing, when ``pdf`` is a file
-    the command may not write (:func:`~airgun_xl.transaction.check_output`), or when it is
-    not in the folder of ``beside``, the workbook published with it
-    (:func:`~airgun_xl.transaction.check_beside`)."""
-    from ..transaction import check_beside, check_output
+    """``--pdf``: refused before any work when matplotlib is missing, or when ``pdf`` is a
+    file the command may not write (:func:`~airgun_xl.transaction.check_output`: an input,
+    or ``beside``, the workbook written with it). Beside its workbook the two are published
+    together; in another folder, after it (:func:`~airgun_xl.transaction.for_file`)."""
+    from ..transaction import check_output
 
     require_matplotlib()
     check_output(pdf, force, inputs=[*inputs, *([beside] if beside is not None else [])],
                  suffixes=(".pdf",), force_word=force_word)
-    if beside is not None:
-        check_beside(pdf, beside, "--pdf")
 
 
 class _Pages:

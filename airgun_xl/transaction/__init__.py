@@ -7,10 +7,10 @@
 - :mod:`.publication`: staging, publishing and recovering a command's files together
   (``Publication``, ``atomic_path``, ``recover``).
 """
-from .checks import check_beside, check_output, display, same_folder, special_kind
+from .checks import check_output, display, same_folder, special_kind
 from .locks import folder_lock, fsync
 from .owners import owner_alive, owner_token
-from .publication import SUFFIX, Publication, atomic_path, recover
+from .publication import SUFFIX, Publication, atomic_path, commit_after, for_file, recover
 from .signals import (
     SIGNALS,
     Interrupted,
@@ -20,7 +20,7 @@ from .signals import (
     signals_held,
 )
 
-__all__ = ["SIGNALS", "SUFFIX", "Interrupted", "Publication", "atomic_path", "check_beside",
-           "check_output", "display", "folder_lock", "fsync", "note_signal", "on_signal",
-           "owner_alive", "owner_token", "recover", "reset_signals", "same_folder",
-           "signals_held", "special_kind"]
+__all__ = ["SIGNALS", "SUFFIX", "Interrupted", "Publication", "atomic_path", "check_output",
+           "commit_after", "display", "folder_lock", "for_file", "fsync", "note_signal",
+           "on_signal", "owner_alive", "owner_token", "recover", "reset_signals",
+           "same_folder", "signals_held", "special_kind"]

@@ -5,7 +5,7 @@ import os
 import stat
 from pathlib import Path
 
-from ..errors import OptionError, OutputError
+from ..errors import OutputError
 
 
 def display(path):
@@ -77,13 +77,3 @@ def same_folder(a, b):
         return os.path.samefile(first, second)
     except OSError:
         return os.path.abspath(first) == os.path.abspath(second)
-
-
-def check_beside(path, other, option):
-    """Refuse ``option``'s file ``path`` outside the folder of ``other``, a file published
-    with it: a command's files are published together, under one folder's lock and journal
-    (:class:`~airgun_xl.transaction.Publication`)."""
-    if not same_folder(path, other):
-        raise OptionError(f"{option}: found {display(path)}, in another folder than "
-                          f"{display(other)}, expected a file beside it (the two are "
-                          "published together, or neither)")

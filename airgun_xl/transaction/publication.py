@@ -74,7 +74,7 @@ class Publication:
         """A new empty temp file for ``final``, to be written by the caller."""
         final = Path(final)
         if self.files and not same_folder(final, self.files[0][1]):
-            raise ValueError("a publication's files share one folder")  # check_beside first
+            raise ValueError("a publication's files share one folder")  # for_file first
         if self.files:  # one folder by one path: the journal names its files in it
             final = self.files[0][1].parent / final.name
         temp = self._name(final, "tmp")
@@ -285,6 +285,28 @@ def recover(folder):
             with contextlib.suppress(OSError):
                 if entry.is_file(follow_symlinks=False) or entry.is_symlink():
                     os.unlink(entry.path)
+
+
+def for_file(pub, final, force=False, force_word="--force"):
+    """The publication ``final`` is staged in: ``pub`` when ``final`` shares its folder (the
+    two published together), else a new one for ``final``'s folder, to be committed after
+    ``pub`` by :func:`commit_after` (each file whole; a failure between them is said)."""
+    if not pub.files or same_folder(final, pub.files[0][1]):
+        return pub
+    return Publication(force, force_word)
+
+
+def commit_after(pub, later):
+    """Commit ``later`` (from :func:`for_file`) once ``pub`` is committed; when it cannot be
+    published, the error says that ``pub``'s files were."""
+    if later is pub:
+        return
+    with later:
+        try:
+            later.commit()
+        except OutputError as exc:
+            written = ", ".join(display(final) for _temp, final in pub.files)
+            raise OutputError(f"{exc}; {written} was written") from None
 
 
 @contextlib.contextmanager
