@@ -2,9 +2,12 @@
 ``--channel`` chooses one (:func:`choose`): the same in every format."""
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
-from ...errors import OptionError
+import numpy as np
+
+from ...errors import OptionError, WorkbookError
 
 
 @dataclass(frozen=True)
@@ -47,3 +50,15 @@ def choose(channel: str | None, names: list[str], kind: str = "channel") -> int:
     shown = ", ".join(names[:8]) + (", ..." if len(names) > 8 else "")
     raise OptionError(f"--channel: found {channel!r}, expected one of the file's {kind}s: "
                       f"{shown} (or its number, 1 to {len(names)})")
+
+
+def check_finite(shown: str, columns: Iterable[tuple[str, np.ndarray]],
+                 item: str = "sample") -> None:
+    """One line for the first NaN or infinity of any of ``columns`` ((what, values) pairs),
+    counting its ``item`` from 1."""
+    for what, column in columns:
+        bad = ~np.isfinite(column)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise WorkbookError(f"{shown}: {what} {item} {k + 1} is {column[k]}, expected "
+                                "finite numbers (no NaN or inf)")

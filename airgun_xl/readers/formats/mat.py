@@ -25,7 +25,7 @@ import numpy as np
 from ... import limits
 from ...errors import OptionError, WorkbookError
 from ...transaction import display
-from .channels import ChannelInfo, choose
+from .channels import ChannelInfo, check_finite, choose
 from .mat5 import Mat5, MatError
 
 NAME = "MATLAB .mat"
@@ -245,12 +245,7 @@ def read(path: str | Path, data: bytes, channel: str | None) -> tuple[str, list[
     else:
         assert step is not None
         time = (start or 0.0) + step * np.arange(n)
-    for what, column in ((f"channel {name!r}", accel), (f"time {vector!r}", time)):
-        bad = ~np.isfinite(column)
-        if bad.any():
-            k = int(np.argmax(bad))
-            raise WorkbookError(f"{variables.shown}: {what} sample {k + 1} is {column[k]}, "
-                                "expected finite numbers (no NaN or inf)")
+    check_finite(variables.shown, ((f"channel {name!r}", accel), (f"time {vector!r}", time)))
     unit = variables.text(variables.find(f"{name.lower()}_unit"))
     header = [f"time [{t_unit}]" if t_unit else "time",
               f"acceleration [{unit}]" if unit else "acceleration"]

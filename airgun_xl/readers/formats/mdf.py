@@ -22,7 +22,7 @@ import numpy as np
 from ... import limits
 from ...errors import OptionError, WorkbookError
 from ...transaction import display
-from .channels import ChannelInfo
+from .channels import ChannelInfo, check_finite
 
 NAME = "ASAM MDF"
 SUFFIXES = (".mf4", ".mdf")
@@ -179,12 +179,7 @@ def read(path: str | Path, data: bytes, channel: str | None) -> tuple[str, list[
     if len(time) != len(values):
         raise WorkbookError(f"{shown}: channel {name!r} has {len(values):,} values and "
                             f"{len(time):,} times, {EXPECTED}")
-    for what, column in ((f"channel {name!r}", values), ("its time", time)):
-        bad = ~np.isfinite(column)
-        if bad.any():
-            k = int(np.argmax(bad))
-            raise WorkbookError(f"{shown}: {what} sample {k + 1} is {column[k]}, expected "
-                                "finite numbers (no NaN or inf)")
+    check_finite(shown, ((f"channel {name!r}", values), ("its time", time)))
     header = ["time [s]", f"acceleration [{unit}]" if unit else "acceleration"]
     return f"{shown} ({name})", header, np.column_stack([time, values])
 

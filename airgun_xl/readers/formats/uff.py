@@ -21,7 +21,7 @@ import numpy as np
 from ... import limits
 from ...errors import OptionError, WorkbookError
 from ...transaction import display
-from .channels import ChannelInfo, choose
+from .channels import ChannelInfo, check_finite, choose
 
 NAME = "UFF dataset 58"
 SUFFIXES = (".uff", ".unv")
@@ -123,12 +123,7 @@ def read(path: str | Path, data: bytes, channel: str | None) -> tuple[str, list[
         raise WorkbookError(f"{shown}: time response {name!r} holds {declared:,} samples, "
                             f"expected at most {limits.MAX_SAMPLES:,} samples")
     accel = values.astype(float)
-    for what, column in ((f"time response {name!r}", accel), ("its time", x)):
-        bad = ~np.isfinite(column)
-        if bad.any():
-            k = int(np.argmax(bad))
-            raise WorkbookError(f"{shown}: {what} point {k + 1} is {column[k]}, expected "
-                                "finite numbers (no NaN or inf)")
+    check_finite(shown, ((f"time response {name!r}", accel), ("its time", x)), "point")
     t_unit, unit = _units(dataset)
     if not t_unit and int(dataset.get("abscissa_spec_data_type", 0)) == 17:
         t_unit = "s"  # the abscissa is time (type 17), in the SI unit the format defaults to
