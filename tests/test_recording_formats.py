@@ -638,3 +638,18 @@ def test_an_mme_test_that_lies_or_links_out_is_one_line(pulse, tmp_path, capsys)
     (moved.parent / "Channel").rename(tmp_path / "elsewhere")
     (moved.parent / "Channel").symlink_to(tmp_path / "elsewhere", target_is_directory=True)
     refused(moved, "its Channel folder is not a folder (a symlink or a file)")
+
+
+@pytest.mark.skipif(not hasattr(os, "O_NOFOLLOW"), reason="the platform has no O_NOFOLLOW")
+def test_a_channel_file_linked_after_the_check_is_refused_at_its_open(tmp_path):
+    """An MME channel file is opened with O_NOFOLLOW: a symlink put there after the folder
+    was listed (a check-then-open race) is refused by the open itself, in one line."""
+    from airgun_xl.readers.guard import read_bytes
+
+    target = tmp_path / "secret.txt"
+    target.write_text("outside the test")
+    link = tmp_path / "TEST.002"
+    link.symlink_to(target)
+    assert read_bytes(link, head=16) == b"outside the test"  # an input named by the user
+    with pytest.raises(airgun_xl.WorkbookError, match=r"TEST\.002: cannot be read \("):
+        read_bytes(link, head=16, follow=False)

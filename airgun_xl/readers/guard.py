@@ -39,9 +39,11 @@ def _mib(n):
     return f"{n / 2**20:,.1f} MB"
 
 
-def read_bytes(path, expected=EXPECTED, what="workbook", head=None):
+def read_bytes(path, expected=EXPECTED, what="workbook", head=None, follow=True):
     """The bytes of a regular file, read without blocking and capped at MAX_INPUT_BYTES; with
-    ``head``, its first ``head`` bytes only, whatever its size (a format told by content).
+    ``head``, its first ``head`` bytes only, whatever its size (a format told by content);
+    ``follow`` False refuses a symlink at the open itself (no check-then-open race), where
+    the platform can (``O_NOFOLLOW``).
 
     Raises
     ------
@@ -52,7 +54,8 @@ def read_bytes(path, expected=EXPECTED, what="workbook", head=None):
     path = Path(path)
     shown = display(path)
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0)
+                     | (0 if follow else getattr(os, "O_NOFOLLOW", 0)))
     except FileNotFoundError:
         raise WorkbookError(f"{shown}: no such file, {expected}") from None
     except IsADirectoryError:

@@ -224,7 +224,7 @@ def _headers(path: str | Path, data: bytes) -> list[tuple[Path, _Channel]]:
     out = []
     for p, whole in _test(path, data):
         head = whole if whole is not None else read_bytes(p, EXPECTED, "MME channel",
-                                                           head=HEADER_BYTES)
+                                                           head=HEADER_BYTES, follow=False)
         out.append((p, _Channel(p, head, whole is not None or len(head) < HEADER_BYTES)))
     return out
 
@@ -246,7 +246,8 @@ def read(path: str | Path, data: bytes, channel: str | None) -> tuple[str, list[
         where, _ = headers[codes[channel]]
     else:
         where, _ = headers[choose(channel, names)]
-    whole = data if Path(path) == where else read_bytes(where, EXPECTED, "MME channel")
+    whole = data if Path(path) == where else read_bytes(where, EXPECTED, "MME channel",
+                                                        follow=False)  # linked meanwhile
     chosen = _Channel(where, whole)
     values = chosen.samples()
     header = ["time [s]", f"acceleration [{chosen.unit}]" if chosen.unit else "acceleration"]
