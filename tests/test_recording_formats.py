@@ -653,3 +653,14 @@ def test_a_channel_file_linked_after_the_check_is_refused_at_its_open(tmp_path):
     assert read_bytes(link, head=16) == b"outside the test"  # an input named by the user
     with pytest.raises(airgun_xl.WorkbookError, match=r"TEST\.002: cannot be read \("):
         read_bytes(link, head=16, follow=False)
+
+
+def test_a_csv_in_a_recorders_time_unit_is_listed_with_its_rate(tmp_path):
+    """The listing reads a CSV's units as the reader does (``sec`` is a file's spelling of
+    s): its rate and start are known, not left blank."""
+    path = tmp_path / "r.csv"
+    path.write_text("time [sec],acceleration [G]\n" + "".join(
+        f"{k / 1e4!r},{float(k % 7)!r}\n" for k in range(64)))
+    (channel,) = airgun_xl.recording(path).channels
+    assert (channel.unit, channel.samples, channel.start) == ("G", 64, 0.0)
+    assert channel.rate == pytest.approx(1e4, rel=1e-12)

@@ -80,9 +80,15 @@ class Trace:
     notes: list = field(default_factory=list)
 
 
-def _unit(header, table, option, which):
+def _stated(header):
+    """The unit a header names in brackets or parentheses (``time [ms]`` -> ``ms``; '' for
+    none)."""
     found = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]", header)
-    text = (found.group(1) if found else "").strip()
+    return (found.group(1) if found else "").strip()
+
+
+def _unit(header, table, option, which):
+    text = _stated(header)
     key = text.replace("'s", "").replace("²", "^2").replace(" ", "")
     near = [k for k in table if k.lower() == key.lower()]
     if key not in table and near:  # units are case sensitive: [Kg] is kilograms, [MS] not ms
@@ -253,7 +259,8 @@ def _source_table(path, channel=None):
     if found and not Path(text).exists():
         if channel is not None:
             raise OptionError("--channel: found with a workbook range, expected it only "
-                              "with a TDMS file")
+                              "with a file of several channels (TDMS, MATLAB .mat, MDF, UFF, "
+                              "MME)")
         return _range_table(found)
     fmt = formats.detect(path)
     if fmt is not None:
@@ -274,14 +281,12 @@ def list_channels(path):
         return fmt.channels(path, read_bytes(path, fmt.EXPECTED, fmt.NAME))
     shown, header, values = (_range_table(found) if found and not Path(text).exists()
                              else _table(path, EXPECTED, ("time", "acceleration")))
-    unit = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]", header[1])
-    t_unit = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]", header[0])
-    scale = TIME_UNITS.get(t_unit.group(1).strip()) if t_unit else None
+    scale = FILE_TIME_UNITS.get(_stated(header[0]))
     time = values[:, 0]
     rate = ((len(time) - 1) / ((time[-1] - time[0]) * scale)
             if scale and len(time) > 1 and time[-1] > time[0] else None)
-    return [formats.ChannelInfo(header[1], unit.group(1).strip() if unit else "", rate,
-                                len(values), float(time[0]) * scale if scale else None)]
+    return [formats.ChannelInfo(header[1], _stated(header[1]), rate, len(values),
+                                float(time[0]) * scale if scale else None)]
 
 
 def _column(letters):
@@ -427,8 +432,7 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
 def _override(shown, option, given, header, table):
     """The warning when ``option``'s unit replaces a different one the file states in
     ``header`` ('' when the file states none, or the same unit)."""
-    found = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]", header)
-    stated = (found.group(1) if found else "").strip()
+    stated = _stated(header)
     key = stated.replace("'s", "").replace("²", "^2").replace(" ", "")
     if not stated or (key in table and table[key] == table[given]):
         return ""
