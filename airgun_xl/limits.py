@@ -48,6 +48,12 @@ MAX_EVERY = 10**9
 #: Most shots of one sweep or Monte Carlo run.
 MAX_SHOTS = 10**7
 
+#: Largest recording file a format that reads a window of a channel (ASAM MDF) opens [bytes]:
+#: such a file is never read whole, only its metadata and the stretch of the chosen channel
+#: around its pulse (a 20 GB export of many channels is usual); every other file stays under
+#: MAX_INPUT_BYTES.
+MAX_WINDOWED_BYTES = 256 * 2**30
+
 #: Most samples a measured recording may hold: 40 s at 50 kHz, 32 MB as two float columns.
 MAX_SAMPLES = 2_000_000
 

@@ -20,6 +20,7 @@ import stat
 import struct
 import zipfile
 import zlib
+from dataclasses import dataclass
 from pathlib import Path
 
 from .. import limits
@@ -39,22 +40,13 @@ def _mib(n):
     return f"{n / 2**20:,.1f} MB"
 
 
-def read_bytes(path, expected=EXPECTED, what="workbook", head=None, follow=True):
-    """The bytes of a regular file, read without blocking and capped at MAX_INPUT_BYTES; with
-    ``head``, its first ``head`` bytes only, whatever its size (a format told by content);
-    ``follow`` False refuses a symlink at the open itself (no check-then-open race), where
-    the platform can (``O_NOFOLLOW``).
-
-    Raises
-    ------
-    WorkbookError
-        When the path is missing, not a regular file (a FIFO, a device, a folder), larger
-        than the cap, or unreadable; ``expected`` ends each message.
-    """
-    path = Path(path)
-    shown = display(path)
+def _open(path, expected, what, follow):
+    """A descriptor of the regular file at ``path`` and its status, opened without blocking
+    (``follow`` False: a symlink refused at the open itself, where the platform can)."""
+    shown = display(Path(path))
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0)
+                     | getattr(os, "O_BINARY", 0)
                      | (0 if follow else getattr(os, "O_NOFOLLOW", 0)))
     except FileNotFoundError:
         raise WorkbookError(f"{shown}: no such file, {expected}") from None
@@ -69,6 +61,31 @@ def read_bytes(path, expected=EXPECTED, what="workbook", head=None, follow=True)
         kind = special_kind(st.st_mode)
         if kind is not None:
             raise WorkbookError(f"{shown}: is {kind}, expected a regular {what} file")
+    except OSError as exc:
+        os.close(fd)
+        raise WorkbookError(f"{shown}: cannot be read ({exc.strerror}), {expected}") from None
+    except WorkbookError:
+        os.close(fd)
+        raise
+    return fd, st
+
+
+def read_bytes(path, expected=EXPECTED, what="workbook", head=None, follow=True):
+    """The bytes of a regular file, read without blocking and capped at MAX_INPUT_BYTES; with
+    ``head``, its first ``head`` bytes only, whatever its size (a format told by content);
+    ``follow`` False refuses a symlink at the open itself (no check-then-open race), where
+    the platform can (``O_NOFOLLOW``).
+
+    Raises
+    ------
+    WorkbookError
+        When the path is missing, not a regular file (a FIFO, a device, a folder), larger
+        than the cap, or unreadable; ``expected`` ends each message.
+    """
+    path = Path(path)
+    shown = display(path)
+    fd, st = _open(path, expected, what, follow)
+    try:
         if head is not None:
             with os.fdopen(os.dup(fd), "rb") as fh:
                 return fh.read(head)
@@ -85,6 +102,47 @@ def read_bytes(path, expected=EXPECTED, what="workbook", head=None, follow=True)
         raise WorkbookError(f"{shown}: is larger than {_mib(limits.MAX_INPUT_BYTES)}, expected "
                             f"a smaller {what}")
     return data
+
+
+@dataclass(frozen=True)
+class LargeFile:
+    """A regular file too large to read whole, known by its identity (device, inode, size) so
+    that whoever opens it later opens this file and no other (:func:`open_large`)."""
+
+    path: str
+    device: int
+    inode: int
+    size: int
+
+
+def large_file(path, expected, what, cap):
+    """The :class:`LargeFile` at ``path`` (a regular file, no symlink, at most ``cap``
+    bytes), or None when it is small enough for :func:`read_bytes`.
+
+    Raises
+    ------
+    WorkbookError
+        As :func:`read_bytes`, and past ``cap``.
+    """
+    fd, st = _open(path, expected, what, follow=False)
+    os.close(fd)
+    if st.st_size <= limits.MAX_INPUT_BYTES:
+        return None
+    if st.st_size > cap:
+        raise WorkbookError(f"{display(Path(path))}: is {_mib(st.st_size)}, expected a {what} "
+                            f"of at most {_mib(cap)}")
+    return LargeFile(str(path), st.st_dev, st.st_ino, st.st_size)
+
+
+def open_large(large):
+    """The :class:`LargeFile` opened for reading, a binary file object; an error when the path
+    no longer names that very file (replaced, grown, or a symlink put in its place)."""
+    fd, st = _open(large.path, "expected the file it was", "recording", follow=False)
+    if (st.st_dev, st.st_ino, st.st_size) != (large.device, large.inode, large.size):
+        os.close(fd)
+        raise WorkbookError(f"{display(Path(large.path))}: changed while it was read, expected "
+                            "the file as it was")
+    return os.fdopen(fd, "rb")
 
 
 def read_input(path):

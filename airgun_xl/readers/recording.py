@@ -253,7 +253,7 @@ def input_file(spec):
 
 
 def _source_table(path, channel=None):
-    """(shown, header, values) of any measured source."""
+    """Any measured source as a :class:`~.formats.Table`."""
     text = str(path)
     found = RANGE.match(text)
     if found and not Path(text).exists():
@@ -261,14 +261,14 @@ def _source_table(path, channel=None):
             raise OptionError("--channel: found with a workbook range, expected it only "
                               "with a file of several channels (TDMS, MATLAB .mat, MDF, UFF, "
                               "MME)")
-        return _range_table(found)
+        return formats.Table(*_range_table(found))
     fmt = formats.detect(path)
     if fmt is not None:
-        return fmt.read(path, read_bytes(path, fmt.EXPECTED, fmt.NAME), channel)
+        return fmt.read(path, formats.source(fmt, path), channel)
     if channel is not None:
         raise OptionError("--channel: found with a CSV file, expected it only with a file of "
                           "several channels (TDMS, MATLAB .mat, MDF, UFF, MME)")
-    return _table(path, EXPECTED, ("time", "acceleration"))
+    return formats.Table(*_table(path, EXPECTED, ("time", "acceleration")))
 
 
 def list_channels(path):
@@ -278,7 +278,7 @@ def list_channels(path):
     found = RANGE.match(text)
     fmt = None if found and not Path(text).exists() else formats.detect(path)
     if fmt is not None:
-        return fmt.channels(path, read_bytes(path, fmt.EXPECTED, fmt.NAME))
+        return fmt.channels(path, formats.source(fmt, path))
     shown, header, values = (_range_table(found) if found and not Path(text).exists()
                              else _table(path, EXPECTED, ("time", "acceleration")))
     scale = FILE_TIME_UNITS.get(_stated(header[0]))
@@ -400,7 +400,7 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
                                  ("--accel-unit", accel_unit, ACCEL_UNITS)):
         if given is not None and given not in table:
             raise OptionError(f"{option}: found {given!r}, expected one of {', '.join(table)}")
-    shown, header, values = _source_table(path, channel)
+    shown, header, values, said = _source_table(path, channel)
     t_unit = time_unit or _unit(header[0], FILE_TIME_UNITS, "--time-unit", "time")
     a_unit = accel_unit or _unit(header[1], FILE_ACCEL_UNITS, "--accel-unit", "acceleration")
     notes = [_override(shown, option, given, stated, table)
@@ -408,7 +408,7 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
                  ("--time-unit", time_unit, header[0], FILE_TIME_UNITS),
                  ("--accel-unit", accel_unit, header[1], FILE_ACCEL_UNITS))
              if given is not None]
-    notes = [note for note in notes if note]
+    notes = [note for note in notes if note] + list(said)
     if len(values) < MIN_SAMPLES:
         raise WorkbookError(f"{shown}: holds {len(values)} samples, expected at least "
                             f"{MIN_SAMPLES}")

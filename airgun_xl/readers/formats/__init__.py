@@ -9,14 +9,20 @@ A format module holds:
   bytes, structure);
 - ``channels(path, data)``: the file's channels as :class:`ChannelInfo`, read from its
   metadata, no samples;
-- ``read(path, data, channel)``: the chosen channel as ``(shown, header, values)``, the
-  header naming the units as the file states them (``time [s]``, ``acceleration [g]``) and
-  ``values`` the (n, 2) array of time and the scaled (physical) acceleration.
+- ``read(path, data, channel)``: the chosen channel as a :class:`Table` (how messages name
+  it, the header naming the units as the file states them, ``time [s]``, ``acceleration [g]``,
+  the (n, 2) array of time and the scaled (physical) acceleration, and the reading's notes);
+- ``WINDOWED`` (optional, True): the format reads a file past
+  :data:`airgun_xl.limits.MAX_INPUT_BYTES` without reading it whole.
 
 The file's bytes come from :func:`airgun_xl.readers.guard.read_bytes` (a regular file, its
-size capped before it is read), so a reader parses bytes in memory and never opens a path. A
-channel's declared length is checked against :data:`airgun_xl.limits.MAX_SAMPLES` before its
-samples are read. Every fault is one :class:`~airgun_xl.errors.WorkbookError` (the file) or
+size capped before it is read), so a reader parses bytes in memory and never opens a path; a
+``WINDOWED`` format is given a larger file as a :class:`~airgun_xl.readers.guard.LargeFile`
+instead (:func:`source`), which it opens only through
+:func:`~airgun_xl.readers.guard.open_large`. A channel's declared length is checked against
+:data:`airgun_xl.limits.MAX_SAMPLES` before its samples are read, and a ``WINDOWED`` format
+reads the stretch of a longer channel around its pulse (:func:`.channels.pulse_window`).
+Every fault is one :class:`~airgun_xl.errors.WorkbookError` (the file) or
 :class:`~airgun_xl.errors.OptionError` (``--channel``) line.
 
 ``--channel`` names a channel the same way in every format: its name as the file gives it
@@ -27,9 +33,10 @@ from __future__ import annotations
 from pathlib import Path
 from types import ModuleType
 
-from ..guard import read_bytes
+from ... import limits
+from ..guard import LargeFile, large_file, read_bytes
 from . import mat, mdf, mme, tdms, uff
-from .channels import ChannelInfo, choose
+from .channels import ChannelInfo, Table, choose
 
 #: Bytes read to tell a format by its content (a MATLAB v7.3 file's HDF5 signature is at 512).
 HEAD = 1024
@@ -55,4 +62,16 @@ def detect(path: str | Path) -> ModuleType | None:
     return next((fmt for fmt in FORMATS if suffix in fmt.SUFFIXES), None)
 
 
-__all__ = ["EXPECTED_RECORDING", "FORMATS", "HEAD", "ChannelInfo", "choose", "detect"]
+def source(fmt: ModuleType, path: str | Path) -> bytes | LargeFile:
+    """What ``fmt``'s reader is given of the file at ``path``: its bytes (at most
+    :data:`~airgun_xl.limits.MAX_INPUT_BYTES`), or, for a ``WINDOWED`` format, a larger file
+    (up to :data:`~airgun_xl.limits.MAX_WINDOWED_BYTES`) as a :class:`LargeFile`."""
+    if getattr(fmt, "WINDOWED", False):
+        large = large_file(path, fmt.EXPECTED, "recording", limits.MAX_WINDOWED_BYTES)
+        if large is not None:
+            return large
+    return read_bytes(path, fmt.EXPECTED, "recording")
+
+
+__all__ = ["EXPECTED_RECORDING", "FORMATS", "HEAD", "ChannelInfo", "LargeFile", "Table",
+           "choose", "detect", "source"]

@@ -1,9 +1,12 @@
-"""What every recording format says of a channel (:class:`ChannelInfo`), and how
-``--channel`` chooses one (:func:`choose`): the same in every format."""
+"""What every recording format says of a channel (:class:`ChannelInfo`), how
+``--channel`` chooses one (:func:`choose`), and which stretch of a long channel is read
+(:func:`pulse_window`): the same in every format."""
 from __future__ import annotations
 
-from collections.abc import Iterable
+import math
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -35,6 +38,17 @@ class ChannelInfo:
     start: float | None
 
 
+class Table(NamedTuple):
+    """A channel as a format reads it: how messages name it, the header naming its units as
+    the file states them (``time [s]``, ``acceleration [g]``), the (n, 2) array of its times
+    and physical values, and what the reading did that the user should know (its notes)."""
+
+    shown: str
+    header: list[str]
+    values: np.ndarray
+    notes: tuple[str, ...] = ()
+
+
 def choose(channel: str | None, names: list[str], kind: str = "channel") -> int:
     """The index of the channel ``--channel`` names in ``names``: its name, else its number
     (1 for the first); the first by default."""
@@ -62,3 +76,68 @@ def check_finite(shown: str, columns: Iterable[tuple[str, np.ndarray]],
             k = int(np.argmax(bad))
             raise WorkbookError(f"{shown}: {what} {item} {k + 1} is {column[k]}, expected "
                                 "finite numbers (no NaN or inf)")
+
+
+#: Seconds read on each side of a long channel's largest excursion (:func:`pulse_window`):
+#: an air gun pulse lasts milliseconds, and its rest before and after is what the recording
+#: checks need; a channel of at most :data:`airgun_xl.limits.MAX_SAMPLES` samples is read
+#: whole.
+WINDOW_SECONDS = 0.5
+
+#: Samples a long channel is scanned by: 8 MB of float64 at a time.
+SCAN_CHUNK = 1_000_000
+
+#: Samples at the start of a long channel whose median is its rest level for the scan.
+REST_SAMPLES = 10_000
+
+
+@dataclass(frozen=True)
+class Window:
+    """The samples ``first`` to ``first + count`` (from 0) of a channel of ``samples``, read
+    around its largest excursion from rest, at sample ``peak``; ``note`` says so."""
+
+    first: int
+    count: int
+    samples: int
+    peak: int
+    note: str
+
+
+def pulse_window(name: str, samples: int, values: Callable[[int, int], np.ndarray],
+                 times: Callable[[int, int], np.ndarray], max_samples: int) -> Window:
+    """Where to read a channel longer than ``max_samples``: :data:`WINDOW_SECONDS` on each
+    side of its largest excursion from its rest level (the median of its first
+    :data:`REST_SAMPLES`), at most ``max_samples`` in all. ``values(offset, count)`` and
+    ``times(offset, count)`` read a stretch of the channel's physical values and times [s];
+    the scan holds one :data:`SCAN_CHUNK` at a time.
+
+    Raises
+    ------
+    ValueError
+        Naming the first sample that is not finite (the caller names the file).
+    """
+    def finite(chunk: np.ndarray, offset: int) -> np.ndarray:
+        if not np.isfinite(chunk).all():
+            k = int(np.argmax(~np.isfinite(chunk)))
+            raise ValueError(f"channel {name!r} sample {offset + k + 1:,} is not finite, "
+                             "expected finite numbers (no NaN or inf)")
+        return chunk
+
+    rest = float(np.median(finite(values(0, min(samples, REST_SAMPLES)), 0)))
+    peak, height = 0, -1.0
+    for offset in range(0, samples, SCAN_CHUNK):
+        chunk = np.abs(finite(values(offset, min(SCAN_CHUNK, samples - offset)), offset) - rest)
+        k = int(np.argmax(chunk))
+        if chunk[k] > height:
+            peak, height = offset + k, float(chunk[k])
+    ends = times(0, 1), times(samples - 1, 1)
+    duration = float(ends[1][0] - ends[0][0])
+    rate = (samples - 1) / duration if duration > 0 else math.inf
+    half = int(min(round(WINDOW_SECONDS * rate), (max_samples - 1) // 2))
+    first = max(0, peak - half)
+    count = min(samples, peak + half + 1) - first
+    note = (f"channel {name!r} holds {samples:,} samples ({duration:.4g} s), more than the "
+            f"{max_samples:,} read whole: read the {count:,} samples around its largest "
+            f"excursion from rest (sample {peak + 1:,}), {first + 1:,} to {first + count:,}; "
+            "a pulse elsewhere in the channel is not looked at")
+    return Window(first, count, samples, peak, note)

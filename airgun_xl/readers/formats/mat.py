@@ -25,7 +25,7 @@ import numpy as np
 from ... import limits
 from ...errors import OptionError, WorkbookError
 from ...transaction import display
-from .channels import ChannelInfo, check_finite, choose
+from .channels import ChannelInfo, Table, check_finite, choose
 from .mat5 import Mat5, MatError
 
 NAME = "MATLAB .mat"
@@ -218,8 +218,7 @@ def _seconds(unit: str) -> float | None:
     return float(TIME_UNITS[unit]) if unit in TIME_UNITS else None
 
 
-def read(path: str | Path, data: bytes, channel: str | None) -> tuple[str, list[str],
-                                                                      np.ndarray]:
+def read(path: str | Path, data: bytes, channel: str | None) -> Table:
     """The chosen channel (the first by default) and its time."""
     variables = _Variables(path, data)
     names = _channels(variables)
@@ -249,4 +248,4 @@ def read(path: str | Path, data: bytes, channel: str | None) -> tuple[str, list[
     unit = variables.text(variables.find(f"{name.lower()}_unit"))
     header = [f"time [{t_unit}]" if t_unit else "time",
               f"acceleration [{unit}]" if unit else "acceleration"]
-    return f"{variables.shown} ({name})", header, np.column_stack([time, accel])
+    return Table(f"{variables.shown} ({name})", header, np.column_stack([time, accel]))

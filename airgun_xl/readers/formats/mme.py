@@ -28,7 +28,7 @@ from ... import limits
 from ...errors import WorkbookError
 from ...transaction import display
 from ..guard import read_bytes
-from .channels import ChannelInfo, choose
+from .channels import ChannelInfo, Table, choose
 
 NAME = "ISO 13499 MME"
 SUFFIXES = (".mme",)
@@ -236,8 +236,7 @@ def channels(path: str | Path, data: bytes) -> list[ChannelInfo]:
     return [c.info for _p, c in _headers(path, data)]
 
 
-def read(path: str | Path, data: bytes, channel: str | None) -> tuple[str, list[str],
-                                                                      np.ndarray]:
+def read(path: str | Path, data: bytes, channel: str | None) -> Table:
     """The chosen channel (by name, channel code or number; the first by default)."""
     headers = _headers(path, data)
     names = [c.name for _p, c in headers]
@@ -251,4 +250,4 @@ def read(path: str | Path, data: bytes, channel: str | None) -> tuple[str, list[
     chosen = _Channel(where, whole)
     values = chosen.samples()
     header = ["time [s]", f"acceleration [{chosen.unit}]" if chosen.unit else "acceleration"]
-    return f"{chosen.shown} ({chosen.name})", header, values
+    return Table(f"{chosen.shown} ({chosen.name})", header, values)

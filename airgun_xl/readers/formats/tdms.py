@@ -12,7 +12,7 @@ import numpy as np
 from ... import limits
 from ...errors import OptionError, WorkbookError
 from ...transaction import display
-from .channels import ChannelInfo, choose
+from .channels import ChannelInfo, Table, choose
 
 NAME = "LabVIEW TDMS"
 SUFFIXES = (".tdms",)
@@ -73,8 +73,7 @@ def channels(path: str | Path, data: bytes) -> list[Any]:
     return out
 
 
-def read(path: str | Path, data: bytes, channel: str | None) -> tuple[str, list[str],
-                                                                      np.ndarray]:
+def read(path: str | Path, data: bytes, channel: str | None) -> Table:
     """The chosen waveform channel (the first by default)."""
     shown, waves, names = _waves(path, data)
     if not waves:
@@ -101,4 +100,4 @@ def read(path: str | Path, data: bytes, channel: str | None) -> tuple[str, list[
     # the header is built for the unit alone: a channel named 'accel (z)' or 'accel [z]' must
     # not lend its brackets to the unit parser
     header = ["time [s]", f"acceleration [{unit}]" if unit else "acceleration"]
-    return shown, header, np.column_stack([start + dt * np.arange(len(accel)), accel])
+    return Table(shown, header, np.column_stack([start + dt * np.arange(len(accel)), accel]))

@@ -21,7 +21,7 @@ import numpy as np
 from ... import limits
 from ...errors import OptionError, WorkbookError
 from ...transaction import display
-from .channels import ChannelInfo, check_finite, choose
+from .channels import ChannelInfo, Table, check_finite, choose
 
 NAME = "UFF dataset 58"
 SUFFIXES = (".uff", ".unv")
@@ -96,8 +96,7 @@ def channels(path: str | Path, data: bytes) -> list[ChannelInfo]:
     return out
 
 
-def read(path: str | Path, data: bytes, channel: str | None) -> tuple[str, list[str],
-                                                                      np.ndarray]:
+def read(path: str | Path, data: bytes, channel: str | None) -> Table:
     """The chosen time response (the first by default)."""
     shown, sets = _datasets(path, data)
     if not sets:
@@ -131,4 +130,4 @@ def read(path: str | Path, data: bytes, channel: str | None) -> tuple[str, list[
               f"acceleration [{unit}]" if unit else "acceleration"]
     if not math.isfinite(float(x[0])):
         raise WorkbookError(f"{shown}: time response {name!r} starts at {x[0]}, {EXPECTED}")
-    return f"{shown} ({name})", header, np.column_stack([x, accel])
+    return Table(f"{shown} ({name})", header, np.column_stack([x, accel]))
