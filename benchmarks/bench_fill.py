@@ -53,13 +53,15 @@ PEAK_RSS = (
 )
 
 
-def measured_process(cmd, times):
-    """Run ``cmd`` once to warm up, then ``times`` times: medians' inputs.
+def measured_process(cmd, times, warm=True):
+    """Run ``cmd`` once to warm up (unless not ``warm``), then ``times`` times: medians'
+    inputs.
 
     Returns the wall times [s] and each run's peak RSS [MB].
     """
     cmd = [sys.executable, "-c", PEAK_RSS, *cmd]
-    subprocess.run(cmd, check=True, capture_output=True)  # warm-up
+    if warm:
+        subprocess.run(cmd, check=True, capture_output=True)
     walls, rss = [], []
     for _ in range(times):
         started = time.perf_counter()

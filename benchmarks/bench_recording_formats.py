@@ -13,7 +13,15 @@ writes and reads them; pyuff parses every dataset of the file, both channels her
 Reports each one's file size, the median wall time over N runs after a warm-up and the peak
 RSS; the process's import of airgun-xl is in every figure (the first row, a process that
 reads nothing, is that floor). --quick: 100,000 samples.
+
+Then a file far larger than its pulse, in each format that reads a window (MDF, TDMS): a
+10 s channel at 1 MHz (float32, the half-sine at 4.2 s) beside channels of zeros that make
+the file AIRGUN_BENCH_LARGE_GB gigabytes (20 by default; with --quick, 3 s beside 64 MB, still
+past the samples read whole); the page cache
+is dropped before each run where the machine lets us (root on Linux), so the file is read
+from the disk.
 """
+import os
 import statistics
 import sys
 from pathlib import Path
@@ -98,8 +106,84 @@ def bench_formats(repeat, tmp):
     return rows
 
 
+def _long_pulse(n):
+    t = np.arange(n) / 1e6
+    a = np.random.default_rng(0).normal(0, 5, n).astype(np.float32)
+    k = n * 42 // 100
+    a[k:k + 5000] += (1000 * np.sin(np.pi * np.arange(5000) / 5000)).astype(np.float32)
+    return t, a
+
+
+def large_files(tmp, gb, n, bulk):
+    """{format: path} of a file of about ``gb`` GB holding one pulse in a channel of ``n``
+    samples, the rest in blocks of ``bulk`` samples and their times."""
+    blocks = max(1, round(gb * 2**30 / (bulk * 8 * 2)))
+    t, a = _long_pulse(n)
+    out = {}
+    try:
+        from asammdf import MDF, Signal
+
+        mdf = MDF(version="4.10")
+        mdf.append([Signal(a, t, name="accel", unit="g")])
+        bulk_t = np.arange(bulk, dtype=float)
+        for k in range(blocks):
+            mdf.append([Signal(np.zeros(bulk), bulk_t, name=f"bulk{k}")])
+        mdf.save(tmp / "large.mf4", overwrite=True)
+        mdf.close()
+        out["ASAM MDF 4.10"] = tmp / "large.mf4"
+    except ImportError:
+        pass
+    try:
+        import nptdms
+
+        with nptdms.TdmsWriter(str(tmp / "large.tdms")) as writer:
+            writer.write_segment([nptdms.ChannelObject("Recorder", "accel", a, properties={
+                "wf_increment": 1e-6, "wf_start_offset": 0.0, "unit_string": "g"})])
+            zeros = np.zeros(bulk * 2)
+            for k in range(blocks):
+                writer.write_segment([nptdms.ChannelObject("Bulk", f"bulk{k}", zeros,
+                                                           properties={"wf_increment": 1.0})])
+        out["TDMS"] = tmp / "large.tdms"
+    except ImportError:
+        pass
+    return out
+
+
+def _drop_caches():
+    """Empty the page cache (root on Linux), so a read comes from the disk: True if done."""
+    try:
+        os.sync()
+        Path("/proc/sys/vm/drop_caches").write_text("3\n")
+        return True
+    except OSError:
+        return False
+
+
+def bench_large(repeat, tmp):
+    gb, n, bulk = ((0.0625, 3_000_000, 2**21) if quick() else
+                   (float(os.environ.get("AIRGUN_BENCH_LARGE_GB", "20")), 10_000_000, 2**25))
+    rows = []
+    for name, path in large_files(tmp, gb, n, bulk).items():
+        cmd = [sys.executable, "-c", "import sys; from airgun_xl.readers.recording import "
+               "read_trace; read_trace(sys.argv[1])", str(path)]
+        walls, rss, cold = [], [], True
+        for _ in range(repeat):
+            cold = _drop_caches() and cold
+            wall, peak = measured_process(cmd, 1, warm=False)
+            walls += wall
+            rss += peak
+        size = path.stat().st_size
+        rows.append((f"{name}, {n:,} samples at 1 MHz in a large file"
+                     f"{'' if cold else ' (page cache kept)'}",
+                     f"{size / 2**30:.2f} GB", f"{statistics.median(walls):.2f} s",
+                     f"peak RSS {max(rss):.0f} MB"))
+        path.unlink()
+    return rows
+
+
 def main():
-    run_table(__doc__, bench_formats)
+    run_table(__doc__, lambda repeat, tmp: bench_formats(repeat, tmp)
+              + bench_large(repeat, tmp))
 
 
 if __name__ == "__main__":

@@ -519,16 +519,27 @@ def test_23_21_calibrate_refuses_an_inverted_pulse_as_compare_measured_does(tmp_
                                "negative")
 
 
-def test_23_2_a_tdms_channel_past_the_sample_cap_is_one_line(tmp_path, capsys, monkeypatch):
-    """Every recording format holds at most limits.MAX_SAMPLES samples: a TDMS channel past it
-    (here the cap lowered to 500) is refused before its samples are read."""
+def test_23_2_a_tdms_channel_past_the_sample_cap_is_read_around_its_pulse(tmp_path, capsys,
+                                                                         monkeypatch):
+    """No recording is read whole past limits.MAX_SAMPLES samples (here the cap lowered to
+    500): a TDMS channel of 600 is read around its pulse, 249 samples each side of its
+    largest excursion (sample 301 of the sine from 1 ms to 5 ms at 10 us), and the warning
+    says so, on the terminal and on the Compared page (a format that cannot read a window refuses
+    the file: tests/test_recording_formats.py)."""
     from airgun_xl import limits
 
     monkeypatch.setattr(limits, "MAX_SAMPLES", 500)
     path = _tdms(tmp_path / "long.tdms", _pulse(600))
     out = tmp_path / "c.xlsx"
-    _refused(capsys, ["compare-measured", TEMPLATE, path, "-o", out],
-             "holds 600 samples, expected at most 500 samples", out)
+    assert main(["compare-measured", str(TEMPLATE), str(path), "-o", str(out)]) == 0
+    said = ("channel 'accel' holds 600 samples (0.00599 s), more than the 500 read whole: "
+            "read the 499 samples around its largest excursion from rest (sample 301), 52 to "
+            "550")
+    assert said in capsys.readouterr().err
+    from openpyxl import load_workbook
+
+    summary = load_workbook(out, read_only=True)["Compared"]
+    assert any(said in str(v) for row in summary.iter_rows(values_only=True) for v in row)
 
 
 def test_23_7_a_fitted_law_that_diverges_is_named_not_the_time_step(tmp_path, capsys):

@@ -680,7 +680,31 @@ def _long_recording(trace, before, after, seed=5):
     return time, values
 
 
-def test_a_long_mdf_channel_is_read_around_its_pulse_and_said(pulse, tmp_path, monkeypatch):
+def _write_long(kind, path, time, g):
+    """The recording in MDF (asammdf's writer) or TDMS (npTDMS's: a waveform from its
+    first time at the median step)."""
+    if kind == "mdf":
+        return _write_mdf(path.with_suffix(".mf4"), time, g)
+    import nptdms
+
+    with nptdms.TdmsWriter(str(path.with_suffix(".tdms"))) as writer:
+        writer.write_segment([nptdms.ChannelObject("Recorder", "accel", g, properties={
+            "wf_increment": float(np.median(np.diff(time))), "wf_start_offset": float(time[0]),
+            "unit_string": "g"})])
+    return path.with_suffix(".tdms")
+
+
+def _accel(kind):
+    """The pulse's channel: the MDF file's second (a temperature first)."""
+    return {"channel": "accel"} if kind == "mdf" else {}
+
+
+WINDOWED = [pytest.param("mdf", marks=pytest.mark.skipif(_asammdf() is None,
+                                                         reason="needs asammdf")), "tdms"]
+
+
+@pytest.mark.parametrize("kind", WINDOWED)
+def test_a_long_channel_is_read_around_its_pulse_and_said(pulse, tmp_path, monkeypatch, kind):
     """A channel longer than limits.MAX_SAMPLES (lowered here to 30,000; 2,000,000 as
     shipped, the rule the same) is scanned a chunk at a time and only the stretch around its
     largest excursion is read: half a second each side, at most the cap in all. The
@@ -692,12 +716,10 @@ def test_a_long_mdf_channel_is_read_around_its_pulse_and_said(pulse, tmp_path, m
     from airgun_xl.readers.formats import channels
 
     folder, trace, files = pulse
-    if "mdf" not in files:
-        pytest.skip("needs asammdf")
     monkeypatch.setattr(limits, "MAX_SAMPLES", 30_000)
     monkeypatch.setattr(channels, "SCAN_CHUNK", 7_000)  # several chunks, the peak in one
     time, g = _long_recording(trace, 40_000, 25_000)
-    path = _write_mdf(tmp_path / "long.mf4", time, g)
+    path = _write_long(kind, tmp_path / "long", time, g)
     peak = int(np.argmax(np.abs(g - np.median(g[:10_000]))))
     half = (30_000 - 1) // 2
     window = slice(peak - half, peak + half + 1)
@@ -706,7 +728,7 @@ def test_a_long_mdf_channel_is_read_around_its_pulse_and_said(pulse, tmp_path, m
         f"{x!r},{y!r}\n" for x, y in zip(time[window].tolist(), g[window].tolist(),
                                          strict=True)))
     reference = airgun_xl.accept(TEMPLATE, ref, **SPEC)
-    found = airgun_xl.accept(TEMPLATE, path, **SPEC, channel="accel")
+    found = airgun_xl.accept(TEMPLATE, path, **SPEC, **_accel(kind))
     assert found.verdict.word == reference.verdict.word == "PASS"
     for mine, theirs in zip(found.verdict.criteria, reference.verdict.criteria, strict=True):
         assert mine.value == pytest.approx(theirs.value, rel=1e-12), mine.name
@@ -715,14 +737,16 @@ def test_a_long_mdf_channel_is_read_around_its_pulse_and_said(pulse, tmp_path, m
     assert f"{peak - half + 1:,} to {peak + half + 1:,}" in said[0]
     # a NaN far from the pulse is found by the scan and named by its place in the channel
     g[3] = np.nan
-    _write_mdf(path, time, g)
-    with pytest.raises(airgun_xl.WorkbookError, match=r"long\.mf4: channel 'accel' sample 4 "
-                       r"is not finite"):
-        airgun_xl.accept(TEMPLATE, path, **SPEC, channel="accel")
+    path.unlink()
+    _write_long(kind, path, time, g)
+    with pytest.raises(airgun_xl.WorkbookError, match=r"long\.(mf4|tdms): channel 'accel' "
+                       r"sample 4 is not finite"):
+        airgun_xl.accept(TEMPLATE, path, **SPEC, **_accel(kind))
 
 
-def test_an_mdf_file_past_the_input_cap_is_opened_by_the_reader(pulse, tmp_path, monkeypatch,
-                                                                capsys):
+@pytest.mark.parametrize("kind", WINDOWED)
+def test_a_file_past_the_input_cap_is_opened_by_the_reader(pulse, tmp_path, monkeypatch,
+                                                           capsys, kind):
     """A file past limits.MAX_INPUT_BYTES (lowered here to 100 kB, above the template's
     size, below the 0.65 MB file's) is not read whole by the caller: the child opens it
     itself and gives the same verdict, to the last bit, as the same file read whole. The file
@@ -732,15 +756,13 @@ def test_an_mdf_file_past_the_input_cap_is_opened_by_the_reader(pulse, tmp_path,
     from airgun_xl.readers import guard
 
     folder, trace, files = pulse
-    if "mdf" not in files:
-        pytest.skip("needs asammdf")
-    path = _write_mdf(tmp_path / "big.mf4", *_long_recording(trace, 20_000, 20_000))
-    reference = airgun_xl.accept(TEMPLATE, path, **SPEC, channel="accel")
+    path = _write_long(kind, tmp_path / "big", *_long_recording(trace, 20_000, 20_000))
+    reference = airgun_xl.accept(TEMPLATE, path, **SPEC, **_accel(kind))
     monkeypatch.setattr(limits, "MAX_INPUT_BYTES", 100_000)
     assert path.stat().st_size > limits.MAX_INPUT_BYTES
     with pytest.raises(airgun_xl.WorkbookError, match="expected a recording of at most 0.1 MB"):
         guard.read_bytes(path, "expected", "recording")  # as any other format would be
-    found = airgun_xl.accept(TEMPLATE, path, **SPEC, channel="accel")
+    found = airgun_xl.accept(TEMPLATE, path, **SPEC, **_accel(kind))
     assert found.verdict.word == reference.verdict.word == "PASS"
     for mine, theirs in zip(found.verdict.criteria, reference.verdict.criteria, strict=True):
         assert mine.value == theirs.value, mine.name
@@ -748,20 +770,21 @@ def test_an_mdf_file_past_the_input_cap_is_opened_by_the_reader(pulse, tmp_path,
     assert "accel" in capsys.readouterr().out
     vetted = guard.large_file(path, "expected", "recording", limits.MAX_WINDOWED_BYTES)
     assert vetted is not None and vetted.size == path.stat().st_size
-    other = tmp_path / "other.mf4"
+    other = tmp_path / "other.bin"
     other.write_bytes(path.read_bytes())
     os.replace(other, path)  # the same bytes, another file
-    with pytest.raises(airgun_xl.WorkbookError, match=r"big\.mf4: changed while it was read"):
+    with pytest.raises(airgun_xl.WorkbookError, match=r"big\.\w+: changed while it was read"):
         guard.open_large(vetted)
     if hasattr(os, "O_NOFOLLOW"):
-        link = tmp_path / "link.mf4"
+        link = tmp_path / f"link{path.suffix}"
         link.symlink_to(path)
-        with pytest.raises(airgun_xl.WorkbookError, match=r"link\.mf4: cannot be read \("):
+        with pytest.raises(airgun_xl.WorkbookError, match=r"link\.\w+: cannot be read \("):
             guard.large_file(link, "expected", "recording", limits.MAX_WINDOWED_BYTES)
     monkeypatch.setattr(limits, "MAX_WINDOWED_BYTES", 200_000)
     out = tmp_path / "a.xlsx"
-    assert main(["accept", str(TEMPLATE), str(path), "--peak", "9kG:10%", "-o",
-                 str(out)]) == 2
+    assert main(["accept", str(TEMPLATE), str(path), "--peak", "9kG:10%", "-o", str(out),
+                 "--channel", "1"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and not out.exists()
-    assert "big.mf4: is 0.6 MB, expected a recording of at most 0.2 MB" in err
+    assert f"{path.name}: is 0.{path.stat().st_size // 100_000} MB, expected a recording of at " \
+        "most 0.2 MB" in err
