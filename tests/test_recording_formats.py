@@ -607,6 +607,52 @@ def test_an_mme_test_gives_the_csvs_verdict(pulse, tmp_path, encoding, explicit)
         c.value for c in verdicts[0].verdict.criteria]
 
 
+def test_an_mme_export_in_nhtsas_layout_is_told_by_content_and_read(pulse, tmp_path):
+    """The layout of NHTSA's MME exports (as pyisomme's test data holds them): the test file
+    opens with ``Data format :ISO-MME``, the channel file with ``Channel code``, its header
+    holds some 30 fields in the agency's order (a field name run into its colon,
+    ``Transducer natural frequency:NOVALUE``, a tab before a colon in the test file), the
+    test's name in lower case, the samples as E-format numbers. Told by its content under any
+    name, it gives the verdict of a CSV of the same samples."""
+    folder, trace, files = pulse
+    g = np.array([float(f"{v:.6E}") for v in (trace.accel_kg / KG_PER_G).tolist()])
+    test = tmp_path / "nhtsa"
+    (test / "Channel").mkdir(parents=True)
+    (test / "test.mme").write_text(
+        "Data format                 :ISO-MME\nVersion                     :1.6\n"
+        "Test number                 :test\nMovie reference\t\t:NOVALUE\n\n"
+        "Comments                    :Time zero: first contact\n")
+    (test / "Channel" / "test.chn").write_text(
+        "Instrumentation standard    :SAEJ211, issued 1992\nNumber of channels          :1\n"
+        "Name of channel 001         :10BIRD0000XXACXP / Bird X acceleration\n")
+    dt = float(trace.time[1] - trace.time[0])
+    fields = [("Channel code", "10BIRD0000XXACXP"), ("Laboratory channel code", "NOVALUE"),
+              ("Reference channel", "implicit"), ("Reference channel name", "NOVALUE"),
+              ("Data source", "transducer"), ("Test object number", "1"),
+              ("Name of the channel", "Bird X acceleration"), ("Direction", "X"),
+              ("Pre-filter type", "2000"), ("Channel frequency class", "NOVALUE"),
+              ("Transducer natural frequency", "NOVALUE"), ("Channel amplitude class", "1000"),
+              ("Sampling interval", repr(dt)), ("Unit", "g"),
+              ("Time of first sample", repr(float(trace.time[0]))),
+              ("Number of samples", str(len(g))), ("First global maximum value", "9.0E+2"),
+              ("Dimension", "AC"), ("Bit resolution", "16"), ("Data status", "ok")]
+    (test / "Channel" / "test.001").write_text("".join(
+        f"{name:<28}:{value}\n" for name, value in fields) + "".join(f"{v:.6E}\n" for v in g))
+    renamed = tmp_path / "shot17.txt"  # told by its content, not its name
+    renamed.write_bytes((test / "Channel" / "test.001").read_bytes())
+    ref = tmp_path / "ref.csv"
+    ref.write_text("time [s],acceleration [g]\n" + "".join(
+        f"{float(trace.time[0]) + k * dt!r},{v!r}\n" for k, v in enumerate(g.tolist())))
+    reference = airgun_xl.accept(TEMPLATE, ref, **SPEC)
+    for source in (test / "test.mme", test / "Channel" / "test.001", renamed):
+        assert airgun_xl.recording(source).format == "ISO 13499 MME"
+        found = airgun_xl.accept(TEMPLATE, source, **SPEC)
+        assert found.verdict.word == reference.verdict.word == "PASS"
+        for mine, theirs in zip(found.verdict.criteria, reference.verdict.criteria,
+                                strict=True):
+            assert mine.value == pytest.approx(theirs.value, rel=1e-12), mine.name
+
+
 def test_an_mme_test_that_lies_or_links_out_is_one_line(pulse, tmp_path, capsys):
     """A sample count that is not the lines there are, a channel file that is a symlink (to
     a file outside the test) or a FIFO, and a Channel folder that is a symlink: one line

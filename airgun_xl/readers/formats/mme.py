@@ -50,16 +50,24 @@ _CHANNEL_FILE = re.compile(r"\.\d{3}$")
 
 
 def sniff(head: bytes) -> bool:
-    """An MME file or channel file starts with one of the format's header lines."""
+    """An MME file or channel file starts with one of the format's header lines (an NHTSA
+    export's test file with ``Data format``, its channel files with ``Channel code``)."""
     text = _decode(head).lstrip("\ufeff").lstrip()
     first = text.split("\n", 1)[0].strip().lower()
-    return re.match(r"^(data format edition number|instrumentation standard)\s*:", first) \
-        is not None
+    return re.match(r"^(data format( edition number)?|instrumentation standard|channel code)"
+                    r"\s*:", first) is not None
 
 
 def channel_file(path: str | Path) -> bool:
     """Whether ``path`` is named as an MME channel file (``TEST.001``)."""
     return _CHANNEL_FILE.search(Path(path).name) is not None
+
+
+def _is_channel(data: bytes) -> bool:
+    """Whether the file's header is a channel's (it names a channel, or its samples' step),
+    whatever the file is called; a test's ``.mme`` file names neither."""
+    fields, _ = _header(_decode(data[:HEADER_BYTES]))
+    return any(key in fields for key in (NAME_FIELD, CODE, STEP))
 
 
 def _decode(data: bytes) -> str:
@@ -213,7 +221,7 @@ def _test(path: str | Path, data: bytes) -> list[tuple[Path, bytes | None]]:
     """The channel files of the test or channel file at ``path``: (path, its bytes when
     already read, else None)."""
     path = Path(path)
-    if channel_file(path):
+    if channel_file(path) or _is_channel(data):
         return [(path, data)]
     return [(p, None) for p in _channel_files(path)]
 
