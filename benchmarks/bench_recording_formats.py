@@ -8,7 +8,8 @@ checked), as a fresh process.
 Formats: CSV (time and acceleration, repr), LabVIEW TDMS (npTDMS writes it), MATLAB v5
 uncompressed and v7 compressed (scipy's savemat writes them, airgun-xl's reader reads them),
 v7.3 (h5py writes it, with MATLAB's header), ASAM MDF 4.10 (asammdf writes it; read in a
-child process), and UFF dataset 58 binary and ASCII (pyuff
+child process), enDAQ IDE (ebmlite writes it on idelib's schema: 16-bit counts and a
+calibration, blocks of 4,096 samples), and UFF dataset 58 binary and ASCII (pyuff
 writes and reads them; pyuff parses every dataset of the file, both channels here).
 Reports each one's file size, the median wall time over N runs after a warm-up and the peak
 RSS; the process's import of airgun-xl is in every figure (the first row, a process that
@@ -16,8 +17,8 @@ reads nothing, is that floor). --quick: 100,000 samples.
 
 Then a file far larger than its pulse, in each format that reads a window (MDF, TDMS): a
 10 s channel at 1 MHz (float32, the half-sine at 4.2 s) beside channels of zeros that make
-the file AIRGUN_BENCH_LARGE_GB gigabytes (20 by default; with --quick, 3 s beside 64 MB, still
-past the samples read whole); the page cache
+the file AIRGUN_BENCH_LARGE_GB gigabytes (20 by default, 0 to leave this part out; with
+--quick, 3 s beside 64 MB, still past the samples read whole); the page cache
 is dropped before each run where the machine lets us (root on Linux), so the file is read
 from the disk.
 """
@@ -77,6 +78,13 @@ def files(tmp, n):
     except ImportError:
         pass
     try:
+        from test_recording_formats import _write_ide
+
+        out["enDAQ IDE (idelib)"], _ = _write_ide(tmp / "r.ide", tmp / "ide.csv", a,
+                                                  rate=1_000_000, per_block=4096)
+    except ImportError:
+        pass
+    try:
         from test_recording_formats import _write_uff58
 
         for binary, name in ((1, "UFF 58b (binary)"), (0, "UFF 58 (ASCII)")):
@@ -95,7 +103,8 @@ def bench_formats(repeat, tmp):
     rows.append(("import only (the floor)", "", f"{statistics.median(walls):.2f} s",
                  f"peak RSS {max(rss):.0f} MB"))
     for name, path in files(tmp, n).items():
-        channel = "accel" if path.suffix == ".mf4" else None  # its slow channel comes first
+        # their slow channel comes first
+        channel = {".mf4": "accel", ".ide": "Acceleration/X"}.get(path.suffix)
         cmd = [sys.executable, "-c", "import sys; from airgun_xl.readers.recording import "
                "read_trace; read_trace(sys.argv[1], channel=sys.argv[2] or None)", str(path),
                channel or ""]
@@ -163,6 +172,8 @@ def bench_large(repeat, tmp):
     gb, n, bulk = ((0.0625, 3_000_000, 2**21) if quick() else
                    (float(os.environ.get("AIRGUN_BENCH_LARGE_GB", "20")), 10_000_000, 2**25))
     rows = []
+    if gb <= 0:
+        return rows
     for name, path in large_files(tmp, gb, n, bulk).items():
         cmd = [sys.executable, "-c", "import sys; from airgun_xl.readers.recording import "
                "read_trace; read_trace(sys.argv[1])", str(path)]

@@ -62,6 +62,9 @@ def pulse(tmp_path_factory):
     files["mme"] = test.parent / "Channel" / "TEST.002"
     if _asammdf() is not None:
         files["mdf"] = _write_mdf(folder / "shot.mf4", trace.time, trace.accel_kg / KG_PER_G)
+    if _idelib() is not None:
+        files["ide"], files["ide_csv"] = _write_ide(folder / "shot.ide", folder / "ide_ref.csv",
+                                                    trace.accel_kg / KG_PER_G)
     if _h5py() is not None:
         files["v73"] = _write_v73(folder / "v73.mat", {"time": trace.time, "time_unit": "s",
                                                        "accel": trace.accel_kg / KG_PER_G,
@@ -101,6 +104,60 @@ def _write_mdf(path, t, g):
     mdf.save(path, overwrite=True)
     mdf.close()
     return path
+
+
+def _idelib():
+    try:
+        import idelib
+    except ImportError:
+        return None
+    return idelib
+
+
+#: The IDE fixture's calibration: g = IDE_GAIN * counts + IDE_OFFSET (16-bit counts: the pulse
+#: peaks near 9,500 g, 19,000 counts).
+IDE_GAIN, IDE_OFFSET = 0.5, 1.5
+
+
+def _write_ide(path, csv, g, rate=51_200, per_block=100, properties=True):
+    """An enDAQ IDE file by ebmlite's writer on idelib's own schema: a temperature channel,
+    then the pulse as 16-bit counts of an accelerometer's subchannel ``X`` with a
+    calibration polynomial (gain and offset) to g, in blocks whose time codes count samples
+    (TimeCodeScale 1/rate); and ``csv``, the same samples as the file defines them (time k /
+    rate from its start, g = gain x counts + offset), worked out here, not by idelib."""
+    from ebmlite import loadSchema
+
+    counts = np.round((np.asarray(g) - IDE_OFFSET) / IDE_GAIN).astype("<i2")
+    accel = [{"ChannelDataBlock": {
+        "ChannelIDRef": 8, "StartTimeCodeAbsMod": k,
+        "EndTimeCodeAbsMod": min(k + per_block, len(counts)) - 1,
+        "ChannelDataPayload": counts[k:k + per_block].tobytes()}}
+        for k in range(0, len(counts), per_block)]
+    temperature = [{"ChannelDataBlock": {
+        "ChannelIDRef": 36, "StartTimeCodeAbsMod": 0, "EndTimeCodeAbsMod": 9,
+        "ChannelDataPayload": np.full(10, 21.0, dtype="<f4").tobytes()}}]
+
+    def channel(number, name, fmt, sub, unit, calibration=None):
+        described = {"SubChannelID": 0, "SubChannelName": sub, "SubChannelUnits": unit,
+                     "SubChannelSensorRef": 0}
+        if calibration is not None:
+            described["SubChannelCalibrationIDRef"] = calibration
+        return {"ChannelID": number, "ChannelName": name, "ChannelFormat": fmt,
+                "TimeCodeScale": f"1/{rate}", "TimeCodeModulus": 2**32,
+                "SampleRate": str(rate), "SubChannel": [described]}
+
+    head = [{"RecordingProperties": {
+        "SensorList": {"Sensor": [{"SensorID": 0, "SensorName": "bird recorder"}]},
+        "ChannelList": {"Channel": [channel(36, "Temperature", "<f", "T", "degC"),
+                                    channel(8, "Acceleration", "<h", "X", "g", 1)]}}},
+        {"CalibrationList": {"UnivariatePolynomial": [
+            {"CalID": 1, "CalReferenceValue": 0.0, "PolynomialCoef": [IDE_GAIN, IDE_OFFSET]}]}}]
+    path.write_bytes(loadSchema("mide_ide.xml").encodes(
+        (head if properties else []) + temperature + accel, headers=True))
+    values = IDE_GAIN * counts.astype(float) + IDE_OFFSET
+    csv.write_text("time [s],acceleration [g]\n" + "".join(
+        f"{k / rate!r},{v!r}\n" for k, v in enumerate(values.tolist())))
+    return path, csv
 
 
 def _pyuff():
@@ -170,7 +227,7 @@ def test_scipy_reads_our_v73_header_as_v73(pulse):
         assert matfile_version(fh) == (2, 0)
 
 
-@pytest.mark.parametrize("kind", ["v5", "fs", "v73", "ascii", "binary", "mdf"])
+@pytest.mark.parametrize("kind", ["v5", "fs", "v73", "ascii", "binary", "mdf", "ide"])
 def test_accept_gives_the_csvs_verdict_and_figures(pulse, kind, tmp_path):
     """Every criterion's value from the file equals the CSV's within 1e-12 relative: the file
     holds the samples in g or its time in ms, or as fs and t0, and a product's rounding is
@@ -179,13 +236,16 @@ def test_accept_gives_the_csvs_verdict_and_figures(pulse, kind, tmp_path):
     (4E20.12: 13 significant digits, so 1e-11 relative). A UFF
     file's time base is its header's start and increment, stored as E13.5: its reference is
     the CSV of the same samples on that time base. Its second time response is chosen by its
-    name."""
+    name. An IDE file's reference is the CSV of the samples it defines (its 16-bit counts
+    through its calibration polynomial, its time codes' times), its channel chosen by name."""
     folder, trace, files = pulse
     if kind not in files:
-        pytest.skip("needs h5py or pyuff")
+        pytest.skip("needs h5py, pyuff, asammdf or idelib")
     uff = kind in ("ascii", "binary")
-    channel = {"channel": "accel"} if uff or kind == "mdf" else {}
-    reference = airgun_xl.accept(TEMPLATE, files["uff_csv" if uff else "csv"], **SPEC)
+    channel = ({"channel": "accel"} if uff or kind == "mdf" else
+               {"channel": "Acceleration/X"} if kind == "ide" else {})
+    reference = airgun_xl.accept(TEMPLATE, files["uff_csv" if uff else "ide_csv" if kind == "ide"
+                                                 else "csv"], **SPEC)
     found = airgun_xl.accept(TEMPLATE, files[kind], **SPEC, **channel)
     assert found.verdict.word == reference.verdict.word == "PASS"
     for mine, theirs in zip(found.verdict.criteria, reference.verdict.criteria, strict=True):
@@ -194,21 +254,32 @@ def test_accept_gives_the_csvs_verdict_and_figures(pulse, kind, tmp_path):
         assert mine.value == pytest.approx(theirs.value, rel=rel), mine.name
 
 
-def test_compare_measured_and_calibrate_give_the_csvs_figures(pulse):
+#: Each format's file, its reference CSV (the same samples) and its channel option.
+SOURCES = {"v5": ("csv", {}), "mdf": ("csv", {"channel": "accel"}),
+           "binary": ("uff_csv", {"channel": "accel"}), "mme": ("csv", {}),
+           "ide": ("ide_csv", {"channel": "Acceleration/X"})}
+
+
+@pytest.mark.parametrize("kind", list(SOURCES))
+def test_compare_measured_and_calibrate_give_the_csvs_figures(pulse, kind):
+    """compare-measured's figures and calibrate's fit from each format equal the reference
+    CSV's: the figures within a rounding of the time (v5 holds it in ms), the fit to a
+    thousandth of its standard error (the optimiser stops on a tolerance)."""
     folder, trace, files = pulse
-    ref = airgun_xl.compare_measured(TEMPLATE, files["csv"]).comparison
-    mat = airgun_xl.compare_measured(TEMPLATE, files["v5"]).comparison
-    # the time vector in ms, read back in s: the figures within a rounding of the time
+    if kind not in files:
+        pytest.skip("needs pyuff, asammdf or idelib")
+    reference, channel = SOURCES[kind]
+    ref = airgun_xl.compare_measured(TEMPLATE, files[reference]).comparison
+    mine = airgun_xl.compare_measured(TEMPLATE, files[kind], **channel).comparison
     for field in ("peak_kg", "time_of_peak", "pulse_duration", "delta_v"):
-        assert getattr(mat.measured, field) == pytest.approx(getattr(ref.measured, field),
-                                                             rel=1e-12), field
-    assert mat.correlation == pytest.approx(ref.correlation, rel=1e-12)
-    calibrations = [airgun_xl.calibrate(TEMPLATE, files[k], fit="scale").calibration
-                    for k in ("csv", "v5")]
+        assert getattr(mine.measured, field) == pytest.approx(getattr(ref.measured, field),
+                                                              rel=1e-12), field
+    assert mine.correlation == pytest.approx(ref.correlation, rel=1e-12)
+    calibrations = [airgun_xl.calibrate(TEMPLATE, files[reference], fit="scale").calibration,
+                    airgun_xl.calibrate(TEMPLATE, files[kind], fit="scale",
+                                        **channel).calibration]
     fitted = [c.fitted for c in calibrations]
     errors = calibrations[0].errors
-    # the time read back from ms differs from the CSV's in its last bits, and the fit's
-    # optimiser stops on a tolerance: the same fit, to a thousandth of its standard error
     assert fitted[0].keys() == fitted[1].keys() and fitted[0]
     for key in fitted[0]:
         assert abs(fitted[1][key] - fitted[0][key]) < 1e-3 * errors[key], key
@@ -314,7 +385,7 @@ def _mutations():
                     max_size=12), st.integers(0, 10**6)
 
 
-@pytest.mark.parametrize("kind", ["v5", "fs", "v73", "ascii", "binary", "mme"])
+@pytest.mark.parametrize("kind", ["v5", "fs", "v73", "ascii", "binary", "mme", "ide"])
 def test_any_damage_to_a_recording_is_a_trace_or_one_error(pulse, kind):
     """Bytes overwritten anywhere, and the file cut anywhere (hypothesis, derandomized): the
     reader gives a Trace or one AirgunXlError, never another exception or a warning."""
@@ -326,7 +397,7 @@ def test_any_damage_to_a_recording_is_a_trace_or_one_error(pulse, kind):
 
     folder, trace, files = pulse
     if kind not in files:
-        pytest.skip("needs h5py or pyuff")
+        pytest.skip("needs h5py, pyuff or idelib")
     good = files[kind].read_bytes()
     flips, cuts = _mutations()
     target = folder / f"damaged_{kind}{files[kind].suffix}"  # an MME channel file: .002
@@ -834,3 +905,33 @@ def test_a_file_past_the_input_cap_is_opened_by_the_reader(pulse, tmp_path, monk
     assert err.count("\n") == 1 and not out.exists()
     assert f"{path.name}: is 0.{path.stat().st_size // 100_000} MB, expected a recording of at " \
         "most 0.2 MB" in err
+
+
+def test_an_ide_files_subchannels_are_listed_and_an_undescribed_file_refused(pulse, tmp_path,
+                                                                             capsys):
+    """``recording`` lists each IDE subchannel as CHANNEL/SUBCHANNEL with the unit the file
+    states and its rate measured from its time codes; the values read are the calibrated
+    ones (the counts through the polynomial, not the counts). A file without recording
+    properties is refused in one line, not read with idelib's guess of an old recorder's
+    channels."""
+    folder, trace, files = pulse
+    if "ide" not in files:
+        pytest.skip("needs idelib")
+    assert main(["recording", str(files["ide"]), "--json"]) == 0
+    listed = json.loads(capsys.readouterr().out)
+    assert listed["format"] == "enDAQ IDE"
+    assert [(c["name"], c["unit"], c["samples"]) for c in listed["channels"]] == [
+        ("Temperature/T", "degC", 10), ("Acceleration/X", "g", len(trace.time))]
+    assert listed["channels"][1]["rate_hz"] == pytest.approx(51_200, rel=1e-12)
+    from airgun_xl.readers.recording import read_trace
+
+    read = read_trace(files["ide"], channel="2")
+    expected = np.loadtxt(files["ide_csv"], delimiter=",", skiprows=1)
+    assert np.array_equal(read.accel_kg, expected[:, 1] * KG_PER_G)
+    bare, _ = _write_ide(tmp_path / "bare.ide", tmp_path / "bare.csv",
+                         trace.accel_kg / KG_PER_G, properties=False)
+    out = tmp_path / "a.xlsx"
+    assert main(["accept", str(TEMPLATE), str(bare), "--peak", "9kG:10%", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and not out.exists()
+    assert "bare.ide: has no recording properties (no channel described" in err

@@ -1,7 +1,7 @@
 """A measured pulse from a CSV file, a workbook's column range or a recorder's file (TDMS,
-MATLAB, MDF, UFF, MME: :mod:`.formats`): time and acceleration, with units from the header (``time
-[ms]``, ``accel (g)``, a channel's unit as its file states it) or given, every row checked;
-and a required shock response spectrum (CSV).
+MATLAB, MDF, IDE, UFF, MME: :mod:`.formats`): time and acceleration, with units from the
+header (``time [ms]``, ``accel (g)``, a channel's unit as its file states it) or given, every
+row checked; and a required shock response spectrum (CSV).
 
 The file is read like any untrusted input (:func:`airgun_xl.readers.guard.read_bytes`: a
 regular file, size capped). Each fault is one line naming the row: a row that is not two
@@ -259,7 +259,7 @@ def _source_table(path, channel=None):
     if found and not Path(text).exists():
         if channel is not None:
             raise OptionError("--channel: found with a workbook range, expected it only "
-                              "with a file of several channels (TDMS, MATLAB .mat, MDF, UFF, "
+                              "with a file of several channels (TDMS, MATLAB .mat, MDF, IDE, UFF, "
                               "MME)")
         return formats.Table(*_range_table(found))
     fmt = formats.detect(path)
@@ -267,7 +267,7 @@ def _source_table(path, channel=None):
         return fmt.read(path, formats.source(fmt, path), channel)
     if channel is not None:
         raise OptionError("--channel: found with a CSV file, expected it only with a file of "
-                          "several channels (TDMS, MATLAB .mat, MDF, UFF, MME)")
+                          "several channels (TDMS, MATLAB .mat, MDF, IDE, UFF, MME)")
     return formats.Table(*_table(path, EXPECTED, ("time", "acceleration")))
 
 

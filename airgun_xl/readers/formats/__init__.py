@@ -35,7 +35,7 @@ from types import ModuleType
 
 from ... import limits
 from ..guard import LargeFile, large_file, read_bytes
-from . import mat, mdf, mme, tdms, uff
+from . import ide, mat, mdf, mme, tdms, uff
 from .channels import ChannelInfo, Table, choose
 
 #: Bytes read to tell a format by its content (a MATLAB v7.3 file's HDF5 signature is at 512).
@@ -43,10 +43,10 @@ HEAD = 1024
 
 #: The formats told by content, in the order they are tried; a file none of them claims is
 #: read as CSV.
-FORMATS: tuple[ModuleType, ...] = (tdms, mat, mdf, uff, mme)
+FORMATS: tuple[ModuleType, ...] = (tdms, mat, mdf, ide, uff, mme)
 
-EXPECTED_RECORDING = ("expected a recording (CSV, TDMS, MATLAB .mat, MDF, UFF 58 or ISO 13499 "
-                      "MME)")
+EXPECTED_RECORDING = ("expected a recording (CSV, TDMS, MATLAB .mat, MDF, enDAQ IDE, UFF 58 or "
+                      "ISO 13499 MME)")
 
 
 def detect(path: str | Path) -> ModuleType | None:
