@@ -913,7 +913,7 @@ def test_an_ide_files_subchannels_are_listed_and_an_undescribed_file_refused(pul
     states and its rate measured from its time codes; the values read are the calibrated
     ones (the counts through the polynomial, not the counts). A file without recording
     properties is refused in one line, not read with idelib's guess of an old recorder's
-    channels."""
+    channels; so is one whose properties nest 20,000 deep."""
     folder, trace, files = pulse
     if "ide" not in files:
         pytest.skip("needs idelib")
@@ -935,3 +935,14 @@ def test_an_ide_files_subchannels_are_listed_and_an_undescribed_file_refused(pul
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and not out.exists()
     assert "bare.ide: has no recording properties (no channel described" in err
+    # 20,000 recording properties, each inside the last (EBML nests): one line as well
+    from ebmlite import loadSchema
+
+    nested = b""
+    for _ in range(20_000):  # the element's ID, an 8-byte size, its payload
+        nested = bytes.fromhex("18526570") + b"\x01" + len(nested).to_bytes(7, "big") + nested
+    deep = tmp_path / "deep.ide"
+    deep.write_bytes(loadSchema("mide_ide.xml").encodes([], headers=True) + nested)
+    assert main(["recording", str(deep)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "deep.ide: has no recording properties" in err
