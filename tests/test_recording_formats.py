@@ -724,6 +724,57 @@ def test_an_mme_export_in_nhtsas_layout_is_told_by_content_and_read(pulse, tmp_p
             assert mine.value == pytest.approx(theirs.value, rel=1e-12), mine.name
 
 
+def test_an_mme_channels_explicit_time_is_its_reference_channel(pulse, tmp_path, capsys):
+    """``Reference channel :explicit``: the time is the values of the channel that
+    ``Reference channel name`` names (here by its code, a time channel in ms, as NHTSA's
+    tests list a ``Time reference`` channel first). The verdict is the CSV's of those times
+    and values, from the test and from the channel file named alone; a reference the test
+    does not hold, or one of another length, is one line."""
+    folder, trace, files = pulse
+    g = trace.accel_kg / KG_PER_G
+    ms = trace.time * 1e3
+    test = tmp_path / "explicit"
+    (test / "Channel").mkdir(parents=True)
+    (test / "T1.mme").write_text("Data format                 :ISO-MME\n")
+
+    def channel(code, name, unit, values, reference="NOVALUE"):
+        fields = [("Channel code", code), ("Reference channel",
+                                           "explicit" if reference != "NOVALUE" else "implicit"),
+                  ("Reference channel name", reference), ("Name of the channel", name),
+                  ("Sampling interval", "NOVALUE"), ("Unit", unit),
+                  ("Time of first sample", "NOVALUE"), ("Number of samples", str(len(values)))]
+        return "".join(f"{k:<28}:{v}\n" for k, v in fields) + "".join(
+            f"{v!r}\n" for v in values.tolist())
+
+    (test / "Channel" / "T1.001").write_text(channel("11TIRS000000TIRP", "Time reference",
+                                                     "ms", ms))
+    (test / "Channel" / "T1.002").write_text(channel("10BIRD0000XXACXP", "Bird X", "g", g,
+                                                     "11TIRS000000TIRP"))
+    ref = tmp_path / "ref.csv"
+    ref.write_text("time [ms],acceleration [g]\n" + "".join(
+        f"{x!r},{y!r}\n" for x, y in zip(ms.tolist(), g.tolist(), strict=True)))
+    reference = airgun_xl.accept(TEMPLATE, ref, **SPEC)
+    for source, channel_option in ((test / "T1.mme", "Bird X"),
+                                   (test / "Channel" / "T1.002", None)):
+        found = airgun_xl.accept(TEMPLATE, source, **SPEC, channel=channel_option)
+        assert found.verdict.word == reference.verdict.word == "PASS"
+        assert [c.value for c in found.verdict.criteria] == [
+            c.value for c in reference.verdict.criteria]
+    (test / "Channel" / "T1.001").write_text(channel("11TIRS000000TIRP", "Time reference",
+                                                     "ms", ms[:-1]))
+    assert main(["accept", str(TEMPLATE), str(test / "T1.mme"), "--channel", "Bird X",
+                 "--peak", "9kG:10%"]) == 2
+    assert (f"holds {len(g):,} samples and its reference channel '11TIRS000000TIRP' "
+            f"{len(g) - 1:,} times") in capsys.readouterr().err
+    (test / "Channel" / "T1.001").unlink()
+    (test / "Channel" / "T1.002").rename(test / "Channel" / "T1.001")
+    assert main(["accept", str(TEMPLATE), str(test / "T1.mme"), "--peak", "9kG:10%"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "its time is explicit, in the reference channel '11TIRS000000TIRP', which the " \
+        "test does not hold" in err
+
+
 def test_an_mme_test_that_lies_or_links_out_is_one_line(pulse, tmp_path, capsys):
     """A sample count that is not the lines there are, a channel file that is a symlink (to
     a file outside the test) or a FIFO, and a Channel folder that is a symlink: one line

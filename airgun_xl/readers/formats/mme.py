@@ -3,12 +3,14 @@ plain text, and its one Python library pins old numpy, pandas and scipy.
 
 A test is a folder: ``TEST.mme`` (the test's description), ``Channel/TEST.chn`` (the channel
 list) and a file per channel, ``Channel/TEST.001``, ``.002``... A channel file is a header of
-``Name :value`` lines, then its samples, one per line (the time implicit, from ``Time of
-first sample`` and ``Sampling interval``), or two per line, time and value (explicit). The
-fields read: ``Name of the channel``, ``Channel code``, ``Unit``, ``Time of first sample``,
-``Sampling interval`` and ``Number of samples``; ``NOVALUE`` is the format's word for a field
-not given. The text's encoding is UTF-8 (with or without a byte-order mark), else Windows-1252,
-else Latin-1.
+``Name :value`` lines, then its samples, one per line, the time implicit (from ``Time of
+first sample`` and ``Sampling interval``) or explicit (``Reference channel :explicit``: the
+values of the test's channel that ``Reference channel name`` names, by name or code, in its
+own unit), or two per line, time and value. The fields read: ``Name of the channel``,
+``Channel code``, ``Unit``, ``Time of first sample``, ``Sampling interval``, ``Number of
+samples``, ``Reference channel`` and ``Reference channel name``; ``NOVALUE`` is the format's
+word for a field not given. The text's encoding is UTF-8 (with or without a byte-order
+mark), else Windows-1252, else Latin-1.
 
 Given the ``.mme`` file, its channels are the numbered files of its ``Channel`` folder, each
 read like any input (a regular file, not a symlink, its size capped), and ``--channel`` takes
@@ -38,6 +40,7 @@ EXPECTED = ("expected an ISO 13499 MME test (its .mme file, with its Channel fol
 #: The fields a channel file's header is read for (lower case, spaces single).
 NAME_FIELD, CODE, UNIT = "name of the channel", "channel code", "unit"
 FIRST, STEP, COUNT = "time of first sample", "sampling interval", "number of samples"
+REFERENCE, REFERENCE_NAME = "reference channel", "reference channel name"
 
 #: The format's word for a field not given.
 NOVALUE = "NOVALUE"
@@ -127,9 +130,19 @@ def _channel_files(path: Path) -> list[Path]:
     if not stat.S_ISDIR(st.st_mode):
         raise WorkbookError(f"{shown}: its Channel folder is not a folder (a symlink or a "
                             f"file), {EXPECTED}")
+    found = _numbered(folder, path.stem)
+    if not found:
+        raise WorkbookError(f"{shown}: its Channel folder holds no {path.stem}.001, "
+                            f"{EXPECTED}")
+    return found
+
+
+def _numbered(folder: Path, stem: str) -> list[Path]:
+    """``stem.001``, ``stem.002``... in ``folder``, up to the first missing; each must be a
+    regular file (no symlink)."""
     found = []
     for k in range(1, MAX_CHANNELS + 1):
-        candidate = folder / f"{path.stem}.{k:03d}"
+        candidate = folder / f"{stem}.{k:03d}"
         try:
             st = os.lstat(candidate)
         except OSError:
@@ -138,9 +151,6 @@ def _channel_files(path: Path) -> list[Path]:
             raise WorkbookError(f"{display(candidate)}: is not a regular file (a symlink or "
                                 f"a device), {EXPECTED}")
         found.append(candidate)
-    if not found:
-        raise WorkbookError(f"{shown}: its Channel folder holds no {path.stem}.001, "
-                            f"{EXPECTED}")
     return found
 
 
@@ -161,6 +171,8 @@ class _Channel:
             raise WorkbookError(f"{self.shown}: '{COUNT}' is {count:g}, expected a whole "
                                 "count")
         self.count = None if count is None else int(count)
+        self.explicit = (_given(fields, REFERENCE) or "").lower() == "explicit"
+        self.reference = _given(fields, REFERENCE_NAME)
 
     @property
     def info(self) -> ChannelInfo:
@@ -169,8 +181,8 @@ class _Channel:
             sum(1 for line in self.body if line.strip()) if self.complete else 0)
         return ChannelInfo(self.name, self.unit, rate, samples, self.first)
 
-    def samples(self) -> np.ndarray:
-        """(n, 2): time [s] and value, every line checked."""
+    def numbers(self) -> np.ndarray:
+        """The sample lines' numbers, (n, 1) or (n, 2), every line checked."""
         if self.count is not None and self.count > limits.MAX_SAMPLES:  # before any parse
             raise WorkbookError(f"{self.shown}: channel {self.name!r} declares "
                                 f"{self.count:,} samples, expected at most "
@@ -196,8 +208,20 @@ class _Channel:
             bad = next(k for k, r in enumerate(rows) if not _all_numbers(r))
             raise WorkbookError(f"{self.shown}: sample {bad + 1} is {' '.join(rows[bad])[:40]!r}"
                                 f", expected numbers") from None
+        return values
+
+    def samples(self, time: np.ndarray | None = None) -> np.ndarray:
+        """(n, 2): time and value (the time in s, or ``time`` given: the explicit reference
+        channel's values, which must be as many)."""
+        values = self.numbers()
         if values.shape[1] == 2:
             return values
+        if time is not None:
+            if len(time) != len(values):
+                raise WorkbookError(f"{self.shown}: holds {len(values):,} samples and its "
+                                    f"reference channel {self.reference!r} {len(time):,} "
+                                    f"times, expected one time a sample")
+            return np.column_stack([time, values[:, 0]])
         if self.step is None or self.step <= 0:
             raise WorkbookError(f"{self.shown}: its samples have no time (one number a line) "
                                 f"and '{STEP}' is not a positive number, {EXPECTED}")
@@ -256,6 +280,26 @@ def read(path: str | Path, data: bytes, channel: str | None) -> Table:
     whole = data if Path(path) == where else read_bytes(where, EXPECTED, "MME channel",
                                                         follow=False)  # linked meanwhile
     chosen = _Channel(where, whole)
-    values = chosen.samples()
-    header = ["time [s]", f"acceleration [{chosen.unit}]" if chosen.unit else "acceleration"]
+    time_unit, time = "s", None
+    if chosen.explicit and chosen.reference:  # the time is another channel's values
+        reference = _reference(where, chosen, headers)
+        time_unit, time = reference.unit or "s", reference.numbers()[:, -1]
+    values = chosen.samples(time)
+    header = [f"time [{time_unit}]",
+              f"acceleration [{chosen.unit}]" if chosen.unit else "acceleration"]
     return Table(f"{chosen.shown} ({chosen.name})", header, values)
+
+
+def _reference(where: Path, chosen: _Channel, headers: list[tuple[Path, _Channel]]
+               ) -> _Channel:
+    """The channel that ``chosen``'s ``Reference channel name`` names (by name or code):
+    among the test's channels, or, for a channel file read alone, its numbered siblings."""
+    pool = headers if len(headers) > 1 else [
+        (p, _Channel(p, read_bytes(p, EXPECTED, "MME channel", head=HEADER_BYTES,
+                                   follow=False), False))
+        for p in _numbered(where.parent, where.stem)]
+    for p, c in pool:
+        if p != where and chosen.reference in (c.name, c.code):
+            return _Channel(p, read_bytes(p, EXPECTED, "MME channel", follow=False))
+    raise WorkbookError(f"{chosen.shown}: its time is explicit, in the reference channel "
+                        f"{chosen.reference!r}, which the test does not hold, {EXPECTED}")
