@@ -397,6 +397,28 @@ def recording(path: str | os.PathLike[str]) -> RecordingOutcome:
     return run(os.fspath(path))
 
 
+def serve(archive: str | os.PathLike[str], *, host: str = "127.0.0.1",
+          port: int = 8765) -> None:
+    """Serve the archive's read-only view in a browser until Ctrl-C, as ``airgun-xl serve``
+    does (needs the ``web`` extra): the loopback address unless ``host`` says otherwise (the
+    page has no login); ``port`` 0 takes any free port. The address is printed once it
+    listens.
+
+    Raises
+    ------
+    AirgunXlError
+        No such archive, a port in use, or the extra missing, named.
+    """
+    from .errors import OptionError
+
+    try:
+        from .web.server import serve as run
+    except ImportError:
+        raise OptionError("serve: needs the web extra (Starlette, uvicorn, Jinja2), expected "
+                          "it installed: pip install 'airgun-xl[web]'") from None
+    run(os.fspath(archive), host, port)
+
+
 def template(output: str | os.PathLike[str], *, force: bool = False) -> os.PathLike[str]:
     """Write a fresh shot A workbook in the report's layout, as ``airgun-xl template``
     does; the path written."""
@@ -692,6 +714,7 @@ __all__ = [
     "load",
     "next_shot",
     "recording",
+    "serve",
     "show",
     "srs",
     "sweep",

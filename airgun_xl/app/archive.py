@@ -269,7 +269,11 @@ class ShowOutcome:
 
 def show(entry: str, archive: str | None = None) -> ShowOutcome:
     """One archived run (``airgun-xl show ENTRY``): SHOT, SHOT@VERSION or #ID."""
-    found = Archive(archive_dir(archive))
+    return show_entry(Archive(archive_dir(archive)), entry)
+
+
+def show_entry(found: Archive, entry: str) -> ShowOutcome:
+    """One run of an archive already open (``serve`` holds one, its index read-only)."""
     e = found.checked(found.get(entry))  # what verify would report is refused
     doc = {"entry": e.ref, "id": e.id, "path": str(e.path), "created": e.created,
            "params": e.load("params.json"), "summary": e.load("summary.json"),
@@ -365,6 +369,17 @@ def compare(request: CompareRequest) -> CompareOutcome:
         lines.append(f"inputs: the {len(pa)} parameter cells agree")
     lines.append(format_report(report))
     return CompareOutcome(report, bool(report.same), files, tuple(lines))
+
+
+def predicted_pulse(entry: Entry) -> tuple[Any, Any]:
+    """An entry's predicted pulse: its time [s] and the bird's acceleration [kG]."""
+    columns = _history(entry)
+    missing = [c for c in ("time", "accel_kg") if c not in columns]
+    if missing:
+        raise ArchiveError(f"{entry.ref}: its history has no {', '.join(missing)} column, "
+                           "expected the run's time and acceleration (see airgun-xl archive "
+                           "verify)")
+    return columns["time"], columns["accel_kg"]
 
 
 def _history(entry: Entry) -> dict[str, Any]:

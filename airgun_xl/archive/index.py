@@ -367,15 +367,23 @@ class SqliteIndex:
 
     kind = "sqlite"
 
-    def __init__(self, root):
+    def __init__(self, root, read_only=False):
         self.path = Path(root) / INDEX
         self.label = self.shown = display(self.path)
+        self.read_only = read_only  # opened with SQLite's mode=ro: a reader that cannot write
 
     def exists(self):
         return self.path.exists()
 
     def _connect(self):
         try:
+            if self.read_only:
+                from urllib.parse import quote
+
+                conn = sqlite3.connect(f"file:{quote(str(self.path.resolve()))}?mode=ro",
+                                       uri=True, timeout=LOCK_WAIT, isolation_level=None)
+                conn.row_factory = sqlite3.Row
+                return conn
             conn = sqlite3.connect(self.path, timeout=LOCK_WAIT, isolation_level=None)
             conn.row_factory = sqlite3.Row
             _prepare(conn)

@@ -17,6 +17,7 @@ from . import (
     fill,
     next_shot,
     recording,
+    serve,
     srs,
     sweep,
     template,
@@ -24,7 +25,7 @@ from . import (
 from .spec_options import PLAIN_OPTIONS, QUANTITY_OPTIONS
 
 COMMANDS = (fill, diff, archive, check, convergence, design, sweep, srs, compare_measured,
-            calibrate, accept, next_shot, recording, template)
+            calibrate, accept, next_shot, recording, serve, template)
 
 
 class _Parser(argparse.ArgumentParser):

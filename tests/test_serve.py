@@ -1,0 +1,229 @@
+"""Issue 48 (first part): ``airgun-xl serve``, the archive's read-only view, tested in a real
+browser: Debian's Chromium driven by Playwright (its executable path given, so no browser is
+downloaded), against a ``serve`` the test starts, on an archive of three shot A fills at
+230, 243.5 and 250 m/s, one of whose index rows is hostile (its shot name a script).
+
+The shots page draws its scatter, filters and sorts by URL (a reload keeps the view), pages on
+the server, and its CSV holds the rows shown; a shot's page draws the predicted pulse and lists
+its figures with units and its warnings. No page error, no request but to the server, and the
+hostile name is text. Over plain HTTP: POST is 405, a rebinding Host is 400, an id that is not
+a number or not in the index is 404, nothing outside the static folder is served, and a port
+in use is one line, exit 2."""
+import csv
+import io
+import json
+import os
+import shutil
+import signal
+import sqlite3
+import subprocess
+import sys
+import urllib.error
+import urllib.request
+
+import openpyxl
+import pytest
+from conftest import TEMPLATE
+
+from airgun_xl.cli import main
+
+pytest.importorskip("starlette")
+pytest.importorskip("uvicorn")
+pytestmark = pytest.mark.slow  # servers in processes, a browser
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+HOSTILE = "=HYPERLINK(\"http://x\")<script>window.pwned=1</script>"
+SPEEDS = (230.0, 243.5, 250.0)
+
+
+@pytest.fixture(scope="module")
+def archive(tmp_path_factory):
+    """Three fills of shot A (A28 at each speed) archived; the third's index row renamed to
+    a script, as a tampered index would hold it."""
+    work = tmp_path_factory.mktemp("serve")
+    root = work / "archive"
+    for v in SPEEDS:
+        book = openpyxl.load_workbook(TEMPLATE)
+        book.active["A28"] = v
+        shot = work / f"shot_{v:g}.xlsx"
+        book.save(shot)
+        assert main(["fill", str(shot), "-o", str(work / f"out_{v:g}.xlsx"), "--archive",
+                     str(root), "--name", f"shot_{v:g}"]) == 0
+    with sqlite3.connect(root / "index.sqlite") as conn:
+        conn.execute("UPDATE entries SET shot = ? WHERE id = 3", (HOSTILE,))
+    return root
+
+
+def _start(root, *extra):
+    """``airgun-xl serve`` on a free port: the process and its base URL (from its first
+    line)."""
+    process = subprocess.Popen(
+        [sys.executable, "-m", "airgun_xl", "serve", "--archive", str(root), "--port", "0",
+         *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    line = process.stdout.readline()
+    assert line.startswith("serving "), (line, process.stderr.read())
+    return process, line.split(" at ", 1)[1].split(" ", 1)[0].rstrip("/")
+
+
+@pytest.fixture(scope="module")
+def server(archive):
+    process, url = _start(archive)
+    yield url
+    process.send_signal(signal.SIGINT)
+    process.wait(timeout=20)
+
+
+def _get(url, method="GET", headers=None):
+    request = urllib.request.Request(url, method=method, headers=headers or {})
+    try:
+        with urllib.request.urlopen(request, timeout=20) as response:
+            return response.status, dict(response.headers), response.read()
+    except urllib.error.HTTPError as exc:
+        return exc.code, dict(exc.headers), exc.read()
+
+
+def test_only_get_from_this_machine_and_nothing_outside_the_archive(server):
+    status, headers, body = _get(f"{server}/shots")
+    assert status == 200 and headers["content-security-policy"].startswith("default-src 'self'")
+    assert headers["x-content-type-options"] == "nosniff"
+    assert _get(f"{server}/shots", "POST")[0] == 405
+    assert _get(f"{server}/shots", "DELETE")[0] == 405
+    assert _get(f"{server}/shots", headers={"Host": "attacker.example"})[0] == 400
+    assert _get(f"{server}/shot/999")[0] == 404
+    for path in ("/shot/..%2f..%2findex.sqlite", "/shot/1%2f..", "/static/..%2findex.sqlite",
+                 "/static/../../index.sqlite", "/index.sqlite"):
+        status, _h, body = _get(server + path)
+        assert status == 404 and b"SQLite" not in body, path
+    assert HOSTILE.encode() not in body
+
+
+def test_a_port_in_use_is_one_line_and_ctrl_c_stops_the_server(archive, server, capsys):
+    port = server.rsplit(":", 1)[1]
+    assert main(["serve", "--archive", str(archive), "--port", port]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"--port: 127.0.0.1:{port} cannot be listened on" in err
+    process, url = _start(archive)
+    assert _get(f"{url}/shots")[0] == 200
+    process.send_signal(signal.SIGINT)
+    process.wait(timeout=20)
+    assert "Traceback" not in process.stderr.read()
+
+
+@pytest.fixture(scope="module")
+def browser():
+    if CHROMIUM is None:
+        pytest.skip("needs Debian's chromium (apt-get install chromium)")
+    sync_api = pytest.importorskip("playwright.sync_api")
+    with sync_api.sync_playwright() as p:
+        launched = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        yield launched
+        launched.close()
+
+
+@pytest.fixture
+def page(browser, server):
+    """A fresh page that records every request's address and every page error."""
+    context = browser.new_context(viewport={"width": 1100, "height": 900})
+    page = context.new_page()
+    page.requests, page.errors = [], []
+    page.on("request", lambda r: page.requests.append(r.url))
+    page.on("pageerror", lambda e: page.errors.append(str(e)))
+    page.on("console", lambda m: m.type == "error" and page.errors.append(m.text))
+    yield page
+    assert not page.errors, page.errors
+    assert all(u.startswith(server + "/") for u in page.requests), page.requests
+    context.close()
+
+
+def _screenshot(page, name):
+    """With $AIRGUN_XL_SCREENSHOTS (a folder), the page as the browser drew it, for docs/."""
+    folder = os.environ.get("AIRGUN_XL_SCREENSHOTS")
+    if folder:
+        page.screenshot(path=os.path.join(folder, f"{name}.png"), full_page=False)
+
+
+def _rows(page):
+    page.wait_for_selector("#scatter[data-drawn]")  # the page loaded and its chart drawn
+    return [[c.strip() for c in row] for row in page.eval_on_selector_all(
+        "#shots tbody tr", "rows => rows.map(r => [...r.cells].map(c => c.textContent))")]
+
+
+def test_the_shots_page_filters_sorts_and_exports_what_it_shows(page, server):
+    page.goto(f"{server}/shots")
+    rows = _rows(page)
+    _screenshot(page, "serve-shots")
+    assert len(rows) == 3 and page.text_content("#count").startswith("3 runs")
+    assert page.get_attribute("#scatter", "data-drawn") == "3"
+    assert page.locator("#scatter canvas").count() == 1
+    assert HOSTILE in [r[1] for r in rows]  # the name is text on the page
+    assert page.evaluate("window.pwned") is None
+    # sorted by v0, descending: a click on its heading twice
+    page.click("#shots th:nth-child(5) a")
+    page.click("#shots th:nth-child(5) a")
+    assert [r[4] for r in _rows(page)] == ["250.00", "243.50", "230.00"]
+    assert "sort=v0" in page.url and "desc=1" in page.url
+    # filtered in place, and the view survives a reload by its URL
+    page.fill("input[name=v0_min]", "240")
+    page.click("#filters button")
+    assert [r[4] for r in _rows(page)] == ["250.00", "243.50"]
+    kept = page.url
+    page.goto(kept)
+    assert [r[4] for r in _rows(page)] == ["250.00", "243.50"]
+    assert page.get_attribute("#scatter", "data-drawn") == "2"
+    # the CSV holds the rows shown, in their order and units
+    response = page.request.get(server + page.get_attribute("#csv", "href"))
+    table = list(csv.reader(io.StringIO(response.text())))
+    assert table[0][:5] == ["#", "shot", "version", "created", "v0 [m/s]"]
+    assert [float(r[4]) for r in table[1:]] == [250.0, 243.5]
+    assert [r[0] for r in table[1:]] == [r[0] for r in _rows(page)]
+    # a text a spreadsheet would run (the hostile name starts with =) is written as text
+    assert [r[1] for r in table[1:]] == ["'" + HOSTILE, "shot_243.5"]
+
+
+def test_a_shots_page_draws_its_pulse_and_lists_its_figures_and_warnings(page, server,
+                                                                         archive):
+    page.goto(f"{server}/shots?sort=v0")
+    page.click("#shots tbody tr:first-child td.shot a")
+    page.wait_for_selector("#pulse[data-drawn]")
+    _screenshot(page, "serve-shot")
+    assert page.url == f"{server}/shot/1"
+    assert page.text_content("#entry").startswith("shot_230@1")
+    assert int(page.get_attribute("#pulse", "data-drawn")) > 1000
+    assert page.locator("#pulse canvas").count() == 1
+    figures = dict(page.eval_on_selector_all(
+        "#figures tr", "rows => rows.map(r => [r.cells[0].textContent, r.cells[1].textContent])"))
+    summary = json.loads((archive / "shot_230" / "v0001" / "summary.json").read_text())
+    assert figures["Peak acceleration (raw)"] == f"{summary['peak_kg']:,.5f} kG"
+    assert figures["Pulse duration"] == f"{summary['pulse_duration'] * 1e3:,.4f} ms"
+    warnings = summary["warnings"]
+    shown = page.eval_on_selector_all("#warnings li", "items => items.map(i => i.textContent)")
+    assert shown == warnings
+    assert page.locator("#inputs tr").count() > 20
+    assert page.text_content("#provenance").count("integrator") >= 1
+    # the hostile row's entry (its files are shot_250's) is refused as show refuses it, in
+    # words on the page, its script text
+    response = page.goto(f"{server}/shot/3")
+    assert response.status == 404 and page.evaluate("window.pwned") is None
+    said = page.text_content("#message")
+    assert said.startswith(f"row #3: it says {HOSTILE}@1, but its folder shot_250/v0001 holds "
+                           "shot_250@1"), said
+    page.errors.remove("Failed to load resource: the server responded with a status of 404 "
+                       "(Not Found)")
+
+
+def test_the_view_opens_the_sqlite_index_read_only(archive, server):
+    """The server never writes the index: its bytes and its write-ahead log are as they were
+    after the pages were read."""
+    before = (archive / "index.sqlite").read_bytes()
+    for path in ("/shots", "/shot/1", "/shots.csv"):
+        assert _get(server + path)[0] == 200
+    assert (archive / "index.sqlite").read_bytes() == before
+    assert os.path.getsize(archive / "index.sqlite") == len(before)
+
+
+def test_no_archive_or_a_bad_port_is_one_line(tmp_path, capsys):
+    for args, said in ((["--archive", str(tmp_path / "none")], "no such archive"),
+                       (["--archive", str(tmp_path), "--port", "70000"],
+                        "--port: found 70000, expected 0 to 65535")):
+        assert main(["serve", *args]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and said in err, err
