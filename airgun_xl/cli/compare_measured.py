@@ -7,8 +7,8 @@ from .run_options import SHOT_HELP, add_crush_law, add_force, add_json, add_outp
 
 def add_parser(sub):
     p = sub.add_parser("compare-measured",
-                       help="compare the shot's predicted pulse with a measured one (CSV, "
-                            "xlsx, TDMS)",
+                       help="compare the shot's predicted pulse with a measured one (a "
+                            "CSV, a workbook range or a recorder's file)",
                        description="Run the shot, read the measured pulse (a CSV of time and "
                                    "acceleration, units in the header: s/ms/us and g/kG/m/s^2), "
                                    "filter both alike (SAE J211), align them at the impact, "
