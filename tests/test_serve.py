@@ -6,7 +6,8 @@ downloaded), against a ``serve`` the test starts, on an archive of three shot A 
 The shots page draws its scatter, filters and sorts by URL (a reload keeps the view), pages on
 the server, and its CSV holds the rows shown; a shot's page draws the predicted pulse and lists
 its figures with units and its warnings. No page error, no request but to the server, and the
-hostile name is text. Over plain HTTP: POST is 405, a rebinding Host is 400, an id that is not
+hostile name is text. An archive whose index is on a PostgreSQL server (tests/pg_server.py)
+is browsed the same way. Over plain HTTP: POST is 405, a rebinding Host is 400, an id that is not
 a number or not in the index is 404, nothing outside the static folder is served, and a port
 in use is one line, exit 2."""
 import csv
@@ -227,3 +228,38 @@ def test_no_archive_or_a_bad_port_is_one_line(tmp_path, capsys):
         assert main(["serve", *args]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and said in err, err
+
+
+def test_a_server_archive_is_browsed_as_an_sqlite_one(tmp_path, server_env, browser, capsys):
+    """An archive whose index is on a PostgreSQL server (README's administrator makes it, an
+    engineer fills into it with $AIRGUN_XL_INDEX): its shots page lists the fills, and a
+    shot's page draws its pulse, in Chromium, with no page error and no request elsewhere."""
+    root = tmp_path / "shared"
+    address = os.environ["AIRGUN_XL_INDEX"].replace("//lab@", "//lab_admin@")
+    assert main(["archive", "init", str(root), "--index", address, "--writers", "lab"]) == 0
+    for v in SPEEDS[:2]:
+        book = openpyxl.load_workbook(TEMPLATE)
+        book.active["A28"] = v
+        shot = tmp_path / f"shot_{v:g}.xlsx"
+        book.save(shot)
+        assert main(["fill", str(shot), "-o", str(tmp_path / f"out_{v:g}.xlsx"), "--archive",
+                     str(root), "--name", f"shared_{v:g}"]) == 0
+    capsys.readouterr()
+    process, url = _start(root)
+    try:
+        context = browser.new_context()
+        page = context.new_page()
+        errors, requests = [], []
+        page.on("pageerror", lambda e: errors.append(str(e)))
+        page.on("request", lambda r: requests.append(r.url))
+        page.goto(f"{url}/shots?sort=v0")
+        assert [r[1] for r in _rows(page)] == ["shared_230", "shared_243.5"]
+        page.click("#shots tbody tr:first-child td.shot a")
+        page.wait_for_selector("#pulse[data-drawn]")
+        assert page.text_content("#entry").startswith("shared_230@1")
+        assert not errors and all(u.startswith(url + "/") for u in requests), (errors,
+                                                                                  requests)
+        context.close()
+    finally:
+        process.send_signal(signal.SIGINT)
+        process.wait(timeout=20)
