@@ -409,13 +409,8 @@ def serve(archive: str | os.PathLike[str], *, host: str = "127.0.0.1",
     AirgunXlError
         No such archive, a port in use, or the extra missing, named.
     """
-    from .errors import OptionError
+    from .web.server import serve as run
 
-    try:
-        from .web.server import serve as run
-    except ImportError:
-        raise OptionError("serve: needs the web extra (Starlette, uvicorn, Jinja2), expected "
-                          "it installed: pip install 'airgun-xl[web]'") from None
     run(os.fspath(archive), host, port)
 
 

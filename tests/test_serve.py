@@ -36,19 +36,24 @@ HOSTILE = "=HYPERLINK(\"http://x\")<script>window.pwned=1</script>"
 SPEEDS = (230.0, 243.5, 250.0)
 
 
+def _fill(work, root, speeds, prefix):
+    """Shot A filled into ``root`` at each of ``speeds`` (A28), named PREFIX_SPEED."""
+    for v in speeds:
+        book = openpyxl.load_workbook(TEMPLATE)
+        book.active["A28"] = v
+        shot = work / f"shot_{v:g}.xlsx"
+        book.save(shot)
+        assert main(["fill", str(shot), "-o", str(work / f"out_{v:g}.xlsx"), "--archive",
+                     str(root), "--name", f"{prefix}_{v:g}"]) == 0
+
+
 @pytest.fixture(scope="module")
 def archive(tmp_path_factory):
     """Three fills of shot A (A28 at each speed) archived; the third's index row renamed to
     a script, as a tampered index would hold it."""
     work = tmp_path_factory.mktemp("serve")
     root = work / "archive"
-    for v in SPEEDS:
-        book = openpyxl.load_workbook(TEMPLATE)
-        book.active["A28"] = v
-        shot = work / f"shot_{v:g}.xlsx"
-        book.save(shot)
-        assert main(["fill", str(shot), "-o", str(work / f"out_{v:g}.xlsx"), "--archive",
-                     str(root), "--name", f"shot_{v:g}"]) == 0
+    _fill(work, root, SPEEDS, "shot")
     with sqlite3.connect(root / "index.sqlite") as conn:
         conn.execute("UPDATE entries SET shot = ? WHERE id = 3", (HOSTILE,))
     return root
@@ -221,6 +226,21 @@ def test_the_view_opens_the_sqlite_index_read_only(archive, server):
     assert os.path.getsize(archive / "index.sqlite") == len(before)
 
 
+def test_the_web_extra_missing_is_one_line_from_the_cli_and_the_api(tmp_path, capsys,
+                                                                    monkeypatch):
+    """Without Starlette (its import fails), serve is one line naming the extra, exit 2, from
+    the CLI; the API raises the same OptionError (it escaped as a traceback from the
+    application's build)."""
+    import airgun_xl
+
+    monkeypatch.setitem(sys.modules, "starlette", None)
+    assert main(["serve", "--archive", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "needs the web extra" in err and "Traceback" not in err
+    with pytest.raises(airgun_xl.OptionError, match="pip install 'airgun-xl\\[web\\]'"):
+        airgun_xl.serve(tmp_path)
+
+
 def test_no_archive_or_a_bad_port_is_one_line(tmp_path, capsys):
     for args, said in ((["--archive", str(tmp_path / "none")], "no such archive"),
                        (["--archive", str(tmp_path), "--port", "70000"],
@@ -237,13 +257,7 @@ def test_a_server_archive_is_browsed_as_an_sqlite_one(tmp_path, server_env, brow
     root = tmp_path / "shared"
     address = os.environ["AIRGUN_XL_INDEX"].replace("//lab@", "//lab_admin@")
     assert main(["archive", "init", str(root), "--index", address, "--writers", "lab"]) == 0
-    for v in SPEEDS[:2]:
-        book = openpyxl.load_workbook(TEMPLATE)
-        book.active["A28"] = v
-        shot = tmp_path / f"shot_{v:g}.xlsx"
-        book.save(shot)
-        assert main(["fill", str(shot), "-o", str(tmp_path / f"out_{v:g}.xlsx"), "--archive",
-                     str(root), "--name", f"shared_{v:g}"]) == 0
+    _fill(tmp_path, root, SPEEDS[:2], "shared")
     capsys.readouterr()
     process, url = _start(root)
     try:

@@ -273,12 +273,41 @@ def listen(host: str, port: int) -> Any:
     return sock
 
 
-def serve(archive: str | Path, host: str = "127.0.0.1", port: int = 8765,
-          say: Any = print) -> None:
-    """Run the view of ``archive`` until Ctrl-C (SIGINT) or SIGTERM; ``say`` is told the
-    address once the server listens."""
-    import uvicorn
+#: What serve says when its extra is missing.
+MISSING = ("serve: needs the web extra (Starlette, uvicorn, Jinja2), expected it installed: pip "
+           "install 'airgun-xl[web]'")
 
+
+def _warn(text: str) -> None:
+    import sys
+
+    print(f"airgun-xl: warning: {text}", file=sys.stderr, flush=True)
+
+
+def serve(archive: str | Path, host: str = "127.0.0.1", port: int = 8765,
+          say: Any = print, warn: Any = _warn) -> None:
+    """Run the view of ``archive`` until Ctrl-C (SIGINT) or SIGTERM; ``say`` is told the
+    address once the server listens, ``warn`` that a ``host`` other than loopback opens a
+    page without a login.
+
+    Raises
+    ------
+    OptionError
+        The extra missing, a port out of range or in use, a host that does not resolve.
+    """
+    from ..errors import OptionError
+
+    try:
+        import jinja2  # noqa: F401 - each is needed: checked before anything starts
+        import starlette  # noqa: F401
+        import uvicorn
+    except ImportError:
+        raise OptionError(MISSING) from None
+    if not 0 <= port <= 65535:
+        raise OptionError(f"--port: found {port}, expected 0 to 65535")
+    if host not in LOOPBACK:
+        warn(f"--host {host}: the view answers on that address, and it has no login: anyone "
+             "who reaches it reads the archive")
     app = build_app(archive, () if host in LOOPBACK else (host,))
     sock = listen(host, port)
     bound = sock.getsockname()
