@@ -157,30 +157,30 @@ def test_the_shots_page_filters_sorts_and_exports_what_it_shows(page, server):
     page.goto(f"{server}/shots")
     rows = _rows(page)
     _screenshot(page, "serve-shots")
-    assert len(rows) == 3 and page.text_content("#count").startswith("3 runs")
+    assert len(rows) == 3 and page.text_content("#count").startswith("3 of 3 runs")
     assert page.get_attribute("#scatter", "data-drawn") == "3"
     assert page.locator("#scatter canvas").count() == 1
-    assert HOSTILE in [r[1] for r in rows]  # the name is text on the page
+    assert HOSTILE in [r[2] for r in rows]  # the name is text on the page
     assert page.evaluate("window.pwned") is None
     # sorted by v0, descending: a click on its heading twice
-    page.click("#shots th:nth-child(5) a")
-    page.click("#shots th:nth-child(5) a")
-    assert [r[4] for r in _rows(page)] == ["250.00", "243.50", "230.00"]
+    page.click("#shots th:nth-child(6) a")
+    page.click("#shots th:nth-child(6) a")
+    assert [r[5] for r in _rows(page)] == ["250.00", "243.50", "230.00"]
     assert "sort=v0" in page.url and "desc=1" in page.url
     # filtered in place, and the view survives a reload by its URL
     page.fill("input[name=v0_min]", "240")
     page.click("#filters button")
-    assert [r[4] for r in _rows(page)] == ["250.00", "243.50"]
+    assert [r[5] for r in _rows(page)] == ["250.00", "243.50"]
     kept = page.url
     page.goto(kept)
-    assert [r[4] for r in _rows(page)] == ["250.00", "243.50"]
+    assert [r[5] for r in _rows(page)] == ["250.00", "243.50"]
     assert page.get_attribute("#scatter", "data-drawn") == "2"
     # the CSV holds the rows shown, in their order and units
     response = page.request.get(server + page.get_attribute("#csv", "href"))
     table = list(csv.reader(io.StringIO(response.text())))
     assert table[0][:5] == ["#", "shot", "version", "created", "v0 [m/s]"]
     assert [float(r[4]) for r in table[1:]] == [250.0, 243.5]
-    assert [r[0] for r in table[1:]] == [r[0] for r in _rows(page)]
+    assert [r[0] for r in table[1:]] == [r[1] for r in _rows(page)]
     # a text a spreadsheet would run (the hostile name starts with =) is written as text
     assert [r[1] for r in table[1:]] == ["'" + HOSTILE, "shot_243.5"]
 

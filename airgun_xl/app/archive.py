@@ -104,18 +104,23 @@ def history_rows(entries: Iterable[Entry], where: Sequence[Where] = ()) -> list[
         except ArchiveError as exc:  # a listing flags a bad record, names it, and goes on
             rows.append(_unreadable_row(e, exc))
             continue
-        law = prov.get("crush_law")
-        warnings = s.get("warnings")
-        rows.append({
-            **dict(e.row), "ref": e.ref, "file": e.ref, "created": e.created, "v0": e.row["v0"],
-            "peak_kg": s.get("peak_kg"), "filtered_peak_kg": s.get("filtered_peak_kg"),
-            "time_of_peak": s.get("time_of_peak"), "pulse_duration": s.get("pulse_duration"),
-            "max_crush": s.get("max_crush"), "final_length": s.get("final_length"),
-            "warnings": [f"{w}" for w in warnings or []],
-            "warning_count": len(warnings) if warnings is not None else None,
-            "integrator": f"{prov.get('integrator')}/{prov.get('model')}",
-            "crush_law": law["name"] if isinstance(law, dict) else "not recorded"})
+        rows.append(history_row(e, s, prov))
     return rows
+
+
+def history_row(e: Entry, s: dict[str, Any], prov: dict[str, Any]) -> Row:
+    """An entry's campaign-table row from its summary.json (``s``) and provenance.json."""
+    law = prov.get("crush_law")
+    warnings = s.get("warnings")
+    return {
+        **dict(e.row), "ref": e.ref, "file": e.ref, "created": e.created, "v0": e.row["v0"],
+        "peak_kg": s.get("peak_kg"), "filtered_peak_kg": s.get("filtered_peak_kg"),
+        "time_of_peak": s.get("time_of_peak"), "pulse_duration": s.get("pulse_duration"),
+        "max_crush": s.get("max_crush"), "final_length": s.get("final_length"),
+        "warnings": [f"{w}" for w in warnings or []],
+        "warning_count": len(warnings) if warnings is not None else None,
+        "integrator": f"{prov.get('integrator')}/{prov.get('model')}",
+        "crush_law": law["name"] if isinstance(law, dict) else "not recorded"}
 
 
 def _unreadable_row(e: Entry, exc: Exception) -> Row:
@@ -272,9 +277,13 @@ def show(entry: str, archive: str | None = None) -> ShowOutcome:
     return show_entry(Archive(archive_dir(archive)), entry)
 
 
-def show_entry(found: Archive, entry: str) -> ShowOutcome:
-    """One run of an archive already open (``serve`` holds one, its index read-only)."""
-    e = found.checked(found.get(entry))  # what verify would report is refused
+def show_entry(found: Archive, entry: str | Entry,
+               rows: list[dict[str, Any]] | None = None) -> ShowOutcome:
+    """One run of an archive already open (``serve`` holds one, its index read-only): an
+    entry named as ``show`` takes it, or one already found; ``rows``, the index's rows when
+    the caller has just read them."""
+    e = found.checked(found.get(entry) if isinstance(entry, str) else entry, rows)
+    # what verify would report is refused
     doc = {"entry": e.ref, "id": e.id, "path": str(e.path), "created": e.created,
            "params": e.load("params.json"), "summary": e.load("summary.json"),
            "provenance": e.load("provenance.json"), "files": e.manifest()["files"]}

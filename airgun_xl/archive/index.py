@@ -427,6 +427,19 @@ class SqliteIndex:
             conn.close()
         return ordered(since_filter(checked_rows(raw, self.label, bad), since), order)
 
+    def stamp(self):
+        """A token that changes when the entries do: each index file's size, modification
+        time and inode (a commit writes the write-ahead log, a checkpoint the database)."""
+        out: list[tuple[int, int, int] | None] = []
+        for name in (INDEX, f"{INDEX}-wal"):
+            try:
+                st = os.stat(self.path.with_name(name))
+            except OSError:
+                out.append(None)
+                continue
+            out.append((st.st_size, st.st_mtime_ns, st.st_ino))
+        return tuple(out)
+
     def problems(self):
         """What the index's own check finds (empty when sound)."""
         conn = self._connect()
@@ -648,6 +661,7 @@ class ServerIndex:
         self.label = f"the archive's index on {self.shown}"
         self._conn: Any = None  # one connection: the writer's lock, its writes, its reads
         self._held: Any = None  # (owner, the connection that holds its session lock)
+        self.read_only = False  # set before first use: every transaction read-only (serve)
 
     def _connection(self):
         """The index's one connection, made (and the identity checked) on first use."""
@@ -670,7 +684,9 @@ class ServerIndex:
 
     def _connect(self, check=True, fresh=False):
         try:
-            conn = Link(self.address, session_options(), fresh)
+            options = session_options() + (" -c default_transaction_read_only=on"
+                                           if self.read_only else "")
+            conn = Link(self.address, options, fresh)
         except LinkError as exc:
             if exc.kind == "missing":
                 raise _link_error(exc, self.label) from None
@@ -793,6 +809,20 @@ class ServerIndex:
             self.close()
             raise ArchiveError(f"{self.label}: cannot be read ({exc.message})") from None
         return ordered(since_filter(checked_rows(found, self.label, bad), since), order)
+
+    def stamp(self):
+        """A token that changes when the entries do: their count and the last id (a writer's
+        role can add entries, never change one: :data:`WRITER_GRANTS`)."""
+        conn = self._connection()
+        try:
+            found = conn.execute(f"SELECT COUNT(*), MAX(id) FROM {SERVER_SCHEMA}.entries WHERE "
+                                 "archive = %s", [self.identity]).fetchone()
+            conn.rollback()
+            self._done()
+        except LinkError as exc:
+            self.close()
+            raise ArchiveError(f"{self.label}: cannot be read ({exc.message})") from None
+        return tuple(str(v) for v in found) if found else ()
 
     def problems(self):
         return []  # the server keeps its own pages whole

@@ -440,7 +440,7 @@ class Archive:
     def _matches_manifest(self, row):
         """Whether an index row is its entry's: the folder is ``<shot>/vNNNN``, its manifest
         names this shot and version, and every file hashes as listed."""
-        entry = self._entry(row)
+        entry = self.entry_of(row)
         if entry is None or not entry.path.is_dir():
             return False
         manifest = _read_manifest(entry.path)
@@ -601,9 +601,9 @@ class Archive:
     # -- reading --------------------------------------------------------------------------
     def entries(self, shot=None, since=None, bad=None):
         rows = self.index.rows(safe_name(shot) if shot else None, since, bad=bad)
-        return [e for e in (self._entry(r) for r in rows) if e is not None]
+        return [e for e in (self.entry_of(r) for r in rows) if e is not None]
 
-    def _entry(self, r):
+    def entry_of(self, r):
         """An Entry from an index row; None for a row whose path is not ``<shot>/vNNNN``."""
         path = str(r["path"])
         parts = path.split("/")
@@ -667,16 +667,18 @@ class Archive:
                 problems.append(f"{entry.ref}: {name} altered (SHA-256 differs)")
         return problems
 
-    def checked(self, entry):
+    def checked(self, entry, rows=None):
         """``entry``, refused in one line when ``verify`` would report it: a show or a
-        compare reads only whole entries of the archive's own.
+        compare reads only whole entries of the archive's own. ``rows``: the index's rows,
+        when the caller has just read them (else they are read).
 
         Raises
         ------
         ArchiveError
         """
         problems = self.entry_problems(entry)
-        twins = [r for r in self.index.rows() if r["id"] != entry.id and (
+        twins = [r for r in (self.index.rows() if rows is None else rows)
+                 if r["id"] != entry.id and (
             r["path"] == entry.row.get("path") or (r["shot"], r["version"]) == (
                 entry.shot, entry.version))]
         if twins:
@@ -738,7 +740,7 @@ class Archive:
         by_path: dict[Path, int] = {}
         by_version: dict[tuple[str, int], int] = {}
         for r in rows:
-            e = self._entry(r)
+            e = self.entry_of(r)
             if e is None:
                 problems.append(f"row #{r['id']}: its path {r['path']!r} is not an entry folder")
                 continue

@@ -21,15 +21,10 @@ import math
 from pathlib import Path
 from typing import Any
 
+from .pages import finite as pages_finite
+
 #: Loopback names the server answers by default; ``--host`` adds its own.
 LOOPBACK = ("127.0.0.1", "localhost", "::1", "[::1]")
-
-#: Rows of the shots page.
-PAGE = 50
-
-#: What the shots page may be sorted by (its columns).
-SORTS = ("id", "shot", "version", "created", "v0", "peak_kg", "pulse_duration",
-         "warning_count")
 
 #: The policy every response carries: nothing but the server's own files.
 CSP = ("default-src 'self'; script-src 'self'; style-src 'self'; img-src 'self' data:; "
@@ -38,15 +33,6 @@ CSP = ("default-src 'self'; script-src 'self'; style-src 'self'; img-src 'self' 
 HEADERS = {"content-security-policy": CSP, "x-content-type-options": "nosniff",
            "referrer-policy": "no-referrer", "x-frame-options": "DENY",
            "cache-control": "no-store"}
-
-#: Columns of the shots page and its CSV: (key, heading, unit, factor to the unit, digits).
-COLUMNS = (("id", "#", "", 1.0, None), ("shot", "shot", "", 1.0, None),
-           ("version", "version", "", 1.0, None), ("created", "created", "", 1.0, None),
-           ("v0", "v0", "m/s", 1.0, 2), ("peak_kg", "peak", "kG", 1.0, 4),
-           ("pulse_duration", "pulse duration", "ms", 1e3, 4),
-           ("warning_count", "warnings", "", 1.0, 0), ("integrator", "integrator", "", 1.0,
-                                                       None),
-           ("crush_law", "crush law", "", 1.0, None))
 
 _HERE = Path(__file__).parent
 
@@ -80,58 +66,9 @@ class Guard:
         await self.app(scope, receive, send_with_headers)
 
 
-def _number(text: str | None) -> float | None:
-    if text is None or not text.strip():
-        return None
-    try:
-        value = float(text)
-    except ValueError:
-        return None
-    return value if math.isfinite(value) else None
-
-
-def _filters(query: Any) -> dict[str, Any]:
-    """The shots page's filters from its URL, each kept as given (bad values ignored)."""
-    sort = query.get("sort", "id")
-    return {"shot": query.get("shot", "").strip()[:200],
-            "since": query.get("since", "").strip()[:10],
-            "v0_min": _number(query.get("v0_min")), "v0_max": _number(query.get("v0_max")),
-            "peak_min": _number(query.get("peak_min")),
-            "peak_max": _number(query.get("peak_max")),
-            "sort": sort if sort in SORTS else "id",
-            "desc": query.get("desc", "") == "1"}
-
-
-def _selected(rows: list[dict[str, Any]], f: dict[str, Any]) -> list[dict[str, Any]]:
-    def within(value: Any, lo: float | None, hi: float | None) -> bool:
-        if lo is None and hi is None:
-            return True
-        if not isinstance(value, (int, float)):
-            return False
-        return (lo is None or value >= lo) and (hi is None or value <= hi)
-
-    out = [r for r in rows
-           if (not f["shot"] or f["shot"].lower() in str(r.get("shot", "")).lower())
-           and (not f["since"] or str(r.get("created", ""))[:10] >= f["since"])
-           and within(r.get("v0"), f["v0_min"], f["v0_max"])
-           and within(r.get("peak_kg"), f["peak_min"], f["peak_max"])]
-    key = f["sort"]
-    present = [r for r in out if r.get(key) is not None]
-    absent = [r for r in out if r.get(key) is None]  # no value: last, whichever way
-    present.sort(key=lambda r: (r[key], r["id"]), reverse=f["desc"])
-    return present + absent
-
-
-def _shown(value: Any, factor: float, digits: int | None) -> str:
-    if value is None:
-        return "n/a"
-    if digits is None or not isinstance(value, (int, float)):
-        return str(value)
-    return f"{value * factor:,.{digits}f}"
-
-
-def build_app(archive: str | Path, hosts: tuple[str, ...] = ()) -> Any:
-    """The view of the archive at ``archive``, answering the loopback names and ``hosts``."""
+def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = True) -> Any:
+    """The view of the archive at ``archive``, answering the loopback names and ``hosts``;
+    ``warm``: its listing read in the background from the start."""
     from starlette.applications import Starlette
     from starlette.middleware import Middleware
     from starlette.middleware.trustedhost import TrustedHostMiddleware
@@ -141,82 +78,229 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = ()) -> Any:
     from starlette.staticfiles import StaticFiles
     from starlette.templating import Jinja2Templates
 
-    from ..app.archive import history_rows, predicted_pulse, show_entry, shown_figure
+    from ..app.archive import FIGURE_UNITS, predicted_pulse, show_entry, shown_figure
     from ..archive import Archive
     from ..archive.index import SqliteIndex
     from ..errors import AirgunXlError
+    from . import pages
+    from .listing import FIGURES, Listing
 
     found = Archive(archive)
     if isinstance(found.index, SqliteIndex):
         found.index = SqliteIndex(found.root, read_only=True)
+    else:
+        found.index.read_only = True  # every transaction on the server read-only
+    listing = Listing(found)
+    if warm:
+        listing.warm()
     import jinja2
 
     templates = Jinja2Templates(env=jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(_HERE / "templates")), autoescape=True))
     templates.env.filters["safe_json"] = _script_json
+    templates.env.globals.update(url=pages.url, compare_url=pages.compare_url)
     label = found.root.name
+    known_cells = pages.cells()
 
-    def rows_for(request: Request) -> tuple[dict[str, Any], list[dict[str, Any]]]:
-        f = _filters(request.query_params)
-        return f, _selected(history_rows(found.entries()), f)
+    def page(request: Request, name: str, context: dict[str, Any], status: int = 200) -> Any:
+        return templates.TemplateResponse(request, name, {"archive": label, **context},
+                                          status_code=status)
+
+    def missing(request: Request, message: str) -> Any:
+        return page(request, "missing.html", {"message": message}, 404)
 
     async def shots(request: Request) -> Response:
-        f, rows = rows_for(request)
-        pages = max(1, math.ceil(len(rows) / PAGE))
-        page = min(max(1, int(_number(request.query_params.get("page")) or 1)), pages)
-        shown = [[(key, _shown(r.get(key), factor, digits)) for key, _h, _u, factor, digits
-                  in COLUMNS] + [("id_raw", r["id"])] for r in
-                 rows[(page - 1) * PAGE: page * PAGE]]
-        query = {k: ("" if v is None else ("1" if v is True else "" if v is False else v))
-                 for k, v in f.items()}
-        return templates.TemplateResponse(request, "shots.html", {
-            "archive": label, "rows": shown, "columns": COLUMNS, "count": len(rows),
-            "page": page, "pages": pages, "f": query,
-            "points": json.dumps([[r.get("v0"), r.get("peak_kg"), r["id"]] for r in rows],
-                                 allow_nan=False)})
+        snapshot = listing.snapshot()
+        f = pages.filters(request.query_params)
+        for cell in {f["x"], f["input"]} - {""}:
+            snapshot.with_inputs(cell)
+        rows = pages.selected(snapshot, f)
+        count = len(rows)
+        last = max(1, math.ceil(count / pages.PAGE))
+        at = min(max(1, int(pages.number(request.query_params.get("page")) or 1)), last)
+        shown = [{"id": r["id"], "cells": [(key, pages.shown(r.get(key), factor, digits))
+                                           for key, _h, _u, factor, digits in pages.COLUMNS],
+                  "warnings": r.get("warnings") or []}
+                 for r in rows[(at - 1) * pages.PAGE: at * pages.PAGE]]
+        return page(request, "shots.html", {
+            "rows": shown, "columns": pages.COLUMNS, "count": count, "page": at,
+            "pages": last, "f": f, "lots": snapshot.lots, "bad": snapshot.bad,
+            "cells": known_cells, "figures": FIGURES, "colours": pages.COLOURS,
+            "total": len(snapshot.rows),
+            "scatter": json.dumps(pages.scatter(rows, f), allow_nan=False)})
 
     async def shots_csv(request: Request) -> Response:
-        _f, rows = rows_for(request)
+        snapshot = listing.snapshot()
+        f = pages.filters(request.query_params)
+        if f["input"]:
+            snapshot.with_inputs(f["input"])
+        rows = pages.selected(snapshot, f)
         out = io.StringIO()
         writer = csv.writer(out, lineterminator="\n")
-        writer.writerow([f"{h} [{u}]" if u else h for _k, h, u, _f2, _d in COLUMNS])
+        writer.writerow([f"{h} [{u}]" if u else h for _k, h, u, _f, _d in pages.COLUMNS])
         for r in rows:  # a text that a spreadsheet would run is written as text
             writer.writerow([_csv_text(r.get(k)) if d is None else
                              ("" if r.get(k) is None else repr(r[k] * factor))
-                             for k, _h, _u, factor, d in COLUMNS])
+                             for k, _h, _u, factor, d in pages.COLUMNS])
         return Response(out.getvalue(), media_type="text/csv; charset=utf-8", headers={
             "content-disposition": f'attachment; filename="{_file_name(label)}-shots.csv"'})
 
+    def entry_doc(snapshot: Any, ident: int) -> tuple[Any, Any]:
+        """An entry's records as ``show`` reads them, and its predicted pulse."""
+        entry = snapshot.entries.get(ident)
+        if entry is None:
+            raise LookupError(f"#{ident}: no such entry in {label}, expected an id the "
+                              "shots page lists")
+        outcome = show_entry(found, entry, snapshot.index_rows)
+        return outcome.doc, predicted_pulse(entry)
+
     async def shot(request: Request) -> Response:
+        snapshot = listing.snapshot()
         ident = request.path_params["ident"]
         try:
-            outcome = show_entry(found, f"#{ident}")
-            entry = found.get(f"#{ident}")
-            time, accel = predicted_pulse(entry)
-        except AirgunXlError as exc:
-            return templates.TemplateResponse(request, "missing.html", {
-                "archive": label, "message": str(exc)}, status_code=404)
-        doc = outcome.doc
+            doc, (time, accel) = entry_doc(snapshot, ident)
+        except (AirgunXlError, LookupError) as exc:
+            return missing(request, str(exc).strip("'\""))
         summary = dict(doc["summary"])
         warnings = summary.pop("warnings", None)
-        summary.pop("predicted_verdict", None)
+        predicted = summary.pop("predicted_verdict", None)
         figures = [shown_figure(k, v) for k, v in summary.items()]
-        step = max(1, len(time) // 4000)  # the chart draws at most ~4,000 points
-        pulse = json.dumps({"time_ms": [_finite(t, 1e3) for t in time[::step]],
-                            "accel_kg": [_finite(a) for a in accel[::step]]}, allow_nan=False)
-        return templates.TemplateResponse(request, "shot.html", {
-            "archive": label, "doc": doc, "figures": figures, "warnings": warnings,
-            "pulse": pulse})
+        t, a = pages.thinned(time, accel)
+        recorded = []
+        for v in snapshot.verdicts.get(snapshot.entries[ident].shot, []):
+            recorded.append(_verdict(found.root, v))
+        predicted = predicted if isinstance(predicted, dict) else None
+        band = _peak_band(predicted, recorded)
+        return page(request, "shot.html", {
+            "doc": doc, "figures": figures, "warnings": warnings, "predicted": predicted,
+            "recorded": recorded, "samples": len(time), "drawn": len(t), "band": band,
+            "pulse": json.dumps({"time_ms": t, "accel_kg": a,
+                                 "band": [band["low"], band["high"]] if band else None},
+                                allow_nan=False)})
+
+    async def compare(request: Request) -> Response:
+        snapshot = listing.snapshot()
+        ids = pages.compared_ids(request.query_params)
+        docs, pulses, refused = [], [], []
+        for ident in ids:
+            try:
+                doc, pulse = entry_doc(snapshot, ident)
+            except (AirgunXlError, LookupError) as exc:
+                refused.append(str(exc).strip("'\""))
+                continue
+            docs.append(doc)
+            pulses.append(pulse)
+        kept = [d["id"] for d in docs]
+        differ, equal = pages.differing(docs)
+        keys = [k for k in FIGURE_UNITS if any(k in d["summary"] for d in docs)]
+        figures = [(shown_figure(k, None)[0], [shown_figure(k, d["summary"].get(k))[1]
+                                               for d in docs]) for k in keys]
+        drawn = pages.overlaid(pulses)
+        return page(request, "compare.html", {
+            "docs": docs, "ids": kept, "refused": refused, "differ": differ, "equal": equal,
+            "figures": figures, "max": pages.MAX_COMPARED,
+            "candidates": [r for r in snapshot.rows if r["id"] not in kept][:500],
+            "pulses": json.dumps({**drawn, "names": [d["entry"] for d in docs]},
+                                 allow_nan=False)})
+
+    async def laws(request: Request) -> Response:
+        snapshot = listing.snapshot()
+        return page(request, "laws.html", _laws(found.root, snapshot, pages))
 
     async def home(_request: Request) -> Response:
         return RedirectResponse("/shots", 302)
 
     routes = [Route("/", home), Route("/shots", shots), Route("/shots.csv", shots_csv),
-              Route("/shot/{ident:int}", shot),
+              Route("/shot/{ident:int}", shot), Route("/compare", compare),
+              Route("/laws", laws),
               Mount("/static", StaticFiles(directory=str(_HERE / "static")), name="static")]
     allowed = [h.strip("[]") if h.count(":") > 1 else h for h in (*LOOPBACK, *hosts)]
     return Starlette(routes=routes, middleware=[
         Middleware(Guard), Middleware(TrustedHostMiddleware, allowed_hosts=allowed)])
+
+
+def _verdict(root: Path, listed: dict[str, Any]) -> dict[str, Any]:
+    """A recorded verdict of a shot as its page shows it: the record's criteria, or why it
+    cannot be read."""
+    from ..archive.records import read_record
+    from ..archive.store import safe_name
+    from ..archive.verdicts import VERDICTS
+    from ..errors import ArchiveError
+
+    path = (root / VERDICTS / safe_name(str(listed["shot"]))
+            / f"v{int(listed['version']):04d}.json")
+    try:
+        record = read_record(root, path, "verdict")
+    except ArchiveError as exc:
+        return {"version": listed["version"], "verdict": "?", "problem": str(exc),
+                "criteria": []}
+    criteria = record.get("criteria") if isinstance(record, dict) else None
+    return {"version": listed["version"], "verdict": str(record.get("verdict")),
+            "created": str(record.get("created", "")), "problem": None,
+            "specification": str(record.get("specification", "")),
+            "recording": str(record.get("recording", "")),
+            "warnings": [str(w) for w in record.get("warnings") or []],
+            "criteria": [c for c in criteria or [] if isinstance(c, dict)]}
+
+
+def _peak_band(predicted: dict[str, Any] | None,
+               recorded: list[dict[str, Any]]) -> dict[str, Any] | None:
+    """The peak's limits [kG] for the pulse chart: the latest recorded verdict's peak
+    criterion, else the prediction's; None when neither judged a peak in kG or g."""
+    sources = [(f"recorded verdict {v['version']}", v["criteria"]) for v in reversed(recorded)]
+    if predicted:
+        sources.append(("the prediction's specification", predicted.get("criteria") or []))
+    for source, criteria in sources:
+        for c in criteria:
+            scale = {"kG": 1.0, "g": 1e-3}.get(str(c.get("unit")))
+            if c.get("name") != "peak" or scale is None:
+                continue
+            low, high = (pages_finite(c.get(k), scale) for k in ("low", "high"))
+            if low is not None or high is not None:
+                return {"low": low, "high": high, "source": source}
+    return None
+
+
+def _laws(root: Path, snapshot: Any, pages: Any) -> dict[str, Any]:
+    """The laws page: each lot's law versions (their ranges, curves, the shots each was fitted
+    on and the entries that ran it), each lot's chain, and P(PASS) against outcomes."""
+    from ..app.next_shot import chain, prediction_record
+    from ..archive.laws import list_laws, load_law
+    from ..errors import AirgunXlError
+
+    lots: dict[str, dict[str, Any]] = {}
+    for law in list_laws(root):
+        name = law["ref"].rpartition("@")[0]
+        lot = lots.setdefault(name, {"name": name, "versions": [], "curves": [],
+                                     "chain": [], "chain_problem": None})
+        try:
+            crush, record = load_law(root, law["ref"])
+        except AirgunXlError as exc:
+            lot["versions"].append({**law, "problem": str(exc), "coefficients": [],
+                                    "fitted_on": [], "used_by": []})
+            continue
+        lot["curves"].append((law["ref"], crush))
+        fitted = [s for s in record.get("shots") or [] if isinstance(s, dict)]
+        lot["versions"].append({
+            **law, "problem": None, "coefficients": list(crush.coefficients),
+            "fitted_on": [{k: str(v) for k, v in s.items()} for s in fitted],
+            "used_by": [(r["id"], r["ref"]) for r in snapshot.rows if r.get("law") == law["ref"]]})
+    for name in snapshot.lots:
+        lot = lots.setdefault(name, {"name": name, "versions": [], "curves": [], "chain": [],
+                                     "chain_problem": None})
+    for name, lot in lots.items():
+        try:
+            lot["chain"] = chain(root, name)
+        except AirgunXlError as exc:
+            lot["chain_problem"] = str(exc) if "has no chain" not in str(exc) else None
+        lot["chart"] = json.dumps(pages.law_curves(lot.pop("curves")), allow_nan=False)
+    try:
+        predictions: Any = prediction_record(root)
+        problem = None
+    except AirgunXlError as exc:
+        predictions, problem = None, str(exc)
+    return {"lots": [lots[k] for k in sorted(lots)], "record": predictions,
+            "record_problem": problem}
 
 
 def _script_json(text: str) -> Any:
@@ -226,12 +310,6 @@ def _script_json(text: str) -> Any:
 
     return Markup(text.replace("<", "\\u003c").replace(">", "\\u003e")
                   .replace("&", "\\u0026"))
-
-
-def _finite(value: Any, factor: float = 1.0) -> float | None:
-    """A number for a chart's JSON: rounded to 6 decimals, None (a gap) where not finite."""
-    number = float(value) * factor
-    return round(number, 6) if math.isfinite(number) else None
 
 
 def _csv_text(value: Any) -> str:

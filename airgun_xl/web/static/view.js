@@ -2,33 +2,96 @@
 // out of data). uPlot, vendored beside this file.
 "use strict";
 (function () {
-  function data(id) {
-    const el = document.getElementById(id);
+  const PALETTE = ["#1f5fa8", "#c0392b", "#27ae60", "#8e44ad", "#d68910", "#17a589",
+    "#7f8c8d", "#2c3e50"];
+
+  function data(el) {
     return el ? JSON.parse(el.textContent) : null;
   }
-  function chart(el, series, x, y, points) {
+  function byId(id) {
+    return document.getElementById(id);
+  }
+  function width() {
+    return Math.min(900, document.body.clientWidth - 40);
+  }
+  // One chart: x and a list of {label, values, colour, points, dash}; logs: distr 3.
+  function chart(el, x, lines, xLabel, yLabel, logx, logy) {
     const opts = {
-      width: Math.min(900, document.body.clientWidth - 40), height: 320,
-      scales: { x: { time: false } },
-      axes: [{ label: x }, { label: y }],
-      series: [{ label: x }, { label: y, stroke: "#1f5fa8",
-        points: points ? { show: true, size: 6, fill: "#1f5fa8" } : { show: false },
-        width: points ? 0 : 1.5 }],
+      width: width(), height: 340,
+      scales: { x: { time: false, distr: logx ? 3 : 1 }, y: { distr: logy ? 3 : 1 } },
+      axes: [{ label: xLabel }, { label: yLabel }],
+      series: [{ label: xLabel }].concat(lines.map((s) => ({
+        label: s.label, stroke: s.colour, width: s.points ? 0 : 1.5, dash: s.dash,
+        points: s.points ? { show: true, size: 6, fill: s.colour, stroke: s.colour }
+          : { show: false },
+        spanGaps: !s.points,
+      }))),
     };
-    el.dataset.drawn = String(series[0].length);
-    return new uPlot(opts, series, el);
+    el.dataset.drawn = String(x.length);
+    el.dataset.series = String(lines.length);
+    return new uPlot(opts, [x].concat(lines.map((s) => s.values)), el);
   }
-  function draw() {
-    const pulse = data("pulse-data");
-    const p = document.getElementById("pulse");
-    if (pulse && p) chart(p, [pulse.time_ms, pulse.accel_kg], p.dataset.x, p.dataset.y, false);
-    const pts = data("points");
-    const s = document.getElementById("scatter");
-    if (pts && s) {
-      const rows = pts.filter((r) => r[0] !== null && r[1] !== null)
-        .sort((a, b) => a[0] - b[0]);
-      chart(s, [rows.map((r) => r[0]), rows.map((r) => r[1])], s.dataset.x, s.dataset.y, true);
+
+  function pulse() {
+    const el = byId("pulse");
+    const d = data(byId("pulse-data"));
+    if (!el || !d) return;
+    const lines = [{ label: el.dataset.y, values: d.accel_kg, colour: PALETTE[0] }];
+    if (d.band) {
+      ["low", "high"].forEach((name, k) => {
+        if (d.band[k] !== null) {
+          lines.push({ label: "peak " + name + " limit", colour: PALETTE[1], dash: [6, 4],
+            values: d.time_ms.map(() => d.band[k]) });
+        }
+      });
     }
+    chart(el, d.time_ms, lines, el.dataset.x, el.dataset.y, false, false);
   }
-  document.addEventListener("DOMContentLoaded", draw);
+
+  function scatter() {
+    const el = byId("scatter");
+    const d = data(byId("scatter-data"));
+    if (!el || !d) return;
+    const lines = d.series.map((s, k) => ({
+      label: s.name + " (" + s.points + ")", values: s.y, points: true,
+      colour: PALETTE[k % PALETTE.length] }));
+    const u = chart(el, d.x, lines, d.x_label, d.y_label, d.logx, d.logy);
+    const note = byId("scatter-note");
+    if (note && d.left_out) {
+      note.textContent = d.left_out + " run(s) not drawn: no value" +
+        (d.logx || d.logy ? ", or not positive on a log axis" : "") + ".";
+    }
+    u.over.addEventListener("click", () => {  // a point opens its run
+      const i = u.cursor.idx;
+      if (i !== null && i !== undefined && d.ids[i] !== undefined) {
+        window.location.href = "/shot/" + String(Number(d.ids[i]));
+      }
+    });
+  }
+
+  function overlay() {
+    const el = byId("overlay");
+    const d = data(byId("overlay-data"));
+    if (!el || !d) return;
+    const lines = d.y.map((values, k) => ({ label: d.names[k], values: values,
+      colour: PALETTE[k % PALETTE.length] }));
+    chart(el, d.x, lines, el.dataset.x, el.dataset.y, false, false);
+  }
+
+  function laws() {
+    document.querySelectorAll(".law-chart").forEach((el) => {
+      const d = data(el.nextElementSibling);
+      if (!d || !d.x.length) return;
+      const lines = d.y.map((values, k) => ({ label: d.names[k], values: values,
+        colour: PALETTE[k % PALETTE.length] }));
+      chart(el, d.x, lines, el.dataset.x, el.dataset.y, false, false);
+    });
+  }
+
+  document.addEventListener("DOMContentLoaded", () => {
+    pulse();
+    scatter();
+    overlay();
+    laws();
+  });
 })();
