@@ -267,7 +267,7 @@ def test_a_server_archive_is_browsed_as_an_sqlite_one(tmp_path, server_env, brow
         page.on("pageerror", lambda e: errors.append(str(e)))
         page.on("request", lambda r: requests.append(r.url))
         page.goto(f"{url}/shots?sort=v0")
-        assert [r[1] for r in _rows(page)] == ["shared_230", "shared_243.5"]
+        assert [r[2] for r in _rows(page)] == ["shared_230", "shared_243.5"]
         page.click("#shots tbody tr:first-child td.shot a")
         page.wait_for_selector("#pulse[data-drawn]")
         assert page.text_content("#entry").startswith("shared_230@1")
@@ -277,3 +277,16 @@ def test_a_server_archive_is_browsed_as_an_sqlite_one(tmp_path, server_env, brow
     finally:
         process.send_signal(signal.SIGINT)
         process.wait(timeout=20)
+    # the view's sessions are read-only: the server itself refuses a write in them (the same
+    # INSERT in an ordinary session reaches the table, and its foreign key refuses it)
+    from airgun_xl.archive import Archive
+    from airgun_xl.archive.agent import LinkError
+
+    insert = ("INSERT INTO airgun_xl.entries (archive, id, shot, version, path, created) "
+              "VALUES ('none', 0, 'x', 1, 'x/v0001', '2026-01-01')")
+    for read_only, said in ((True, "read-only transaction"), (False, "foreign key")):
+        found = Archive(root)
+        found.index.read_only = read_only
+        with pytest.raises(LinkError, match=said):
+            found.index._connection().execute(insert)
+        found.index.close()
