@@ -14,24 +14,20 @@ import csv
 import io
 import json
 import os
-import shutil
 import signal
 import sqlite3
-import subprocess
 import sys
-import urllib.error
-import urllib.request
 
 import openpyxl
 import pytest
 from conftest import TEMPLATE
+from serve_helpers import chromium, get, screenshot, start, watched
 
 from airgun_xl.cli import main
 
 pytest.importorskip("starlette")
 pytest.importorskip("uvicorn")
 pytestmark = pytest.mark.slow  # servers in processes, a browser
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 HOSTILE = "=HYPERLINK(\"http://x\")<script>window.pwned=1</script>"
 SPEEDS = (230.0, 243.5, 250.0)
 
@@ -59,45 +55,25 @@ def archive(tmp_path_factory):
     return root
 
 
-def _start(root, *extra):
-    """``airgun-xl serve`` on a free port: the process and its base URL (from its first
-    line)."""
-    process = subprocess.Popen(
-        [sys.executable, "-m", "airgun_xl", "serve", "--archive", str(root), "--port", "0",
-         *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    line = process.stdout.readline()
-    assert line.startswith("serving "), (line, process.stderr.read())
-    return process, line.split(" at ", 1)[1].split(" ", 1)[0].rstrip("/")
-
-
 @pytest.fixture(scope="module")
 def server(archive):
-    process, url = _start(archive)
+    process, url = start(archive)
     yield url
     process.send_signal(signal.SIGINT)
     process.wait(timeout=20)
 
 
-def _get(url, method="GET", headers=None):
-    request = urllib.request.Request(url, method=method, headers=headers or {})
-    try:
-        with urllib.request.urlopen(request, timeout=20) as response:
-            return response.status, dict(response.headers), response.read()
-    except urllib.error.HTTPError as exc:
-        return exc.code, dict(exc.headers), exc.read()
-
-
 def test_only_get_from_this_machine_and_nothing_outside_the_archive(server):
-    status, headers, body = _get(f"{server}/shots")
+    status, headers, body = get(f"{server}/shots")
     assert status == 200 and headers["content-security-policy"].startswith("default-src 'self'")
     assert headers["x-content-type-options"] == "nosniff"
-    assert _get(f"{server}/shots", "POST")[0] == 405
-    assert _get(f"{server}/shots", "DELETE")[0] == 405
-    assert _get(f"{server}/shots", headers={"Host": "attacker.example"})[0] == 400
-    assert _get(f"{server}/shot/999")[0] == 404
+    assert get(f"{server}/shots", "POST")[0] == 405
+    assert get(f"{server}/shots", "DELETE")[0] == 405
+    assert get(f"{server}/shots", headers={"Host": "attacker.example"})[0] == 400
+    assert get(f"{server}/shot/999")[0] == 404
     for path in ("/shot/..%2f..%2findex.sqlite", "/shot/1%2f..", "/static/..%2findex.sqlite",
                  "/static/../../index.sqlite", "/index.sqlite"):
-        status, _h, body = _get(server + path)
+        status, _h, body = get(server + path)
         assert status == 404 and b"SQLite" not in body, path
     assert HOSTILE.encode() not in body
 
@@ -107,8 +83,8 @@ def test_a_port_in_use_is_one_line_and_ctrl_c_stops_the_server(archive, server, 
     assert main(["serve", "--archive", str(archive), "--port", port]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and f"--port: 127.0.0.1:{port} cannot be listened on" in err
-    process, url = _start(archive)
-    assert _get(f"{url}/shots")[0] == 200
+    process, url = start(archive)
+    assert get(f"{url}/shots")[0] == 200
     process.send_signal(signal.SIGINT)
     process.wait(timeout=20)
     assert "Traceback" not in process.stderr.read()
@@ -116,35 +92,14 @@ def test_a_port_in_use_is_one_line_and_ctrl_c_stops_the_server(archive, server, 
 
 @pytest.fixture(scope="module")
 def browser():
-    if CHROMIUM is None:
-        pytest.skip("needs Debian's chromium (apt-get install chromium)")
-    sync_api = pytest.importorskip("playwright.sync_api")
-    with sync_api.sync_playwright() as p:
-        launched = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+    with chromium() as launched:
         yield launched
-        launched.close()
 
 
 @pytest.fixture
 def page(browser, server):
-    """A fresh page that records every request's address and every page error."""
-    context = browser.new_context(viewport={"width": 1100, "height": 900})
-    page = context.new_page()
-    page.requests, page.errors = [], []
-    page.on("request", lambda r: page.requests.append(r.url))
-    page.on("pageerror", lambda e: page.errors.append(str(e)))
-    page.on("console", lambda m: m.type == "error" and page.errors.append(m.text))
-    yield page
-    assert not page.errors, page.errors
-    assert all(u.startswith(server + "/") for u in page.requests), page.requests
-    context.close()
-
-
-def _screenshot(page, name):
-    """With $AIRGUN_XL_SCREENSHOTS (a folder), the page as the browser drew it, for docs/."""
-    folder = os.environ.get("AIRGUN_XL_SCREENSHOTS")
-    if folder:
-        page.screenshot(path=os.path.join(folder, f"{name}.png"), full_page=False)
+    with watched(browser, server) as page:
+        yield page
 
 
 def _rows(page):
@@ -156,7 +111,7 @@ def _rows(page):
 def test_the_shots_page_filters_sorts_and_exports_what_it_shows(page, server):
     page.goto(f"{server}/shots")
     rows = _rows(page)
-    _screenshot(page, "serve-shots")
+    screenshot(page, "serve-shots")
     assert len(rows) == 3 and page.text_content("#count").startswith("3 of 3 runs")
     assert page.get_attribute("#scatter", "data-drawn") == "3"
     assert page.locator("#scatter canvas").count() == 1
@@ -190,7 +145,7 @@ def test_a_shots_page_draws_its_pulse_and_lists_its_figures_and_warnings(page, s
     page.goto(f"{server}/shots?sort=v0")
     page.click("#shots tbody tr:first-child td.shot a")
     page.wait_for_selector("#pulse[data-drawn]")
-    _screenshot(page, "serve-shot")
+    screenshot(page, "serve-shot")
     assert page.url == f"{server}/shot/1"
     assert page.text_content("#entry").startswith("shot_230@1")
     assert int(page.get_attribute("#pulse", "data-drawn")) > 1000
@@ -221,7 +176,7 @@ def test_the_view_opens_the_sqlite_index_read_only(archive, server):
     after the pages were read."""
     before = (archive / "index.sqlite").read_bytes()
     for path in ("/shots", "/shot/1", "/shots.csv"):
-        assert _get(server + path)[0] == 200
+        assert get(server + path)[0] == 200
     assert (archive / "index.sqlite").read_bytes() == before
     assert os.path.getsize(archive / "index.sqlite") == len(before)
 
@@ -259,21 +214,20 @@ def test_a_server_archive_is_browsed_as_an_sqlite_one(tmp_path, server_env, brow
     assert main(["archive", "init", str(root), "--index", address, "--writers", "lab"]) == 0
     _fill(tmp_path, root, SPEEDS[:2], "shared")
     capsys.readouterr()
-    process, url = _start(root)
+    process, url = start(root)
     try:
-        context = browser.new_context()
-        page = context.new_page()
-        errors, requests = [], []
-        page.on("pageerror", lambda e: errors.append(str(e)))
-        page.on("request", lambda r: requests.append(r.url))
-        page.goto(f"{url}/shots?sort=v0")
-        assert [r[2] for r in _rows(page)] == ["shared_230", "shared_243.5"]
-        page.click("#shots tbody tr:first-child td.shot a")
-        page.wait_for_selector("#pulse[data-drawn]")
-        assert page.text_content("#entry").startswith("shared_230@1")
-        assert not errors and all(u.startswith(url + "/") for u in requests), (errors,
-                                                                                  requests)
-        context.close()
+        with watched(browser, url) as page:
+            page.goto(f"{url}/shots?sort=v0")
+            assert [r[2] for r in _rows(page)] == ["shared_230", "shared_243.5"]
+            page.click("#shots tbody tr:first-child td.shot a")
+            page.wait_for_selector("#pulse[data-drawn]")
+            assert page.text_content("#entry").startswith("shared_230@1")
+            # the laws page, the compare page: drawn from the server's archive as well
+            page.goto(f"{url}/compare?id=1&id=2")
+            page.wait_for_selector("#overlay[data-drawn]")
+            assert page.get_attribute("#overlay", "data-series") == "2"
+            page.goto(f"{url}/laws")
+            assert page.text_content("#no-laws").startswith("No crush law")
     finally:
         process.send_signal(signal.SIGINT)
         process.wait(timeout=20)

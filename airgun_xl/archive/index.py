@@ -429,7 +429,9 @@ class SqliteIndex:
 
     def stamp(self):
         """A token that changes when the entries do: each index file's size, modification
-        time and inode (a commit writes the write-ahead log, a checkpoint the database)."""
+        time and inode (a commit writes the write-ahead log, a checkpoint the database). An
+        empty log is no log: a reader's first open may create one, and it holds nothing the
+        database does not."""
         out: list[tuple[int, int, int] | None] = []
         for name in (INDEX, f"{INDEX}-wal"):
             try:
@@ -437,7 +439,7 @@ class SqliteIndex:
             except OSError:
                 out.append(None)
                 continue
-            out.append((st.st_size, st.st_mtime_ns, st.st_ino))
+            out.append((st.st_size, st.st_mtime_ns, st.st_ino) if st.st_size else None)
         return tuple(out)
 
     def problems(self):

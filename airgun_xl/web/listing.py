@@ -41,6 +41,20 @@ FIGURES = (("peak_kg", "peak", "kG", 1.0), ("filtered_peak_kg", "filtered peak",
            ("warning_count", "warnings", "", 1.0))
 
 
+def read_only(root: str | Path) -> Any:
+    """The archive at ``root``, its index opened read-only: SQLite's ``mode=ro``, or every
+    transaction on the server read-only."""
+    from ..archive import Archive
+    from ..archive.index import SqliteIndex
+
+    found = Archive(root)
+    if isinstance(found.index, SqliteIndex):
+        found.index = SqliteIndex(found.root, read_only=True)
+    else:
+        found.index.read_only = True
+    return found
+
+
 @dataclasses.dataclass(frozen=True)
 class Snapshot:
     """The archive as read at one moment.

@@ -139,10 +139,15 @@ def _sortable(value: Any) -> tuple[int, Any]:
     return (1, str(value))
 
 
-def shown(value: Any, factor: float = 1.0, digits: int | None = None) -> str:
-    """A value as a cell shows it: ``n/a`` when missing, numbers to ``digits``."""
+#: Columns whose missing value is a "none" (no lot, no verdict), not a figure not available.
+NONE_SAID = ("lot", "predicted", "verdict")
+
+
+def shown(value: Any, factor: float = 1.0, digits: int | None = None, key: str = "") -> str:
+    """A value as a cell shows it: ``n/a`` (or ``none`` in :data:`NONE_SAID`) when missing,
+    numbers to ``digits``."""
     if value is None:
-        return "n/a"
+        return "none" if key in NONE_SAID else "n/a"
     if digits is None or isinstance(value, bool) or not isinstance(value, (int, float)):
         return str(value)
     return f"{value * factor:,.{digits}f}"
@@ -214,9 +219,15 @@ def overlaid(pulses: list[tuple[Any, Any]]) -> dict[str, Any]:
     return {"x": xs, "y": ys}
 
 
+#: What a run was made with besides its cells: provenance.json's key -> words.
+RUN_SETTINGS = (("crush_law", "crush law"), ("integrator", "integrator"), ("model", "model"),
+                ("unloading", "unloading"), ("engine", "airgun-xl"))
+
+
 def differing(docs: list[dict[str, Any]]) -> tuple[list[dict[str, Any]], int]:
-    """The inputs whose values differ between the compared entries' records, and how many
-    are equal (not listed)."""
+    """The inputs (cells, then the run's settings: crush law, integrator, model, unloading,
+    version) whose values differ between the compared entries' records, and how many are
+    equal (not listed)."""
     by_cell: dict[str, dict[str, Any]] = {}
     for k, doc in enumerate(docs):
         for p in doc["params"]:
@@ -227,6 +238,13 @@ def differing(docs: list[dict[str, Any]]) -> tuple[list[dict[str, Any]], int]:
                                              "unit": str(p.get("unit", "")),
                                              "values": [None] * len(docs)})
             item["values"][k] = p.get("value")
+        for key, words in RUN_SETTINGS:
+            value = doc["provenance"].get(key)
+            if isinstance(value, dict):  # a crush law: its name (its coefficients follow it)
+                value = value.get("name")
+            item = by_cell.setdefault(key, {"cell": "", "label": words, "unit": "",
+                                            "values": [None] * len(docs)})
+            item["values"][k] = value
     differ = [item for item in by_cell.values() if len({repr(v) for v in item["values"]}) > 1]
     return differ, len(by_cell) - len(differ)
 

@@ -79,17 +79,11 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
     from starlette.templating import Jinja2Templates
 
     from ..app.archive import FIGURE_UNITS, predicted_pulse, show_entry, shown_figure
-    from ..archive import Archive
-    from ..archive.index import SqliteIndex
     from ..errors import AirgunXlError
     from . import pages
-    from .listing import FIGURES, Listing
+    from .listing import FIGURES, Listing, read_only
 
-    found = Archive(archive)
-    if isinstance(found.index, SqliteIndex):
-        found.index = SqliteIndex(found.root, read_only=True)
-    else:
-        found.index.read_only = True  # every transaction on the server read-only
+    found = read_only(archive)
     listing = Listing(found)
     if warm:
         listing.warm()
@@ -118,7 +112,7 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
         count = len(rows)
         last = max(1, math.ceil(count / pages.PAGE))
         at = min(max(1, int(pages.number(request.query_params.get("page")) or 1)), last)
-        shown = [{"id": r["id"], "cells": [(key, pages.shown(r.get(key), factor, digits))
+        shown = [{"id": r["id"], "cells": [(key, pages.shown(r.get(key), factor, digits, key))
                                            for key, _h, _u, factor, digits in pages.COLUMNS],
                   "warnings": r.get("warnings") or []}
                  for r in rows[(at - 1) * pages.PAGE: at * pages.PAGE]]
@@ -240,6 +234,7 @@ def _verdict(root: Path, listed: dict[str, Any]) -> dict[str, Any]:
             "specification": str(record.get("specification", "")),
             "recording": str(record.get("recording", "")),
             "warnings": [str(w) for w in record.get("warnings") or []],
+            "definitions": [str(d) for d in record.get("definitions") or []],
             "criteria": [c for c in criteria or [] if isinstance(c, dict)]}
 
 

@@ -1,0 +1,285 @@
+"""Issue 48 (second part): the view's scatter, filters, compare and laws pages, and a shot's
+verdicts, in Debian's Chromium, on a small lab's archive.
+
+The lab: shot A filled into the archive (shot1, the report's law), fired on a lot 10 % stronger
+than the report's law and put through ``next`` (its verdict FAIL, law LOT-A@1, a proposal);
+the proposed workbook filled with LOT-A@1 (shot1.next), fired and put through ``next`` (PASS,
+LOT-A@2); the second proposal filled with LOT-A@2 (shot3). Beside them, records as a hostile
+hand would leave them: a law whose fields are a script, a verdict of shot3 whose criterion is
+one, and a law folder that is a link to a folder outside the archive.
+
+What is checked against the archive's own records (read here with the tool's readers): every
+point of the scatter, every row a filter keeps, every input a compare lists as differing, every
+law version's runs, the chain's verdicts and P(PASS), a verdict's criteria and the peak's
+limits drawn.
+"""
+import csv
+import io
+import json
+import shutil
+import signal
+
+import pytest
+from conftest import TEMPLATE, write_trace_csv
+from serve_helpers import chromium, get, screenshot, start, watched
+
+import airgun_xl
+from airgun_xl.app.archive import shown_figure
+from airgun_xl.app.next_shot import chain, prediction_record
+from airgun_xl.crush_law import LEGACY_LAW
+from airgun_xl.studies.calibrate import synthetic_measurement
+
+pytest.importorskip("starlette")
+pytest.importorskip("uvicorn")
+pytestmark = pytest.mark.slow  # a lab's two shots through next, a server, a browser
+HOSTILE = "=HYPERLINK(\"http://x\")<script>window.pwned=1</script>"
+SPEC = {"peak": "8.5kG:5%", "duration": "4.5ms:15%"}
+
+
+def _fire(workbook, recording, seed):
+    """The lab fires ``workbook`` on a lot 10 % stronger than the report's law."""
+    p = airgun_xl.load(workbook).params.replace(crush_law=LEGACY_LAW.scaled(1.10))
+    write_trace_csv(recording, synthetic_measurement(p, dt=1 / 51_200, seed=seed))
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory):
+    work = tmp_path_factory.mktemp("lab")
+    root = work / "arch"
+    shot1 = work / "shot1.xlsx"
+    shot1.write_bytes(TEMPLATE.read_bytes())
+    airgun_xl.fill(shot1, output=work / "out1.xlsx", archive=root)
+    _fire(shot1, work / "rec1.csv", 3)
+    first = airgun_xl.next_shot(shot1, work / "rec1.csv", archive=root, lot="LOT-A",
+                                new_lot=True, sd=["A28=1.5%"], shots=100, **SPEC)
+    airgun_xl.fill(first.output, output=work / "out2.xlsx", archive=root, crush_law="LOT-A@1")
+    _fire(first.output, work / "rec2.csv", 4)
+    second = airgun_xl.next_shot(first.output, work / "rec2.csv", archive=root, lot="LOT-A",
+                                 sd=["A28=1.5%"], shots=100, output=work / "shot3.xlsx",
+                                 **SPEC)
+    airgun_xl.fill(second.output, output=work / "out3.xlsx", archive=root,
+                   crush_law="LOT-A@2")
+    # hostile records: a law and a verdict whose texts are a script, a law folder that links
+    # out of the archive
+    law = json.loads((root / ".laws" / "LOT-A" / "v0001.json").read_text())
+    (root / ".laws" / "EVIL").mkdir()
+    (root / ".laws" / "EVIL" / "v0001.json").write_text(json.dumps(
+        {**law, "shots": [{"workbook": HOSTILE}], "created": HOSTILE}))
+    outside = work / "outside"
+    outside.mkdir()
+    (outside / "v0001.json").write_text(json.dumps({**law, "created": "OUTSIDE-THE-ARCHIVE"}))
+    (root / ".laws" / "LINKED").symlink_to(outside, target_is_directory=True)
+    verdict = json.loads((root / ".verdicts" / "shot1" / "v0001.json").read_text())
+    (root / ".verdicts" / "shot3").mkdir()
+    (root / ".verdicts" / "shot3" / "v0001.json").write_text(json.dumps(
+        {**verdict, "shot": "shot3", "criteria": [{**verdict["criteria"][0],
+                                                   "name": HOSTILE}]}))
+    return root
+
+
+@pytest.fixture(scope="module")
+def server(lab):
+    process, url = start(lab)
+    yield url
+    process.send_signal(signal.SIGINT)
+    process.wait(timeout=20)
+
+
+@pytest.fixture(scope="module")
+def browser():
+    with chromium() as launched:
+        yield launched
+
+
+@pytest.fixture
+def page(browser, server):
+    with watched(browser, server) as page:
+        yield page
+
+
+def _summary(lab, shot):
+    return json.loads((lab / shot / "v0001" / "summary.json").read_text())
+
+
+def _inputs(lab, shot):
+    return {p["cell"]: p["value"] for p in
+            json.loads((lab / shot / "v0001" / "params.json").read_text())}
+
+
+def _csv(server, query):
+    status, _h, body = get(f"{server}/shots.csv?{query}")
+    assert status == 200
+    return list(csv.DictReader(io.StringIO(body.decode())))
+
+
+def test_filters_by_lot_verdict_and_any_input_a_limit_within(server, lab):
+    """Each filter keeps exactly the runs its field selects; a value on a limit is within."""
+    def shots(query):
+        return [r["shot"] for r in _csv(server, query + "&sort=id")]
+
+    assert shots("") == ["shot1", "shot1.next", "shot3"]
+    assert shots("lot=LOT-A") == ["shot1.next", "shot3"]
+    assert shots("lot=(none)") == ["shot1"]
+    assert shots("verdict=PASS") == ["shot1.next"]
+    assert shots("verdict=FAIL") == ["shot1", "shot3"]
+    assert shots("verdict=none") == []
+    v3 = _inputs(lab, "shot3")["A28"]
+    assert shots(f"input=A28&input_min={v3!r}&input_max={v3!r}") == ["shot3"]  # on both limits
+    assert shots(f"input=A28&input_min={v3 * (1 + 1e-12)!r}") == ["shot1", "shot1.next"]
+    # an input the index does not hold (read from each params.json): E43, zeta, 0.02 in all
+    assert shots("input=E43&input_min=0.02&input_max=0.02") == ["shot1", "shot1.next", "shot3"]
+    assert shots("input=E43&input_max=0.019") == []
+    rows = _csv(server, "lot=LOT-A")
+    assert [r["lot"] for r in rows] == ["LOT-A", "LOT-A"]
+    assert [r["recorded verdict"] for r in rows] == ["PASS", "FAIL"]
+
+
+def test_the_scatter_draws_any_figure_against_any_input_coloured_and_on_log_axes(page, server,
+                                                                                 lab):
+    page.goto(f"{server}/shots")
+    page.wait_for_selector("#scatter[data-drawn]")
+    screenshot(page, "serve-scatter")
+    data = json.loads(page.text_content("#scatter-data"))
+    assert [(s["name"], s["points"]) for s in data["series"]] == [("LOT-A", 2), ("none", 1)]
+    assert page.get_attribute("#scatter", "data-series") == "2"
+    # the pulse duration [ms] against A28, coloured by recorded verdict, on a log y axis
+    page.select_option("select[name=y]", "pulse_duration")
+    page.select_option("select[name=colour]", "verdict")
+    page.check("input[name=logy]")
+    page.click("#filters button")
+    page.wait_for_selector("#scatter[data-drawn]")
+    assert "y=pulse_duration" in page.url and "colour=verdict" in page.url \
+        and "logy=1" in page.url
+    page.goto(page.url)  # the view survives a reload by its URL
+    page.wait_for_selector("#scatter[data-drawn]")
+    assert page.input_value("select[name=y]") == "pulse_duration"
+    assert page.is_checked("input[name=logy]")
+    data = json.loads(page.text_content("#scatter-data"))
+    assert data["logy"] and data["y_label"] == "pulse duration [ms]"
+    drawn = {}
+    for s in data["series"]:
+        for x, y in zip(data["x"], s["y"], strict=True):
+            if y is not None:
+                drawn.setdefault(s["name"], []).append((x, y))
+    expected = {}
+    for shot, verdict in (("shot1", "FAIL"), ("shot1.next", "PASS"), ("shot3", "FAIL")):
+        point = (float(f"{_inputs(lab, shot)['A28']:.6g}"),
+                 float(f"{_summary(lab, shot)['pulse_duration'] * 1e3:.6g}"))
+        expected.setdefault(verdict, []).append(point)
+    assert {k: sorted(v) for k, v in drawn.items()} == {k: sorted(v) for k, v in
+                                                        expected.items()}
+    # on a log axis, a value that is not positive is left out and said: A27 is 0 in all
+    page.goto(f"{server}/shots?x=A27&logx=1")
+    page.wait_for_selector("#scatter[data-drawn]")
+    assert page.text_content("#scatter-note").startswith("3 run(s) not drawn")
+
+
+def test_compare_lists_what_differs_and_its_set_changes_in_place(page, server, lab):
+    page.goto(f"{server}/shots?sort=id")
+    page.wait_for_selector("#scatter[data-drawn]")
+    page.check("#shots tbody tr:nth-child(1) input[name=id]")
+    page.check("#shots tbody tr:nth-child(3) input[name=id]")
+    page.click("#compare-selected")
+    page.wait_for_selector("#overlay[data-drawn]")
+    screenshot(page, "serve-compare")
+    assert page.url == f"{server}/compare?id=1&id=3"
+    assert page.get_attribute("#overlay", "data-series") == "2"
+    differ = page.eval_on_selector_all(
+        "#compared tr.input", "rows => rows.map(r => [...r.cells].map(c => c.textContent))")
+    one, three = _inputs(lab, "shot1"), _inputs(lab, "shot3")
+    cells = sorted(c for c in one if one[c] != three[c])
+    assert cells == ["A28", "A29", "A30"]  # the proposal's speed, set in the three cells
+    assert [row[0].split(" ")[0] for row in differ[:3]] == cells
+    assert [float(row[1]) for row in differ[:3]] == [one[c] for c in cells]
+    assert [float(row[2]) for row in differ[:3]] == [three[c] for c in cells]
+    assert differ[3] == ["crush law", "legacy (Eq. 8)", "fitted (LOT-A@2)"]
+    figures = {row[0]: row[1:] for row in page.eval_on_selector_all(
+        "#compared tr.figure", "rows => rows.map(r => [...r.cells].map(c => c.textContent))")}
+    for shot, column in (("shot1", 0), ("shot3", 1)):
+        peak = _summary(lab, shot)["peak_kg"]
+        assert figures["Peak acceleration (raw)"][column] == shown_figure("peak_kg", peak)[1]
+    # the set changed in place: one removed, another added, and a reload keeps it
+    page.click("#compared th:nth-child(2) a.remove")
+    page.wait_for_selector("#overlay[data-drawn]")
+    assert page.url == f"{server}/compare?id=3"
+    page.select_option("#add", "2")
+    page.click("#compare-set button")
+    page.wait_for_selector("#overlay[data-drawn]")
+    assert page.url == f"{server}/compare?id=3&id=2"
+    page.goto(page.url)
+    page.wait_for_selector("#overlay[data-drawn]")
+    heads = page.eval_on_selector_all("#compared th a:not(.remove)",
+                                      "links => links.map(a => a.textContent)")
+    assert heads == ["shot3@1", "shot1.next@1"]
+
+
+def test_the_laws_page_holds_each_version_its_runs_the_chain_and_the_outcomes(page, server,
+                                                                              lab):
+    page.goto(f"{server}/laws")
+    page.wait_for_selector(".law-chart[data-drawn]")
+    screenshot(page, "serve-laws")
+    assert page.evaluate("window.pwned") is None
+    sections = page.eval_on_selector_all("section.lot h2", "hs => hs.map(h => h.textContent)")
+    assert sections == ["EVIL", "LOT-A"]  # the link out of the archive is not followed
+    assert "OUTSIDE-THE-ARCHIVE" not in page.content()
+    lot = page.locator("section.lot", has_text="LOT-A").last
+    assert lot.locator(".law-chart").get_attribute("data-series") == "2"
+    versions = lot.locator("table.versions tr").all_text_contents()[1:]
+    assert versions[0].startswith("LOT-A@1") and "shot1.next@1" in versions[0]
+    assert versions[1].startswith("LOT-A@2") and "shot3@1" in versions[1]
+    rows = [r.split("\n") for r in lot.locator("table.chain tr").evaluate_all(
+        "rows => rows.slice(1).map(r => [...r.cells].map(c => c.textContent).join('\\n'))")]
+    expected = chain(lab, "LOT-A")
+    assert [r[2] for r in rows] == [e["verdict"] for e in expected] == ["FAIL", "PASS"]
+    assert rows[0][3] == "n/a" and rows[1][3] == f"{expected[1]['predicted_before']:.3f}"
+    assert [r[5] for r in rows] == [f"{e['next_A28']:.3f}" for e in expected]
+    record = prediction_record(lab)
+    assert page.text_content("#record") == (f"1 shot fired from next's proposals; Brier score "
+                                            f"{record.brier:.4f}.")
+    evil = page.locator("section.lot", has_text="EVIL")
+    assert HOSTILE in evil.text_content()  # a script shown as text
+
+
+def test_a_shots_page_lists_its_verdicts_and_draws_the_peaks_limits(page, server, lab):
+    page.goto(f"{server}/shot/1")
+    page.wait_for_selector("#pulse[data-drawn]")
+    record = json.loads((lab / ".verdicts" / "shot1" / "v0001.json").read_text())
+    assert page.text_content("h3.recorded").startswith("Recorded verdict 1: FAIL")
+    table = page.eval_on_selector_all(
+        "#recorded-criteria-1 tr", "rows => rows.slice(1).map(r => [...r.cells].map("
+        "c => c.textContent))")
+    assert [r[0] for r in table] == [c["name"] for c in record["criteria"]]
+    assert [r[1] for r in table] == [f"{c['value']:.6g} {c['unit']}" for c in
+                                     record["criteria"]]
+    assert [r[5] for r in table] == ["PASS" if c["passed"] else "FAIL"
+                                     for c in record["criteria"]]
+    peak = next(c for c in record["criteria"] if c["name"] == "peak")
+    assert peak["unit"] == "kG"
+    pulse = json.loads(page.text_content("#pulse-data"))
+    assert pulse["band"] == [float(f"{peak['low']:.6g}"), float(f"{peak['high']:.6g}")]
+    assert page.get_attribute("#pulse", "data-series") == "3"  # the pulse and two limits
+    # the hostile verdict of shot3: its criterion is text
+    page.goto(f"{server}/shot/3")
+    page.wait_for_selector("#pulse[data-drawn]")
+    assert page.evaluate("window.pwned") is None
+    assert page.text_content("#recorded-criteria-1 tr:nth-child(2) td") == HOSTILE
+
+
+def test_the_listing_is_read_once_and_again_when_the_archive_changes(lab, tmp_path,
+                                                                     monkeypatch):
+    """Entries are read once while the index is unchanged; a new fill is listed at the next
+    request, without a restart; past FRESH seconds the index is read again anyway."""
+    from airgun_xl.web import listing
+
+    root = tmp_path / "copy"
+    shutil.copytree(lab, root, symlinks=True)
+    view = listing.Listing(listing.read_only(root))  # as the server opens it
+    first = view.snapshot()
+    assert view.snapshot() is first
+    assert [r["shot"] for r in first.rows] == ["shot1", "shot1.next", "shot3"]
+    airgun_xl.fill(TEMPLATE, output=tmp_path / "o.xlsx", archive=root, name="later")
+    second = view.snapshot()
+    assert [r["shot"] for r in second.rows] == ["shot1", "shot1.next", "shot3", "later"]
+    assert all(a is b for a, b in zip(first.rows, second.rows[:3], strict=False))  # kept
+    monkeypatch.setattr(listing, "FRESH", 0.0)
+    assert view.snapshot() is not second
