@@ -81,7 +81,16 @@ SCHEMAS: dict[str, dict] = {
                                           "additionalProperties": _TEXT,
                                           "description": "what the recording said of "
                                                          "itself, text by label"},
-                       "created": _TEXT, "command": _TEXTS}},
+                       "created": _TEXT, "command": _TEXTS,
+                       "trace": {"type": ["object", "null"],
+                                 "description": "the record judged, thinned for a drawing",
+                                 "properties": {"time_ms": {"type": "array"},
+                                                "kg": {"type": "array"},
+                                                "upper_kg": {"type": ["array", "null"]},
+                                                "lower_kg": {"type": ["array", "null"]},
+                                                "onset_ms": _NUMBER_OR_NULL,
+                                                "samples": {"type": "integer"},
+                                                "thinned": _TEXT}}}},
     "proposal": {
         "type": "object", "description": "a lot's proposal (next)",
         "required": ["lot", "shot", "verdict", "law", "setting_A28", "p_pass", "interval",

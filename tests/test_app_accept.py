@@ -187,3 +187,54 @@ def test_accept_json_escapes_what_the_files_say(tmp_path, recording, capsys):
     out = capsys.readouterr().out
     assert "\x1b" not in out and "\\u001b[2J" in out
     assert json.loads(out)["recording"] == str(hostile)
+
+
+def test_an_archived_verdict_keeps_the_record_it_judged_and_its_corridor(tmp_path, recording):
+    """The verdict record keeps the record judged (here 1,076 samples: whole) and the
+    corridor's limits at its times inside the window monitored, each to 6 significant digits
+    (the drawing's precision; the criteria keep full precision), read back by the archive's
+    bounded reader (``serve`` draws them on a shot's page)."""
+    import json
+
+    from airgun_xl.studies.acceptance import corridor_limits
+
+    v = airgun_xl.accept(TEMPLATE, recording, shape="half-sine", peak="40g:10%",
+                         duration="11ms:10%", cfc="none", archive=tmp_path / "arch",
+                         output=tmp_path / "verdict.xlsx")
+    record = json.loads(v.archived.read_text())
+    trace = record["trace"]
+    t, kg = v.verdict.record
+    assert trace["samples"] == len(t) == 1076 and trace["thinned"] == "whole"
+    assert trace["time_ms"] == [float(f"{x * 1e3:.6g}") for x in t]
+    assert trace["kg"] == [float(f"{x:.6g}") for x in kg]
+    assert trace["onset_ms"] == float(f"{v.verdict.onset * 1e3:.6g}")
+    upper, lower = corridor_limits(v.verdict.spec, t - v.verdict.onset)
+    lo, hi = v.verdict.window
+    inside = (t >= lo) & (t <= hi)
+    assert trace["upper_kg"] == [float(f"{u:.6g}") if k else None
+                                 for u, k in zip(upper, inside, strict=True)]
+    assert trace["lower_kg"] == [float(f"{x:.6g}") if k else None
+                                 for x, k in zip(lower, inside, strict=True)]
+    assert None not in trace["upper_kg"]  # the whole record lies in the window monitored
+
+
+def test_a_long_record_is_kept_as_its_envelope_so_no_peak_is_lost():
+    """A record of 1,000,000 samples with a one-sample spike: the kept trace is at most 4,000
+    points in time order, holds the spike's value exactly and every span's extremes (so the
+    drawn record's largest and smallest values are the record's own)."""
+    from types import SimpleNamespace
+
+    from airgun_xl.archive.verdicts import TRACE_SPANS, judged_trace
+
+    t = np.arange(1_000_000) / 1e6
+    kg = np.sin(2 * np.pi * 50 * t)
+    kg[654_321] = 7.0
+    verdict = SimpleNamespace(record=(t, kg), onset=None, window=None,
+                              spec=SimpleNamespace(corridor=None))
+    trace = judged_trace(verdict)
+    assert len(trace["time_ms"]) <= 2 * TRACE_SPANS
+    assert all(a < b for a, b in zip(trace["time_ms"], trace["time_ms"][1:], strict=False))
+    assert max(trace["kg"]) == 7.0 and min(trace["kg"]) == float(f"{kg.min():.6g}")
+    assert trace["time_ms"][trace["kg"].index(7.0)] == float(f"{t[654_321] * 1e3:.6g}")
+    assert trace["samples"] == 1_000_000 and trace["upper_kg"] is None
+    assert trace["thinned"] == "the smallest and largest sample of each of 2,000 spans"

@@ -4,7 +4,8 @@ verdicts, in Debian's Chromium, on a small lab's archive.
 The lab: shot A filled into the archive (shot1, the report's law), fired on a lot 10 % stronger
 than the report's law and put through ``next`` (its verdict FAIL, law LOT-A@1, a proposal);
 the proposed workbook filled with LOT-A@1 (shot1.next), fired and put through ``next`` (PASS,
-LOT-A@2); the second proposal filled with LOT-A@2 (shot3). Beside them, records as a hostile
+LOT-A@2); the second proposal filled with LOT-A@2 (shot3), fired and judged by ``accept`` with
+a half-sine's corridor. Beside them, records as a hostile
 hand would leave them: a law whose fields are a script, a verdict of shot3 whose criterion is
 one, and a law folder that is a link to a folder outside the archive.
 
@@ -59,6 +60,11 @@ def lab(tmp_path_factory):
                                  **SPEC)
     airgun_xl.fill(second.output, output=work / "out3.xlsx", archive=root,
                    crush_law="LOT-A@2")
+    _fire(second.output, work / "rec3.csv", 5)  # judged with a corridor: its verdict FAIL
+    accepted = airgun_xl.accept(second.output, work / "rec3.csv", archive=root,
+                                output=work / "verdict3.xlsx", shape="half-sine",
+                                corridor="20%", **SPEC)
+    assert accepted.word == "FAIL" and accepted.archived.name == "v0001.json"
     # hostile records: a law and a verdict whose texts are a script, a law folder that links
     # out of the archive
     law = json.loads((root / ".laws" / "LOT-A" / "v0001.json").read_text())
@@ -70,10 +76,11 @@ def lab(tmp_path_factory):
     (outside / "v0001.json").write_text(json.dumps({**law, "created": "OUTSIDE-THE-ARCHIVE"}))
     (root / ".laws" / "LINKED").symlink_to(outside, target_is_directory=True)
     verdict = json.loads((root / ".verdicts" / "shot1" / "v0001.json").read_text())
-    (root / ".verdicts" / "shot3").mkdir()
-    (root / ".verdicts" / "shot3" / "v0001.json").write_text(json.dumps(
+    (root / ".verdicts" / "shot3" / "v0002.json").write_text(json.dumps(
         {**verdict, "shot": "shot3", "criteria": [{**verdict["criteria"][0],
-                                                   "name": HOSTILE}]}))
+                                                   "name": HOSTILE}],
+         "trace": {"time_ms": [HOSTILE, 0.1, 0.2], "kg": [1.0, HOSTILE, 3.0], "onset_ms": None,
+                   "upper_kg": None, "lower_kg": None, "samples": 3, "thinned": HOSTILE}}))
     return root
 
 
@@ -258,11 +265,33 @@ def test_a_shots_page_lists_its_verdicts_and_draws_the_peaks_limits(page, server
     pulse = json.loads(page.text_content("#pulse-data"))
     assert pulse["band"] == [float(f"{peak['low']:.6g}"), float(f"{peak['high']:.6g}")]
     assert page.get_attribute("#pulse", "data-series") == "3"  # the pulse and two limits
-    # the hostile verdict of shot3: its criterion is text
+    assert page.locator("#verdict-chart-1").count() == 1  # the record judged, no corridor
+    # shot3: its verdict judged a corridor; the record and the limits drawn over the
+    # prediction, shifted as the page says; the hostile second verdict's criterion is text
     page.goto(f"{server}/shot/3")
-    page.wait_for_selector("#pulse[data-drawn]")
+    page.wait_for_selector("#verdict-chart-1[data-drawn]")
+    screenshot(page, "serve-verdict")
     assert page.evaluate("window.pwned") is None
-    assert page.text_content("#recorded-criteria-1 tr:nth-child(2) td") == HOSTILE
+    assert page.text_content("#recorded-criteria-2 tr:nth-child(2) td") == HOSTILE
+    assert page.get_attribute("#verdict-chart-1", "data-series") == "4"
+    trace = json.loads((lab / ".verdicts" / "shot3" / "v0001.json").read_text())["trace"]
+    drawn = json.loads(page.locator("#verdict-chart-1 + script").text_content())
+    assert drawn["names"] == ["predicted pulse", "record judged", "corridor upper",
+                              "corridor lower"]
+    shift = _summary(lab, "shot3")["pulse_start"] * 1e3 - trace["onset_ms"]
+    assert drawn["shift_ms"] == pytest.approx(shift, abs=1e-5)
+    record = {x: y for x, y in zip(drawn["x"], drawn["y"][1], strict=True) if y is not None}
+    expected = {float(f"{t + drawn['shift_ms']:.6g}"): k
+                for t, k in zip(trace["time_ms"], trace["kg"], strict=True)}
+    assert record == expected
+    assert max(y for y in drawn["y"][2] if y is not None) == max(
+        u for u in trace["upper_kg"] if u is not None)
+    # the hostile trace: a text where a number belongs is a gap, its words text
+    hostile = json.loads(page.locator("#verdict-chart-2 + script").text_content())
+    assert hostile["names"] == ["predicted pulse", "record judged"]
+    assert {x: y for x, y in zip(hostile["x"], hostile["y"][1], strict=True)
+            if y is not None} == {0.2: 3.0}
+    assert HOSTILE in page.locator("#verdict-chart-2 ~ p.note").first.text_content()
 
 
 def test_the_listing_is_read_once_and_again_when_the_archive_changes(lab, tmp_path,

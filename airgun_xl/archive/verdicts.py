@@ -24,6 +24,61 @@ def _plain(value):
     return value
 
 
+#: Spans of the record a verdict keeps for a drawing (each keeps its smallest and largest
+#: sample): at most twice this many points, about 100 kB of JSON.
+TRACE_SPANS = 2000
+
+
+def _short(value):
+    """A number to 6 significant digits for a drawing; None (a gap) where not finite."""
+    value = float(value)
+    return float(f"{value:.6g}") if value == value and abs(value) != float("inf") else None
+
+
+def judged_trace(verdict, spans=TRACE_SPANS):
+    """The record a verdict judged, kept for a drawing (``serve``'s shot page): a min/max
+    envelope (the record cut into ``spans`` spans of time, each keeping its smallest and
+    largest sample, in time order, so no peak is lost to the thinning), time [ms] and
+    acceleration [kG], with the corridor's limits at those times where one was judged (None
+    outside its window) and the ideal pulse's start [ms]; None when the verdict holds no
+    record."""
+    import numpy as np
+
+    if verdict.record is None:
+        return None
+    time, kg = (np.asarray(a, dtype=float) for a in verdict.record)
+    if len(time) > 2 * spans:
+        edges = np.linspace(0, len(time), spans + 1).astype(int)
+        keep = []
+        for lo, hi in zip(edges[:-1], edges[1:], strict=True):
+            part = kg[lo:hi]
+            if not len(part) or not np.isfinite(part).any():
+                continue
+            low, high = lo + int(np.nanargmin(part)), lo + int(np.nanargmax(part))
+            keep += sorted({low, high})
+        index = np.array(keep, dtype=int)
+    else:
+        index = np.arange(len(time))
+    t, a = time[index], kg[index]
+    trace = {"time_ms": [_short(x * 1e3) for x in t], "kg": [_short(x) for x in a],
+             "upper_kg": None, "lower_kg": None,
+             "onset_ms": None if verdict.onset is None else _short(verdict.onset * 1e3),
+             "samples": int(len(time)),
+             "thinned": "whole" if len(index) == len(time) else
+             f"the smallest and largest sample of each of {spans:,} spans"}
+    spec = verdict.spec
+    if spec.corridor is not None and verdict.onset is not None and verdict.window:
+        from ..studies.acceptance import corridor_limits
+
+        upper, lower = corridor_limits(spec, t - verdict.onset)
+        inside = (t >= verdict.window[0]) & (t <= verdict.window[1])
+        trace["upper_kg"] = [_short(u) if k else None for u, k in zip(upper, inside,
+                                                                         strict=True)]
+        trace["lower_kg"] = [_short(v) if k else None for v, k in zip(lower, inside,
+                                                                         strict=True)]
+    return trace
+
+
 def verdict_record(verdict, shot, recording, report, command=()):
     """The JSON record of a verdict."""
     data = Path(str(recording).partition(":")[0])
@@ -41,6 +96,7 @@ def verdict_record(verdict, shot, recording, report, command=()):
                 verdict.spec.duration.nominal if verdict.spec.duration else None))
             if verdict.quality is not None else None,
             "recording_sha256": digest, "report": str(report),
+            "trace": judged_trace(verdict),
             "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
             "command": list(command)}
 

@@ -206,17 +206,48 @@ def thinned(time: Any, values: Any, factor: float = 1.0) -> tuple[list[Any], lis
 def overlaid(pulses: list[tuple[Any, Any]]) -> dict[str, Any]:
     """Several pulses on one time axis for a chart: the union of their thinned times, each
     pulse's values where it has a sample (a gap elsewhere)."""
-    thin = [thinned(t, a) for t, a in pulses]
-    xs = sorted({x for t, _a in thin for x in t if x is not None})
+    return merged([thinned(t, a) for t, a in pulses])
+
+
+def merged(lines: list[tuple[list[Any], list[Any]]]) -> dict[str, Any]:
+    """Lines of their own x values on one x axis: the union of their x, each line's value
+    where it has one (a gap elsewhere); a point with no finite x is left out."""
+    xs = sorted({x for t, _a in lines for x in t if x is not None})
     at = {x: k for k, x in enumerate(xs)}
     ys = []
-    for t, a in thin:
+    for t, a in lines:
         column: list[float | None] = [None] * len(xs)
-        for x, y in zip(t, a, strict=True):
+        for x, y in zip(t, a, strict=False):
             if x is not None:
                 column[at[x]] = y
         ys.append(column)
     return {"x": xs, "y": ys}
+
+
+def verdict_chart(prediction: tuple[list[Any], list[Any]], trace: Any,
+                  pulse_start_ms: float | None) -> dict[str, Any] | None:
+    """A recorded verdict's chart: the record it judged (its kept trace) and the corridor's
+    limits, over the predicted pulse, the record shifted so that the ideal pulse's start
+    (placed by the verdict) falls on the prediction's pulse start; None without a trace.
+    Every value of the trace is untrusted: a non-number is a gap."""
+    if not isinstance(trace, dict) or not isinstance(trace.get("time_ms"), list):
+        return None
+    onset = finite(trace.get("onset_ms"))
+    shift = finite(pulse_start_ms - onset) if onset is not None and pulse_start_ms is not None \
+        else 0.0
+    shift = shift or 0.0  # as shown: to 6 significant digits
+    time = [None if (x := finite(t)) is None else float(f"{x + shift:.6g}")
+            for t in trace["time_ms"]]
+    lines = [prediction, (time, [finite(v) for v in trace.get("kg") or []])]
+    names = ["predicted pulse", "record judged"]
+    for key, words in (("upper_kg", "corridor upper"), ("lower_kg", "corridor lower")):
+        if isinstance(trace.get(key), list):
+            lines.append((time, [finite(v) for v in trace[key]]))
+            names.append(words)
+    return {**merged(lines), "names": names, "shift_ms": shift,
+            "aligned": onset is not None and pulse_start_ms is not None,
+            "samples": trace.get("samples") if isinstance(trace.get("samples"), int)
+            else None, "thinned": str(trace.get("thinned", ""))}
 
 
 #: What a run was made with besides its cells: provenance.json's key -> words.

@@ -161,8 +161,12 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
         figures = [shown_figure(k, v) for k, v in summary.items()]
         t, a = pages.thinned(time, accel)
         recorded = []
+        start = pages.finite(summary.get("pulse_start"), 1e3)
         for v in snapshot.verdicts.get(snapshot.entries[ident].shot, []):
-            recorded.append(_verdict(found.root, v))
+            shown = _verdict(found.root, v)
+            chart = pages.verdict_chart((t, a), shown.pop("trace", None), start)
+            shown["chart"] = chart and {**chart, "json": json.dumps(chart, allow_nan=False)}
+            recorded.append(shown)
         predicted = predicted if isinstance(predicted, dict) else None
         band = _peak_band(predicted, recorded)
         return page(request, "shot.html", {
@@ -235,6 +239,7 @@ def _verdict(root: Path, listed: dict[str, Any]) -> dict[str, Any]:
             "recording": str(record.get("recording", "")),
             "warnings": [str(w) for w in record.get("warnings") or []],
             "definitions": [str(d) for d in record.get("definitions") or []],
+            "trace": record.get("trace"),
             "criteria": [c for c in criteria or [] if isinstance(c, dict)]}
 
 

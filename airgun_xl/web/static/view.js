@@ -78,12 +78,15 @@
     chart(el, d.x, lines, el.dataset.x, el.dataset.y, false, false);
   }
 
-  function laws() {
-    document.querySelectorAll(".law-chart").forEach((el) => {
+  // Charts of several named lines on one x axis (a law's versions, a verdict's record):
+  // the JSON beside each holds x, y (a list a line) and names; a corridor's lines dashed.
+  function multi() {
+    document.querySelectorAll(".multi-chart").forEach((el) => {
       const d = data(el.nextElementSibling);
       if (!d || !d.x.length) return;
       const lines = d.y.map((values, k) => ({ label: d.names[k], values: values,
-        colour: PALETTE[k % PALETTE.length] }));
+        colour: PALETTE[k % PALETTE.length],
+        dash: d.names[k].startsWith("corridor") ? [6, 4] : undefined }));
       chart(el, d.x, lines, el.dataset.x, el.dataset.y, false, false);
     });
   }
@@ -92,6 +95,6 @@
     pulse();
     scatter();
     overlay();
-    laws();
+    multi();
   });
 })();
