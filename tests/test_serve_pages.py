@@ -270,6 +270,8 @@ def test_a_shots_page_lists_its_verdicts_and_draws_the_peaks_limits(page, server
     # prediction, shifted as the page says; the hostile second verdict's criterion is text
     page.goto(f"{server}/shot/3")
     page.wait_for_selector("#verdict-chart-1[data-drawn]")
+    page.locator("h3.recorded").first.scroll_into_view_if_needed()
+    page.evaluate("window.scrollBy(0, -20)")
     screenshot(page, "serve-verdict")
     assert page.evaluate("window.pwned") is None
     assert page.text_content("#recorded-criteria-2 tr:nth-child(2) td") == HOSTILE
