@@ -68,10 +68,13 @@ def cells() -> dict[str, tuple[str, str]]:
 
 def filters(query: Any) -> dict[str, Any]:
     """The shots page's choices from its URL, each kept as given (bad values: the default)."""
+    from ..cells import address
+
     sort = query.get("sort", "id")
     known = cells()
     figure_keys = [k for k, *_ in FIGURES]
-    x = query.get("x", "A28")
+    speed = address("v31")  # the scatter's default x: the bird's speed
+    x = query.get("x", speed)
     y = query.get("y", "peak_kg")
     colour = query.get("colour", "lot")
     return {"shot": query.get("shot", "").strip()[:200],
@@ -87,7 +90,7 @@ def filters(query: Any) -> dict[str, Any]:
             "input_max": number(query.get("input_max")),
             "sort": sort if sort in SORTS else "id",
             "desc": query.get("desc", "") == "1",
-            "x": x if x in known else "A28", "y": y if y in figure_keys else "peak_kg",
+            "x": x if x in known else speed, "y": y if y in figure_keys else "peak_kg",
             "colour": colour if colour in COLOURS else "lot",
             "logx": query.get("logx", "") == "1", "logy": query.get("logy", "") == "1"}
 
