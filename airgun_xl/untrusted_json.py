@@ -68,6 +68,8 @@ SCHEMAS: dict[str, dict] = {
                         "description": "2 numbers [m/s], the lower first"},
             "shots": {"type": "array", "items": {"type": "object"}},
             "scores": {"type": "array", "items": {"type": "object"}},
+            "intervals": {"type": "array", "items": {"type": "object"},
+                          "description": "the law at its nodes with their intervals"},
             "created": _TEXT, "command": _TEXTS}},
     "verdict": {
         "type": "object", "required": ["shot", "verdict", "criteria"],

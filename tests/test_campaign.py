@@ -1,5 +1,6 @@
 """Issue 21: a day's shots in one command (fill of many workbooks, --jobs, --summary), the
 archive as the lab's record (history's figures, --where, -o) and its library of crush laws."""
+import json
 import os
 import signal
 import subprocess
@@ -165,7 +166,15 @@ def test_a_law_stored_and_run_by_name_equals_the_same_law_from_its_workbook(tmp_
     calibrated = tmp_path / "cal.xlsx"
     assert main(["calibrate", str(TEMPLATE), str(measured), "--cfc", "1000", "-o",
                  str(calibrated), "--archive", str(archive), "--name", "LOT-2026-07"]) == 0
-    assert "stored the law as LOT-2026-07@1" in capsys.readouterr().out
+    said = capsys.readouterr().out
+    assert "stored the law as LOT-2026-07@1" in said
+    # the law's record keeps its nodes' intervals, the ones calibrate printed
+    record = json.loads((archive / ".laws" / "LOT-2026-07" / "v0001.json").read_text())
+    assert len(record["intervals"]) == 7
+    for n in record["intervals"]:
+        assert (f"    {n['velocity']:6.1f} m/s: {n['value']:.4f} ({n['low']:.4f} to "
+                f"{n['high']:.4f}, +/- ") in said
+        assert n["low"] < n["value"] < n["high"]
     by_name, by_sheet = tmp_path / "by_name.xlsx", tmp_path / "by_sheet.xlsx"
     assert main(["fill", str(TEMPLATE), "--crush-law", "LOT-2026-07", "--archive",
                  str(archive), "-o", str(by_name), "--name", "shot"]) == 0

@@ -27,6 +27,7 @@ from serve_helpers import chromium, get, screenshot, start, watched
 import airgun_xl
 from airgun_xl.app.archive import shown_figure
 from airgun_xl.app.next_shot import chain, prediction_record
+from airgun_xl.archive.lots import proposals
 from airgun_xl.crush_law import LEGACY_LAW
 from airgun_xl.studies.calibrate import synthetic_measurement
 
@@ -65,6 +66,13 @@ def lab(tmp_path_factory):
                                 output=work / "verdict3.xlsx", shape="half-sine",
                                 corridor="20%", **SPEC)
     assert accepted.word == "FAIL" and accepted.archived.name == "v0001.json"
+    # a law calibrate keeps, with its nodes' intervals (a lot 5 % stronger in yield stress)
+    p = airgun_xl.load(TEMPLATE).params
+    write_trace_csv(work / "cal.csv", synthetic_measurement(p.replace(sigmay=p.sigmay * 1.05),
+                                                            seed=5))
+    calibrated = airgun_xl.calibrate(TEMPLATE, work / "cal.csv", cfc=1000, archive=root,
+                                     name="CAL-1")
+    assert calibrated.stored == "CAL-1@1"
     # hostile records: a law and a verdict whose texts are a script, a law folder that links
     # out of the archive
     law = json.loads((root / ".laws" / "LOT-A" / "v0001.json").read_text())
@@ -227,13 +235,25 @@ def test_the_laws_page_holds_each_version_its_runs_the_chain_and_the_outcomes(pa
     screenshot(page, "serve-laws")
     assert page.evaluate("window.pwned") is None
     sections = page.eval_on_selector_all("section.lot h2", "hs => hs.map(h => h.textContent)")
-    assert sections == ["EVIL", "LOT-A"]  # the link out of the archive is not followed
+    assert sections == ["CAL-1", "EVIL", "LOT-A"]  # the link out of the archive: not followed
+    # calibrate's law: each node with its interval, as the record keeps them
+    record = json.loads((lab / ".laws" / "CAL-1" / "v0001.json").read_text())
+    nodes = page.locator("section.lot", has_text="CAL-1").first.locator("td.pinned")
+    said = nodes.inner_text()
+    assert len(record["intervals"]) == 7
+    for n in record["intervals"]:
+        assert (f"{n['velocity']:.1f} m/s: {n['value']:.4f} ({n['low']:.4f} to "
+                f"{n['high']:.4f})") in said
+    assert said.count("weakly pinned") == sum(n["weak"] for n in record["intervals"])
     assert "OUTSIDE-THE-ARCHIVE" not in page.content()
     lot = page.locator("section.lot", has_text="LOT-A").last
     assert lot.locator(".law-chart").get_attribute("data-series") == "2"
     versions = lot.locator("table.versions tr").all_text_contents()[1:]
     assert versions[0].startswith("LOT-A@1") and "shot1.next@1" in versions[0]
     assert versions[1].startswith("LOT-A@2") and "shot3@1" in versions[1]
+    for (_v, proposal), text in zip(proposals(lab, "LOT-A"), versions, strict=True):
+        assert (f"scaled by next: ×{proposal['scale']:.4f} ± {proposal['scale_error']:.4f} "
+                "(standard error)") in text
     rows = [r.split("\n") for r in lot.locator("table.chain tr").evaluate_all(
         "rows => rows.slice(1).map(r => [...r.cells].map(c => c.textContent).join('\\n'))")]
     expected = chain(lab, "LOT-A")

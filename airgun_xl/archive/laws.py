@@ -26,7 +26,7 @@ def _folder(root, name):
     return Path(root) / LAWS / safe_name(name)
 
 
-def store_law(root, name, law, shots, scores, command=()):
+def store_law(root, name, law, shots, scores, command=(), intervals=None):
     """Keep ``law`` in the archive at ``root`` under ``name``; return its reference
     ``NAME@N``.
 
@@ -37,12 +37,16 @@ def store_law(root, name, law, shots, scores, command=()):
         Each shot the law was fitted on (its workbook, recording, impact speed).
     scores : list of dict
         Each shot's residuals before and after.
+    intervals : list of dict, optional
+        The law at its nodes with their 95 % intervals (``calibrate``'s): each node's
+        ``velocity`` [m/s], ``value``, ``error``, ``low``, ``high`` [-] and ``weak``.
     """
     if not name or safe_name(name) != name:
         raise OptionError(f"--name: found {name!r}, expected a law name of letters, digits, "
                           "'-', '_' and '.' (such as LOT-2026-07)")
     record = {"name": name, "coefficients": list(law.coefficients),
               "v_range": list(law.v_range), "shots": shots, "scores": scores,
+              **({"intervals": intervals} if intervals is not None else {}),
               "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
               "command": list(command)}
     with signals_held():  # the archive made and the law stored, or neither

@@ -156,6 +156,13 @@ def shown(value: Any, factor: float = 1.0, digits: int | None = None, key: str =
     return f"{value * factor:,.{digits}f}"
 
 
+def real(value: Any) -> float | None:
+    """A number from an untrusted record, as it is: None where it is not a finite number."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    return float(value) if math.isfinite(value) else None
+
+
 def finite(value: Any, factor: float = 1.0) -> float | None:
     """A number for a chart's JSON: rounded to 6 significant decimals, None (a gap) where
     missing or not finite."""

@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from .pages import finite as pages_finite
+from .pages import real
 
 #: Loopback names the server answers by default; ``--host`` adds its own.
 LOOPBACK = ("127.0.0.1", "localhost", "::1", "[::1]")
@@ -261,6 +262,40 @@ def _peak_band(predicted: dict[str, Any] | None,
     return None
 
 
+def _intervals(given: Any) -> list[dict[str, Any]] | None:
+    """A law record's nodes with their 95 % intervals, each value a finite number (a node
+    that is not is left out); None when the record keeps none."""
+    if not isinstance(given, list):
+        return None
+    out = []
+    for node in given:
+        if not isinstance(node, dict):
+            continue
+        values = {k: real(node.get(k)) for k in ("velocity", "value", "low", "high")}
+        if None not in values.values():
+            out.append({**values, "weak": node.get("weak") is True})
+    return out
+
+
+def _scales(root: Path, lots: list[str]) -> dict[str, tuple[float, float | None]]:
+    """Each law version ``next`` made: its scale on the lot's prior and that scale's standard
+    error, from the lot's proposals (a proposal that cannot be read: none)."""
+    from ..archive.lots import proposals
+    from ..errors import AirgunXlError
+
+    out: dict[str, tuple[float, float | None]] = {}
+    for lot in lots:
+        try:
+            chained = proposals(root, lot)
+        except AirgunXlError:
+            continue
+        for _version, record in chained:
+            scale = real(record.get("scale"))
+            if isinstance(record.get("law"), str) and scale is not None:
+                out[record["law"]] = (scale, real(record.get("scale_error")))
+    return out
+
+
 def _laws(root: Path, snapshot: Any, pages: Any) -> dict[str, Any]:
     """The laws page: each lot's law versions (their ranges, curves, the shots each was fitted
     on and the entries that ran it), each lot's chain, and P(PASS) against outcomes."""
@@ -269,6 +304,7 @@ def _laws(root: Path, snapshot: Any, pages: Any) -> dict[str, Any]:
     from ..errors import AirgunXlError
 
     lots: dict[str, dict[str, Any]] = {}
+    scales = _scales(root, snapshot.lots)
     for law in list_laws(root):
         name = law["ref"].rpartition("@")[0]
         lot = lots.setdefault(name, {"name": name, "versions": [], "curves": [],
@@ -284,6 +320,8 @@ def _laws(root: Path, snapshot: Any, pages: Any) -> dict[str, Any]:
         lot["versions"].append({
             **law, "problem": None, "coefficients": list(crush.coefficients),
             "fitted_on": [{k: str(v) for k, v in s.items()} for s in fitted],
+            "intervals": _intervals(record.get("intervals")),
+            "scale": scales.get(law["ref"]),
             "used_by": [(r["id"], r["ref"]) for r in snapshot.rows if r.get("law") == law["ref"]]})
     for name in snapshot.lots:
         lot = lots.setdefault(name, {"name": name, "versions": [], "curves": [], "chain": [],
