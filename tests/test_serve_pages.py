@@ -245,6 +245,14 @@ def test_the_laws_page_holds_each_version_its_runs_the_chain_and_the_outcomes(pa
         assert (f"{n['velocity']:.1f} m/s: {n['value']:.4f} ({n['low']:.4f} to "
                 f"{n['high']:.4f})") in said
     assert said.count("weakly pinned") == sum(n["weak"] for n in record["intervals"])
+    cal = page.locator("section.lot", has_text="CAL-1").first
+    assert cal.locator(".law-chart").get_attribute("data-series") == "3"
+    drawn = json.loads(cal.locator(".law-chart + script").text_content())
+    assert drawn["names"] == ["CAL-1@1", "CAL-1@1 nodes, 95 % low", "CAL-1@1 nodes, 95 % high"]
+    for k, end in ((1, "low"), (2, "high")):
+        points = {x: y for x, y in zip(drawn["x"], drawn["y"][k], strict=True) if y is not None}
+        assert points == {float(f"{n['velocity']:.6g}"): float(f"{n[end]:.6g}")
+                          for n in record["intervals"]}
     assert "OUTSIDE-THE-ARCHIVE" not in page.content()
     lot = page.locator("section.lot", has_text="LOT-A").last
     assert lot.locator(".law-chart").get_attribute("data-series") == "2"

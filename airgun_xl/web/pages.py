@@ -306,16 +306,26 @@ def compare_url(ids: list[int]) -> str:
     return "/compare" + ("?" + urlencode([("id", i) for i in ids]) if ids else "")
 
 
-def law_curves(versions: list[tuple[str, Any]]) -> dict[str, Any]:
+def law_curves(versions: list[tuple[str, Any]],
+               intervals: dict[str, list[dict[str, Any]]] | None = None) -> dict[str, Any]:
     """Each law version's crush factor against relative velocity over its own range, on one
-    velocity axis (a gap outside a version's range)."""
+    velocity axis (a gap outside a version's range); a version with its nodes' intervals
+    (``intervals``, by its reference) also gets their low and high ends as points."""
     if not versions:
         return {"x": [], "y": [], "names": []}
     lo = min(law.v_range[0] for _r, law in versions)
     hi = max(law.v_range[1] for _r, law in versions)
-    xs = np.linspace(lo, hi, 200)
-    ys = []
-    for _ref, law in versions:
+    xs = [finite(x) for x in np.linspace(lo, hi, 200)]
+    lines, names = [], []
+    for ref, law in versions:
         a, b = law.v_range
-        ys.append([finite(law(x)) if a <= x <= b else None for x in xs])
-    return {"x": [finite(x) for x in xs], "y": ys, "names": [r for r, _law in versions]}
+        lines.append((xs, [finite(law(x)) if x is not None and a <= x <= b else None
+                           for x in xs]))
+        names.append(ref)
+        for end in ("low", "high"):
+            nodes = (intervals or {}).get(ref) or []
+            if nodes:
+                lines.append(([finite(n["velocity"]) for n in nodes],
+                              [finite(n[end]) for n in nodes]))
+                names.append(f"{ref} nodes, 95 % {end}")
+    return {**merged(lines), "names": names}

@@ -331,7 +331,9 @@ def _laws(root: Path, snapshot: Any, pages: Any) -> dict[str, Any]:
             lot["chain"] = chain(root, name)
         except AirgunXlError as exc:
             lot["chain_problem"] = str(exc) if "has no chain" not in str(exc) else None
-        lot["chart"] = json.dumps(pages.law_curves(lot.pop("curves")), allow_nan=False)
+        intervals = {v["ref"]: v.get("intervals") or [] for v in lot["versions"]}
+        lot["chart"] = json.dumps(pages.law_curves(lot.pop("curves"), intervals),
+                                  allow_nan=False)
     try:
         predictions: Any = prediction_record(root)
         problem = None

@@ -84,9 +84,14 @@
     document.querySelectorAll(".multi-chart").forEach((el) => {
       const d = data(el.nextElementSibling);
       if (!d || !d.x.length) return;
-      const lines = d.y.map((values, k) => ({ label: d.names[k], values: values,
-        colour: PALETTE[k % PALETTE.length],
-        dash: d.names[k].startsWith("corridor") ? [6, 4] : undefined }));
+      let colour = -1;  // a line's points (a law's nodes) share its colour
+      const lines = d.y.map((values, k) => {
+        const points = d.names[k].includes(" nodes, ");
+        if (!points) colour += 1;
+        return { label: d.names[k], values: values, points: points,
+          colour: PALETTE[colour % PALETTE.length],
+          dash: d.names[k].startsWith("corridor") ? [6, 4] : undefined };
+      });
       chart(el, d.x, lines, el.dataset.x, el.dataset.y, false, false);
     });
   }
