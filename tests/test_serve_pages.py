@@ -342,3 +342,38 @@ def test_the_listing_is_read_once_and_again_when_the_archive_changes(lab, tmp_pa
     assert all(a is b for a, b in zip(first.rows, second.rows[:3], strict=False))  # kept
     monkeypatch.setattr(listing, "FRESH", 0.0)
     assert view.snapshot() is not second
+
+
+def test_an_entry_folder_that_links_out_of_the_archive_is_never_read(lab, tmp_path):
+    """An index row whose shot folder is a link to a copy of an entry outside the archive
+    (its peak made 123.456 kG): the listing names the link and shows no figure of it, its
+    page is refused as show refuses it, and nothing of the outside entry reaches a page."""
+    import sqlite3
+
+    root = tmp_path / "copy"
+    shutil.copytree(lab, root, symlinks=True)
+    outside = tmp_path / "outside" / "v0001"
+    shutil.copytree(lab / "shot3" / "v0001", outside)
+    summary = json.loads((outside / "summary.json").read_text())
+    (outside / "summary.json").write_text(json.dumps({**summary, "peak_kg": 123.456}))
+    (root / "linked").symlink_to(outside.parent, target_is_directory=True)
+    with sqlite3.connect(root / "index.sqlite") as conn:
+        row = conn.execute("SELECT * FROM entries WHERE id = 3").fetchone()
+        conn.execute("INSERT INTO entries VALUES (?, 'linked', 1, 'linked/v0001', ?, ?, ?, ?, "
+                     "?, ?, ?, ?, ?, ?, ?)", (9, *row[4:]))
+    process, url = start(root)
+    try:
+        rows = {r["shot"]: r for r in csv.DictReader(io.StringIO(
+            get(f"{url}/shots.csv")[2].decode()))}
+        said = rows["linked"]["crush law"]
+        assert said.startswith("unreadable: linked@1: ") and said.endswith(
+            f"{root / 'linked'} is a link to {outside.parent}, expected the entry's own folder "
+            "inside the archive (not followed; see airgun-xl archive verify)")
+        assert rows["linked"]["pulse duration [ms]"] == ""
+        status, _h, body = get(f"{url}/shot/9")
+        assert status == 404 and b"linked is a link to" in body
+        for path in ("/shots", "/shots.csv", "/shot/9", "/compare?id=9&id=1", "/laws"):
+            assert b"123.456" not in get(url + path)[2], path
+    finally:
+        process.send_signal(signal.SIGINT)
+        process.wait(timeout=20)
