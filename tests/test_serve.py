@@ -219,6 +219,14 @@ def test_a_server_archive_is_browsed_as_an_sqlite_one(tmp_path, server_env, brow
         with watched(browser, url) as page:
             page.goto(f"{url}/shots?sort=v0")
             assert [r[2] for r in _rows(page)] == ["shared_230", "shared_243.5"]
+            page.fill("input[name=v0_min]", "240")  # filtered, and kept by the URL
+            page.click("#filters button")
+            page.goto(page.url)
+            assert [r[2] for r in _rows(page)] == ["shared_243.5"]
+            table = list(csv.reader(io.StringIO(page.request.get(
+                url + page.get_attribute("#csv", "href")).text())))
+            assert [r[1] for r in table[1:]] == ["shared_243.5"]
+            page.goto(f"{url}/shots?sort=v0")
             page.click("#shots tbody tr:first-child td.shot a")
             page.wait_for_selector("#pulse[data-drawn]")
             assert page.text_content("#entry").startswith("shared_230@1")
