@@ -177,6 +177,26 @@ def server_env(pg_server, monkeypatch):
     return pg_server
 
 
+@pytest.fixture(scope="module")
+def browser():
+    """Debian's Chromium under Playwright, for a module's browser tests (tests/serve_helpers.py);
+    skipped without it."""
+    from serve_helpers import chromium
+
+    with chromium() as launched:
+        yield launched
+
+
+@pytest.fixture
+def page(browser, server):
+    """A fresh page on the module's ``server`` fixture that fails the test on any page error
+    or any request to another address."""
+    from serve_helpers import watched
+
+    with watched(browser, server) as page:
+        yield page
+
+
 def pytest_collection_modifyitems(config, items):
     for item in items:
         if (item.module.__name__.rsplit(".", 1)[-1] in SLOW_MODULES

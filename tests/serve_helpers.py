@@ -25,6 +25,19 @@ def start(root, *extra):
     return process, line.split(" at ", 1)[1].split(" ", 1)[0].rstrip("/")
 
 
+@contextlib.contextmanager
+def serving(root):
+    """A server on ``root`` for the block: its base URL; stopped by Ctrl-C (SIGINT) after."""
+    import signal
+
+    process, url = start(root)
+    try:
+        yield url
+    finally:
+        process.send_signal(signal.SIGINT)
+        process.wait(timeout=20)
+
+
 def get(url, method="GET", headers=None):
     """(status, headers, body) of one request."""
     request = urllib.request.Request(url, method=method, headers=headers or {})

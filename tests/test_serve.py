@@ -21,7 +21,7 @@ import sys
 import openpyxl
 import pytest
 from conftest import TEMPLATE
-from serve_helpers import chromium, get, screenshot, start, watched
+from serve_helpers import get, screenshot, serving, start, watched
 
 from airgun_xl.cli import main
 
@@ -57,10 +57,8 @@ def archive(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def server(archive):
-    process, url = start(archive)
-    yield url
-    process.send_signal(signal.SIGINT)
-    process.wait(timeout=20)
+    with serving(archive) as url:
+        yield url
 
 
 def test_only_get_from_this_machine_and_nothing_outside_the_archive(server):
@@ -88,18 +86,6 @@ def test_a_port_in_use_is_one_line_and_ctrl_c_stops_the_server(archive, server, 
     process.send_signal(signal.SIGINT)
     process.wait(timeout=20)
     assert "Traceback" not in process.stderr.read()
-
-
-@pytest.fixture(scope="module")
-def browser():
-    with chromium() as launched:
-        yield launched
-
-
-@pytest.fixture
-def page(browser, server):
-    with watched(browser, server) as page:
-        yield page
 
 
 def _rows(page):

@@ -18,11 +18,10 @@ import csv
 import io
 import json
 import shutil
-import signal
 
 import pytest
 from conftest import TEMPLATE, write_trace_csv
-from serve_helpers import chromium, get, screenshot, start, watched
+from serve_helpers import get, screenshot, serving
 
 import airgun_xl
 from airgun_xl.app.archive import shown_figure
@@ -94,22 +93,8 @@ def lab(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def server(lab):
-    process, url = start(lab)
-    yield url
-    process.send_signal(signal.SIGINT)
-    process.wait(timeout=20)
-
-
-@pytest.fixture(scope="module")
-def browser():
-    with chromium() as launched:
-        yield launched
-
-
-@pytest.fixture
-def page(browser, server):
-    with watched(browser, server) as page:
-        yield page
+    with serving(lab) as url:
+        yield url
 
 
 def _summary(lab, shot):
@@ -361,8 +346,7 @@ def test_an_entry_folder_that_links_out_of_the_archive_is_never_read(lab, tmp_pa
         row = conn.execute("SELECT * FROM entries WHERE id = 3").fetchone()
         conn.execute("INSERT INTO entries VALUES (?, 'linked', 1, 'linked/v0001', ?, ?, ?, ?, "
                      "?, ?, ?, ?, ?, ?, ?)", (9, *row[4:]))
-    process, url = start(root)
-    try:
+    with serving(root) as url:
         rows = {r["shot"]: r for r in csv.DictReader(io.StringIO(
             get(f"{url}/shots.csv")[2].decode()))}
         said = rows["linked"]["crush law"]
@@ -374,6 +358,3 @@ def test_an_entry_folder_that_links_out_of_the_archive_is_never_read(lab, tmp_pa
         assert status == 404 and b"linked is a link to" in body
         for path in ("/shots", "/shots.csv", "/shot/9", "/compare?id=9&id=1", "/laws"):
             assert b"123.456" not in get(url + path)[2], path
-    finally:
-        process.send_signal(signal.SIGINT)
-        process.wait(timeout=20)
