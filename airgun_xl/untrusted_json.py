@@ -74,7 +74,8 @@ SCHEMAS: dict[str, dict] = {
     "verdict": {
         "type": "object", "required": ["shot", "verdict", "criteria"],
         "description": "a verdict record",
-        "properties": {"shot": _TEXT, "verdict": {"enum": ["PASS", "FAIL"]},
+        "properties": {"shot": _TEXT, "shot_sha256": {"type": ["string", "null"]},
+                       "verdict": {"enum": ["PASS", "FAIL"]},
                        "criteria": {"type": "array", "items": _CRITERION},
                        "tolerances": _TEXTS, "definitions": _TEXTS, "specification": _TEXT,
                        "notes": _TEXTS, "warnings": _TEXTS, "recording": _TEXT,

@@ -190,10 +190,12 @@ def test_accept_json_escapes_what_the_files_say(tmp_path, recording, capsys):
 
 
 def test_an_archived_verdict_keeps_the_record_it_judged_and_its_corridor(tmp_path, recording):
-    """The verdict record keeps the record judged (here 1,076 samples: whole) and the
+    """The verdict record keeps the judged workbook's SHA-256 (an archive's entry of that
+    workbook is the verdict's run), the record judged (here 1,076 samples: whole) and the
     corridor's limits at its times inside the window monitored, each to 6 significant digits
     (the drawing's precision; the criteria keep full precision), read back by the archive's
     bounded reader (``serve`` draws them on a shot's page)."""
+    import hashlib
     import json
 
     from airgun_xl.studies.acceptance import corridor_limits
@@ -202,6 +204,7 @@ def test_an_archived_verdict_keeps_the_record_it_judged_and_its_corridor(tmp_pat
                          duration="11ms:10%", cfc="none", archive=tmp_path / "arch",
                          output=tmp_path / "verdict.xlsx")
     record = json.loads(v.archived.read_text())
+    assert record["shot_sha256"] == hashlib.sha256(TEMPLATE.read_bytes()).hexdigest()
     trace = record["trace"]
     t, kg = v.verdict.record
     assert trace["samples"] == len(t) == 1076 and trace["thinned"] == "whole"

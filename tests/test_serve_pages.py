@@ -5,9 +5,10 @@ The lab: shot A filled into the archive (shot1, the report's law), fired on a lo
 than the report's law and put through ``next`` (its verdict FAIL, law LOT-A@1, a proposal);
 the proposed workbook filled with LOT-A@1 (shot1.next), fired and put through ``next`` (PASS,
 LOT-A@2); the second proposal filled with LOT-A@2 (shot3), fired and judged by ``accept`` with
-a half-sine's corridor. Beside them, records as a hostile
-hand would leave them: a law whose fields are a script, a verdict of shot3 whose criterion is
-one, and a law folder that is a link to a folder outside the archive.
+a half-sine's corridor. Beside them, records as a hostile hand would leave them: a law whose
+fields are a script, a verdict of shot3 whose criterion is one (and no workbook's SHA-256, as
+an older record), a verdict of another workbook named shot3, and a law folder that is a link
+to a folder outside the archive.
 
 What is checked against the archive's own records (read here with the tool's readers): every
 point of the scatter, every row a filter keeps, every input a compare lists as differing, every
@@ -84,10 +85,14 @@ def lab(tmp_path_factory):
     (root / ".laws" / "LINKED").symlink_to(outside, target_is_directory=True)
     verdict = json.loads((root / ".verdicts" / "shot1" / "v0001.json").read_text())
     (root / ".verdicts" / "shot3" / "v0002.json").write_text(json.dumps(
-        {**verdict, "shot": "shot3", "criteria": [{**verdict["criteria"][0],
-                                                   "name": HOSTILE}],
+        {**verdict, "shot": "shot3", "shot_sha256": None,  # as a record before they kept it
+         "criteria": [{**verdict["criteria"][0], "name": HOSTILE}],
          "trace": {"time_ms": [HOSTILE, 0.1, 0.2], "kg": [1.0, HOSTILE, 3.0], "onset_ms": None,
                    "upper_kg": None, "lower_kg": None, "samples": 3, "thinned": HOSTILE}}))
+    # a verdict of another workbook named shot3 (another version's): not shot3@1's
+    (root / ".verdicts" / "shot3" / "v0003.json").write_text(json.dumps(
+        {**verdict, "shot": "shot3", "shot_sha256": "0" * 64, "verdict": "PASS",
+         "criteria": [{**verdict["criteria"][0], "name": "ANOTHER-WORKBOOK"}]}))
     return root
 
 
@@ -129,6 +134,10 @@ def test_filters_by_lot_verdict_and_any_input_a_limit_within(server, lab):
     # an input the index does not hold (read from each params.json): E43, zeta, 0.02 in all
     assert shots("input=E43&input_min=0.02&input_max=0.02") == ["shot1", "shot1.next", "shot3"]
     assert shots("input=E43&input_max=0.019") == []
+    # a limit given in full is kept in full by the page's own links (sort, pages, CSV)
+    status, _h, body = get(f"{server}/shots?input=A28&input_min={v3!r}")
+    assert status == 200 and f"input_min={v3!r}".encode() in body
+    assert b"input_min=228.943&" not in body and b"input_min=228.943\"" not in body
     rows = _csv(server, "lot=LOT-A")
     assert [r["lot"] for r in rows] == ["LOT-A", "LOT-A"]
     assert [r["recorded verdict"] for r in rows] == ["PASS", "FAIL"]
@@ -288,6 +297,12 @@ def test_a_shots_page_lists_its_verdicts_and_draws_the_peaks_limits(page, server
     screenshot(page, "serve-verdict")
     assert page.evaluate("window.pwned") is None
     assert page.text_content("#recorded-criteria-2 tr:nth-child(2) td") == HOSTILE
+    # the first verdict is of this very workbook; the second was matched by name, and says
+    # so; the third, of another workbook of that name, is not this run's
+    said = page.locator("h3.recorded").all_text_contents()
+    assert [t.split(":")[0] for t in said] == ["Recorded verdict 1", "Recorded verdict 2"]
+    assert page.locator("p.by-name").count() == 1
+    assert "ANOTHER-WORKBOOK" not in page.content()
     assert page.get_attribute("#verdict-chart-1", "data-series") == "4"
     trace = json.loads((lab / ".verdicts" / "shot3" / "v0001.json").read_text())["trace"]
     drawn = json.loads(page.locator("#verdict-chart-1 + script").text_content())

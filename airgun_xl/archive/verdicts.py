@@ -86,7 +86,9 @@ def verdict_record(verdict, shot, recording, report, command=()):
         digest = hashlib.sha256(data.read_bytes()).hexdigest() if data.is_file() else None
     except OSError:
         digest = None
-    return {"shot": shot_name(shot), "verdict": verdict.word,
+    return {"shot": shot_name(shot),
+            "shot_sha256": shot.source.sha256 if shot.source is not None else None,
+            "verdict": verdict.word,
             "criteria": [{k: _plain(v) for k, v in dataclasses.asdict(c).items()}
                          for c in verdict.criteria],
             "tolerances": verdict.tolerances(), "definitions": verdict.definitions,
@@ -132,15 +134,21 @@ class StoredVerdict:
 
 
 def list_verdicts(root):
-    """Every stored verdict: ``[{"shot", "version", "verdict", "created", "recording"}]``."""
+    """Every stored verdict: ``[{"shot", "version", "verdict", "created", "recording",
+    "shot_sha256", "folder"}]`` (``shot_sha256``: the judged workbook's, None in a record
+    from before it was kept; ``folder``: the record's folder, its shot's archive name)."""
     out: list[dict] = []
     for folder, version, path in all_versions(Path(root) / VERDICTS):
         try:
             record = read_record(root, path, "verdict")
+            digest = record.get("shot_sha256")
             out.append({"shot": record["shot"], "version": version,
                         "verdict": record["verdict"], "created": record.get("created", ""),
-                        "recording": record.get("recording", "")})
+                        "recording": record.get("recording", ""),
+                        "shot_sha256": digest if isinstance(digest, str) else None,
+                        "folder": folder.name})
         except ArchiveError as exc:  # listed and named, not fatal (as a law)
             out.append({"shot": folder.name, "version": version, "verdict": "?",
-                        "created": f"unreadable: {exc}", "recording": display(path)})
+                        "created": f"unreadable: {exc}", "recording": display(path),
+                        "shot_sha256": None, "folder": folder.name})
     return out

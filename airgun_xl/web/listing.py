@@ -75,7 +75,8 @@ class Snapshot:
     lots : list of str
         The lots named by the entries' laws or by a chain.
     verdicts : dict
-        Each shot's recorded verdicts (``list_verdicts``' rows), by the shot's archive name.
+        Each shot's recorded verdicts (``list_verdicts``' rows), by the shot's archive name
+        (:meth:`verdicts_of` gives an entry's own).
     """
 
     index_rows: list[dict[str, Any]]
@@ -84,6 +85,16 @@ class Snapshot:
     bad: list[str]
     lots: list[str]
     verdicts: dict[str, list[dict[str, Any]]]
+
+    def verdicts_of(self, entry: Any) -> list[dict[str, Any]]:
+        """The verdicts recorded for ``entry``'s run: those of its very workbook (the same
+        SHA-256 as the entry's input), and from records that kept no workbook's SHA-256 those
+        of its shot's name, each marked ``by_name``. A verdict of another workbook of the
+        same name (another version) is not this entry's."""
+        digest = entry.row.get("input_sha256")
+        return [{**v, "by_name": v["shot_sha256"] is None}
+                for v in self.verdicts.get(entry.shot, [])
+                if v["shot_sha256"] is None or v["shot_sha256"] == digest]
 
     def with_inputs(self, cell: str) -> None:
         """Make sure every row holds the input ``cell``, reading params.json where needed."""
@@ -144,15 +155,15 @@ class Listing:
 
     def _read(self) -> Snapshot:
         from ..archive.lots import lot_names
-        from ..archive.store import safe_name
         from ..archive.verdicts import list_verdicts
 
         bad: list[str] = []
         index_rows = self.archive.index.rows(bad=bad)
         verdicts: dict[str, list[dict[str, Any]]] = {}
         for v in list_verdicts(self.archive.root):
-            verdicts.setdefault(safe_name(str(v["shot"])), []).append(v)
-        entries, rows, kept = {}, [], {}
+            verdicts.setdefault(str(v["folder"]), []).append(v)
+        snapshot = Snapshot(index_rows, {}, [], bad, [], verdicts)
+        entries, rows, kept = snapshot.entries, snapshot.rows, {}
         for r in index_rows:
             e = self.archive.entry_of(r)
             if e is None:
@@ -163,12 +174,13 @@ class Listing:
             row = self._rows.get(key) or entry_row(e)
             kept[key] = row
             entries[e.id] = e
-            stored = verdicts.get(e.shot)
+            stored = snapshot.verdicts_of(e)
             row["verdict"] = str(stored[-1]["verdict"]) if stored else None
             rows.append(row)
         self._rows = kept  # rows of entries gone from the index are dropped
-        lots = sorted({r["lot"] for r in rows if r["lot"]} | set(lot_names(self.archive.root)))
-        return Snapshot(index_rows, entries, rows, bad, lots, verdicts)
+        snapshot.lots.extend(sorted({r["lot"] for r in rows if r["lot"]}
+                                    | set(lot_names(self.archive.root))))
+        return snapshot
 
 
 def indexed_cells() -> dict[str, str]:

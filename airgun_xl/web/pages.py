@@ -104,8 +104,8 @@ def url(path: str, f: dict[str, Any], **changes: Any) -> str:
         value = merged.get(key)
         if value is None or value is False or value == "":
             continue
-        pairs.append((key, "1" if value is True else f"{value:g}" if isinstance(value, float)
-                      else str(value)))
+        pairs.append((key, "1" if value is True else repr(value) if isinstance(value, float)
+                      else str(value)))  # a float in full: a link keeps the limit given
     return path + ("?" + urlencode(pairs) if pairs else "")
 
 

@@ -163,7 +163,7 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
         t, a = pages.thinned(time, accel)
         recorded = []
         start = pages.finite(summary.get("pulse_start"), 1e3)
-        for v in snapshot.verdicts.get(snapshot.entries[ident].shot, []):
+        for v in snapshot.verdicts_of(snapshot.entries[ident]):
             shown = _verdict(found.root, v)
             chart = pages.verdict_chart((t, a), shown.pop("trace", None), start)
             shown["chart"] = chart and {**chart, "json": json.dumps(chart, allow_nan=False)}
@@ -226,15 +226,16 @@ def _verdict(root: Path, listed: dict[str, Any]) -> dict[str, Any]:
     from ..archive.verdicts import VERDICTS
     from ..errors import ArchiveError
 
-    path = (root / VERDICTS / safe_name(str(listed["shot"]))
+    path = (root / VERDICTS / safe_name(str(listed["folder"]))
             / f"v{int(listed['version']):04d}.json")
     try:
         record = read_record(root, path, "verdict")
     except ArchiveError as exc:
         return {"version": listed["version"], "verdict": "?", "problem": str(exc),
-                "criteria": []}
+                "criteria": [], "by_name": listed["by_name"]}
     criteria = record.get("criteria") if isinstance(record, dict) else None
     return {"version": listed["version"], "verdict": str(record.get("verdict")),
+            "by_name": listed["by_name"],
             "created": str(record.get("created", "")), "problem": None,
             "specification": str(record.get("specification", "")),
             "recording": str(record.get("recording", "")),
