@@ -86,14 +86,17 @@ class AcceptOutcome:
     def to_json(self) -> str:
         """The outcome as one JSON document (``accept --json``, for a LIMS): the archive's
         record of the verdict (criteria with value, limits and margin in their unit, the
-        tolerances, definitions, warnings, the recording and what it said of itself), the
-        equivalent half-sine, and the files written. A value that is not finite is null; the
-        text is ASCII, a file's control characters escaped (never sent to a terminal)."""
+        tolerances, definitions, warnings, the workbook's SHA-256, the recording and what it
+        said of itself; not the trace of the record judged, which the archive keeps to draw
+        it), the equivalent half-sine, and the files written. A value that is not finite is
+        null; the text is ASCII, a file's control characters escaped (never sent to a
+        terminal)."""
         def finite(value: float) -> float | None:
             return value if math.isfinite(value) else None
 
         peak, duration = self.equivalent_half_sine
-        document = {**self.record, "passed": self.passed,
+        document = {**{k: v for k, v in self.record.items() if k != "trace"},
+                    "passed": self.passed,
                     "equivalent_half_sine": {"peak_kG": finite(peak),
                                              "duration_s": finite(duration)},
                     "peak_pseudo_velocity_m_s": finite(self.peak_pseudo_velocity),
