@@ -97,6 +97,9 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
     label = found.root.name
     known_cells = pages.cells()
 
+    # The pages are plain functions: Starlette runs each in its thread pool, so a page that
+    # reads an entry from the disk does not hold another's request (the listing is shared
+    # under its lock).
     def page(request: Request, name: str, context: dict[str, Any], status: int = 200) -> Any:
         return templates.TemplateResponse(request, name, {"archive": label, **context},
                                           status_code=status)
@@ -104,7 +107,7 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
     def missing(request: Request, message: str) -> Any:
         return page(request, "missing.html", {"message": message}, 404)
 
-    async def shots(request: Request) -> Response:
+    def shots(request: Request) -> Response:
         snapshot = listing.snapshot()
         f = pages.filters(request.query_params)
         for cell in {f["x"], f["input"]} - {""}:
@@ -124,7 +127,7 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
             "total": len(snapshot.rows),
             "scatter": json.dumps(pages.scatter(rows, f), allow_nan=False)})
 
-    async def shots_csv(request: Request) -> Response:
+    def shots_csv(request: Request) -> Response:
         snapshot = listing.snapshot()
         f = pages.filters(request.query_params)
         if f["input"]:
@@ -149,7 +152,7 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
         outcome = show_entry(found, entry, snapshot.index_rows)
         return outcome.doc, predicted_pulse(entry)
 
-    async def shot(request: Request) -> Response:
+    def shot(request: Request) -> Response:
         snapshot = listing.snapshot()
         ident = request.path_params["ident"]
         try:
@@ -177,7 +180,7 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
                                  "band": [band["low"], band["high"]] if band else None},
                                 allow_nan=False)})
 
-    async def compare(request: Request) -> Response:
+    def compare(request: Request) -> Response:
         snapshot = listing.snapshot()
         ids = pages.compared_ids(request.query_params)
         docs, pulses, refused = [], [], []
@@ -202,7 +205,7 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
             "pulses": json.dumps({**drawn, "names": [d["entry"] for d in docs]},
                                  allow_nan=False)})
 
-    async def laws(request: Request) -> Response:
+    def laws(request: Request) -> Response:
         snapshot = listing.snapshot()
         return page(request, "laws.html", _laws(found.root, snapshot, pages))
 
