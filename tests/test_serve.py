@@ -23,7 +23,9 @@ import pytest
 from conftest import TEMPLATE
 from serve_helpers import get, screenshot, serving, start, watched
 
+from airgun_xl.archive.laws import store_law
 from airgun_xl.cli import main
+from airgun_xl.crush_law import LEGACY_LAW
 
 pytest.importorskip("starlette")
 pytest.importorskip("uvicorn")
@@ -222,6 +224,10 @@ def test_a_server_archive_is_browsed_as_an_sqlite_one(tmp_path, server_env, brow
             assert page.get_attribute("#overlay", "data-series") == "2"
             page.goto(f"{url}/laws")
             assert page.text_content("#no-laws").startswith("No crush law")
+            store_law(root, "LOT-S", LEGACY_LAW.scaled(1.1), [], [])  # listed at once
+            page.goto(f"{url}/laws")
+            page.wait_for_selector(".law-chart[data-drawn]")
+            assert page.text_content("section.lot h2") == "LOT-S"
     finally:
         process.send_signal(signal.SIGINT)
         process.wait(timeout=20)
