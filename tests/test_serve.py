@@ -75,7 +75,17 @@ def test_only_get_from_this_machine_and_nothing_outside_the_archive(server):
                  "/static/../../index.sqlite", "/index.sqlite"):
         status, _h, body = get(server + path)
         assert status == 404 and b"SQLite" not in body, path
-    assert HOSTILE.encode() not in body
+    # the hostile row's name never reaches a page as markup; a compare names its refusal
+    for path in ("/shots", "/shot/3", "/compare?id=1&id=3", "/laws", "/shots?shot=%3Cscript"):
+        status, _h, body = get(server + path)
+        assert status in (200, 404) and b"<script>window.pwned" not in body, path
+    body = get(f"{server}/compare?id=1&id=3")[2].decode()
+    said = "row #3: it says =HYPERLINK(&#34;http://x&#34;)&lt;script&gt;"
+    assert 'id="refused"' in body and said in body
+    # an id that is not a number is no entry (nothing is looked up by it)
+    for query in ("id=..%2F..%2Findex.sqlite", "id=1e400", "id=-1", "id=nan"):
+        body = get(f"{server}/compare?{query}")[2].decode()
+        assert 'id="empty"' in body, query
 
 
 def test_a_port_in_use_is_one_line_and_ctrl_c_stops_the_server(archive, server, capsys):
