@@ -22,7 +22,20 @@ def start(root, *extra):
          *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     line = process.stdout.readline()
     assert line.startswith("serving "), (line, process.stderr.read())
-    return process, line.split(" at ", 1)[1].split(" ", 1)[0].rstrip("/")
+    url = line.split(" at ", 1)[1].split(" ", 1)[0].rstrip("/")
+    listed(url)
+    return process, url
+
+
+def listed(url, timeout=60.0):
+    """Wait until the server at ``url`` has read its listing and its runs' inputs (its pages
+    say 503 before): A2, an input the index does not hold, is what the poll asks for."""
+    import time
+
+    deadline = time.monotonic() + timeout
+    while get(f"{url}/shots.csv?input=A2")[0] == 503:
+        assert time.monotonic() < deadline, "the listing was not read in time"
+        time.sleep(0.02)  # a poll for a condition, not a wait for a guessed time
 
 
 @contextlib.contextmanager

@@ -373,3 +373,74 @@ def test_an_entry_folder_that_links_out_of_the_archive_is_never_read(lab, tmp_pa
         assert status == 404 and b"linked is a link to" in body
         for path in ("/shots", "/shots.csv", "/shot/9", "/compare?id=9&id=1", "/laws"):
             assert b"123.456" not in get(url + path)[2], path
+
+
+def test_while_the_first_listing_is_read_the_pages_say_how_far_and_a_shot_answers(
+        lab, monkeypatch):
+    """The server reads its listing in the background from its start; a page asked before
+    that ends answers at once, 503 with the progress and a reload (its CSV the same in
+    words), and a shot's page answers from the index alone. Held open here by an event at
+    the second entry, so the test sees the middle of the read, whatever the machine."""
+    import threading
+
+    import uvicorn
+
+    from airgun_xl.web import listing
+    from airgun_xl.web import server as web
+
+    gate, reached = threading.Event(), threading.Event()
+    inputs_gate, inputs_reached = threading.Event(), threading.Event()
+    real, real_inputs = listing.entry_row, listing.with_inputs
+
+    def held(entry):
+        if entry.id == 2:
+            reached.set()
+            assert gate.wait(60)
+        return real(entry)
+
+    def inputs_held(row, entry):
+        if entry.id == 2:
+            inputs_reached.set()
+            assert inputs_gate.wait(60)
+        return real_inputs(row, entry)
+
+    monkeypatch.setattr(listing, "entry_row", held)
+    monkeypatch.setattr(listing, "with_inputs", inputs_held)
+    app = web.build_app(lab)  # its listing's read starts here
+    sock = web.listen("127.0.0.1", 0)
+    server = uvicorn.Server(uvicorn.Config(app, log_level="critical", lifespan="off"))
+    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
+    thread.start()
+    url = f"http://127.0.0.1:{sock.getsockname()[1]}"
+    try:
+        assert reached.wait(60)
+        while not server.started:  # a poll for uvicorn's own flag
+            thread.join(0.01)
+        status, headers, body = get(f"{url}/shots")
+        assert status == 503 and b'http-equiv="refresh" content="1"' in body
+        assert b"1 of 3 so far" in body
+        status, _h, body = get(f"{url}/shots.csv")
+        assert status == 503 and body == b"reading the archive's runs (1 of 3): try again in a " \
+                                          b"second\n"
+        status, _h, body = get(f"{url}/shot/1")
+        assert status == 200 and b"shot1@1" in body
+        gate.set()
+        app.state.listing.snapshot()  # waits for the read to end
+        status, _h, body = get(f"{url}/shots")
+        assert status == 200 and b"3 of 3 runs" in body
+        # then the inputs the index does not hold: a page drawing by one says how far
+        assert inputs_reached.wait(60)
+        status, _h, body = get(f"{url}/shots?x=E43")
+        assert status == 503 and b"reading the archive&#39;s runs&#39; inputs: 1 of 3" in body
+        assert get(f"{url}/shots?x=E2")[0] == 200  # an input the index holds: at once
+        inputs_gate.set()
+        while app.state.listing.inputs_progress is not None:  # a poll for the read's end
+            thread.join(0.01)
+        status, _h, body = get(f"{url}/shots?x=E43")
+        assert status == 200 and b"3 of 3 runs" in body
+    finally:
+        gate.set()
+        inputs_gate.set()
+        server.should_exit = True
+        thread.join(30)
+        sock.close()

@@ -10,17 +10,21 @@ index holds the same row for it. What is read afresh:
   stamp);
 - a shot's page, every time: its entry checked whole as ``show`` checks it.
 
-The first listing reads every entry (about 0.5 ms each); the server starts it in the background
-as soon as it is built (:meth:`Listing.warm`), so the shots page is ready when the browser is.
+The first listing reads every entry's summary and provenance (about 0.5 ms each), then every
+entry's inputs; the server does both in the background from its start, between requests
+(:meth:`Listing.warm`), and a page that needs what is still being read says how far the read
+is (503, and a reload each second) instead of waiting.
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import os
 import re
 import threading
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +43,12 @@ FIGURES = (("peak_kg", "peak", "kG", 1.0), ("filtered_peak_kg", "filtered peak",
            ("obr_exit_velocity", "OBR exit velocity", "m/s", 1.0),
            ("mem_final_velocity", "MEM final velocity", "m/s", 1.0),
            ("warning_count", "warnings", "", 1.0))
+
+
+def _now() -> str:
+    import datetime
+
+    return datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")
 
 
 def read_only(root: str | Path) -> Any:
@@ -85,6 +95,7 @@ class Snapshot:
     bad: list[str]
     lots: list[str]
     verdicts: dict[str, list[dict[str, Any]]]
+    taken: str = ""  # when it was read: UTC, to the second
 
     def verdicts_of(self, entry: Any) -> list[dict[str, Any]]:
         """The verdicts recorded for ``entry``'s run: those of its very workbook (the same
@@ -109,21 +120,71 @@ class Listing:
 
     def __init__(self, archive: Any) -> None:
         self.archive = archive
-        self._lock = threading.Lock()
+        self._lock = threading.Lock()  # one reader of the listing at a time
+        self._index = threading.Lock()  # the index's connection is one: one user at a time
         self._snapshot: Snapshot | None = None
         self._stamp: Any = None
         self._taken = 0.0
         self._rows: dict[tuple[Any, ...], dict[str, Any]] = {}  # by the index row's key
+        #: While a listing is read: (entries read, entries in all); None otherwise.
+        self.progress: tuple[int, int] | None = None
+        #: While :meth:`warm` reads the inputs the index does not hold: (entries read, in
+        #: all); None otherwise.
+        self.inputs_progress: tuple[int, int] | None = None
+        self._in_flight = 0  # requests being answered: the background read waits for them
+        self._counted = threading.Lock()
+        self._idle = threading.Event()
+        self._idle.set()
+
+    @contextlib.contextmanager
+    def request(self) -> Iterator[None]:
+        """Around a request's work: while any is answered, the background read of
+        :meth:`warm` waits between entries, so a page asked meanwhile has the machine."""
+        with self._counted:
+            self._in_flight += 1
+            self._idle.clear()
+        try:
+            yield
+        finally:
+            with self._counted:
+                self._in_flight -= 1
+                if not self._in_flight:
+                    self._idle.set()
 
     def warm(self) -> None:
-        """Read the listing in a background thread (a failure is met again on first use)."""
+        """Read the listing in a background thread, holding the listing's lock from now on
+        (a page asked meanwhile says how far the read is), after importing what a shot's page
+        reads its history with; a failure is met again on first use."""
+        self._lock.acquire()
+
         def run() -> None:
+            snapshot = None
             try:
-                self.snapshot()
+                import pandas  # noqa: F401 - a shot's page reads its history with them: the
+                import pyarrow.parquet  # noqa: F401 - first one need not wait for the imports
+
+                snapshot = self._refresh(background=True)
+                self.inputs_progress = (0, len(snapshot.rows))  # before a page can ask
             except Exception:  # noqa: BLE001, S110 - the request that needs it says why
                 pass
+            finally:
+                self.progress = None
+                self._lock.release()
+            if snapshot is not None:
+                self._all_inputs(snapshot)
 
         threading.Thread(target=run, name="airgun-xl-listing", daemon=True).start()
+
+    def _all_inputs(self, snapshot: Snapshot) -> None:
+        """Read every row's inputs the index does not hold, between requests
+        (:attr:`inputs_progress` says how far); a page that needs one meanwhile says so."""
+        try:
+            for k, row in enumerate(snapshot.rows):
+                self.inputs_progress = (k, len(snapshot.rows))
+                self._idle.wait()
+                with_inputs(row, snapshot.entries[row["id"]])
+        finally:
+            self.inputs_progress = None
 
     def stamp(self) -> tuple[Any, ...]:
         """What changes when the archive's listing does: the index's stamp, and the times of
@@ -139,32 +200,64 @@ class Listing:
                                       for e in found)
             except OSError:
                 folders.append((hidden, None))
-        return (self.archive.index.stamp(), tuple(folders))
+        with self._index:
+            return (self.archive.index.stamp(), tuple(folders))
 
-    def snapshot(self) -> Snapshot:
+    def snapshot(self, wait: bool = True) -> Snapshot | None:
         """The listing now: kept while :meth:`stamp` is unchanged, for at most :data:`FRESH`
-        seconds."""
-        with self._lock:
-            stamp = self.stamp()
-            if (self._snapshot is not None and stamp == self._stamp
-                    and time.monotonic() - self._taken < FRESH):
-                return self._snapshot
-            self._snapshot = self._read()
-            self._stamp, self._taken = stamp, time.monotonic()
+        seconds. Without ``wait``, while another reads it: the one before (its ``taken`` says
+        when), or None before the first (:attr:`progress` says how far)."""
+        if not self._lock.acquire(blocking=wait):
             return self._snapshot
+        try:
+            return self._refresh()
+        finally:
+            self.progress = None
+            self._lock.release()
 
-    def _read(self) -> Snapshot:
+    def _refresh(self, background: bool = False) -> Snapshot:
+        """The listing, read again if :meth:`stamp` changed or it is :data:`FRESH` seconds
+        old; the caller holds the lock. ``background``: read between requests only
+        (:meth:`request`)."""
+        stamp = self.stamp()
+        if (self._snapshot is not None and stamp == self._stamp
+                and time.monotonic() - self._taken < FRESH):
+            return self._snapshot
+        self._snapshot = self._read(background)
+        self._stamp, self._taken = stamp, time.monotonic()
+        return self._snapshot
+
+    def one(self, ident: int) -> Snapshot:
+        """A listing of the entry ``ident`` alone (no entry's records read): the index's rows,
+        the entry, and the verdicts, for a shot's page while the whole listing is read."""
+        from ..archive.verdicts import list_verdicts
+
+        with self._index:
+            index_rows = self.archive.index.rows(bad=[])
+        found = [e for e in (self.archive.entry_of(r) for r in index_rows if r["id"] == ident)
+                 if e is not None]
+        verdicts: dict[str, list[dict[str, Any]]] = {}
+        for v in list_verdicts(self.archive.root):
+            verdicts.setdefault(str(v["folder"]), []).append(v)
+        return Snapshot(index_rows, {e.id: e for e in found}, [], [], [], verdicts, _now())
+
+    def _read(self, background: bool = False) -> Snapshot:
         from ..archive.lots import lot_names
         from ..archive.verdicts import list_verdicts
 
         bad: list[str] = []
-        index_rows = self.archive.index.rows(bad=bad)
+        with self._index:
+            index_rows = self.archive.index.rows(bad=bad)
+        self.progress = (0, len(index_rows))
         verdicts: dict[str, list[dict[str, Any]]] = {}
         for v in list_verdicts(self.archive.root):
             verdicts.setdefault(str(v["folder"]), []).append(v)
-        snapshot = Snapshot(index_rows, {}, [], bad, [], verdicts)
+        snapshot = Snapshot(index_rows, {}, [], bad, [], verdicts, _now())
         entries, rows, kept = snapshot.entries, snapshot.rows, {}
-        for r in index_rows:
+        for k, r in enumerate(index_rows):
+            self.progress = (k, len(index_rows))
+            if background:
+                self._idle.wait()
             e = self.archive.entry_of(r)
             if e is None:
                 bad.append(f"row #{r['id']}: its path {r['path']!r} is not SHOT/vNNNN, "

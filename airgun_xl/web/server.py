@@ -82,7 +82,7 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
     from ..app.archive import FIGURE_UNITS, predicted_pulse, show_entry, shown_figure
     from ..errors import AirgunXlError
     from . import pages
-    from .listing import FIGURES, Listing, read_only
+    from .listing import FIGURES, Listing, indexed_cells, read_only
 
     found = read_only(archive)
     listing = Listing(found)
@@ -107,11 +107,34 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
     def missing(request: Request, message: str) -> Any:
         return page(request, "missing.html", {"message": message}, 404)
 
-    def shots(request: Request) -> Response:
-        snapshot = listing.snapshot()
-        f = pages.filters(request.query_params)
-        for cell in {f["x"], f["input"]} - {""}:
+    def reading(request: Request, inputs: bool = False) -> Any:
+        """While the first listing (or, with ``inputs``, the runs' inputs the index does not
+        hold) is read: how far it is, 503 and a retry in a second (the page reloads itself:
+        a meta refresh, no script)."""
+        done, total = (listing.inputs_progress if inputs else listing.progress) or (0, 0)
+        what = "the archive's runs' inputs" if inputs else "the archive's runs"
+        return page(request, "reading.html", {"done": done, "total": total, "what": what},
+                    503) if request.url.path != "/shots.csv" else Response(
+                        f"reading {what} ({done:,} of {total:,}): try again in a second\n",
+                        503, media_type="text/plain")
+
+    def inputs_for(request: Request, snapshot: Any, cells: set[str]) -> Any:
+        """Every row's inputs ``cells`` read (None), or the page saying they are being read."""
+        needed = cells - {""} - set(indexed_cells())
+        if needed and listing.inputs_progress is not None:
+            return reading(request, inputs=True)
+        for cell in needed:
             snapshot.with_inputs(cell)
+        return None
+
+    def shots(request: Request) -> Response:
+        snapshot = listing.snapshot(wait=False)
+        if snapshot is None:
+            return reading(request)
+        f = pages.filters(request.query_params)
+        waiting = inputs_for(request, snapshot, {f["x"], f["input"]})
+        if waiting is not None:
+            return waiting
         rows = pages.selected(snapshot, f)
         count = len(rows)
         last = max(1, math.ceil(count / pages.PAGE))
@@ -124,14 +147,17 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
             "rows": shown, "columns": pages.COLUMNS, "count": count, "page": at,
             "pages": last, "f": f, "lots": snapshot.lots, "bad": snapshot.bad,
             "cells": known_cells, "figures": FIGURES, "colours": pages.COLOURS,
-            "total": len(snapshot.rows),
+            "total": len(snapshot.rows), "taken": snapshot.taken,
             "scatter": json.dumps(pages.scatter(rows, f), allow_nan=False)})
 
     def shots_csv(request: Request) -> Response:
-        snapshot = listing.snapshot()
+        snapshot = listing.snapshot(wait=False)
+        if snapshot is None:
+            return reading(request)
         f = pages.filters(request.query_params)
-        if f["input"]:
-            snapshot.with_inputs(f["input"])
+        waiting = inputs_for(request, snapshot, {f["input"]})
+        if waiting is not None:
+            return waiting
         rows = pages.selected(snapshot, f)
         out = io.StringIO()
         writer = csv.writer(out, lineterminator="\n")
@@ -153,8 +179,8 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
         return outcome.doc, predicted_pulse(entry)
 
     def shot(request: Request) -> Response:
-        snapshot = listing.snapshot()
         ident = request.path_params["ident"]
+        snapshot = listing.snapshot(wait=False) or listing.one(ident)
         try:
             doc, (time, accel) = entry_doc(snapshot, ident)
         except (AirgunXlError, LookupError) as exc:
@@ -181,7 +207,9 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
                                 allow_nan=False)})
 
     def compare(request: Request) -> Response:
-        snapshot = listing.snapshot()
+        snapshot = listing.snapshot(wait=False)
+        if snapshot is None:
+            return reading(request)
         ids = pages.compared_ids(request.query_params)
         docs, pulses, refused = [], [], []
         for ident in ids:
@@ -206,19 +234,30 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
                                  allow_nan=False)})
 
     def laws(request: Request) -> Response:
-        snapshot = listing.snapshot()
+        snapshot = listing.snapshot(wait=False)
+        if snapshot is None:
+            return reading(request)
         return page(request, "laws.html", _laws(found.root, snapshot, pages))
 
     async def home(_request: Request) -> Response:
         return RedirectResponse("/shots", 302)
 
-    routes = [Route("/", home), Route("/shots", shots), Route("/shots.csv", shots_csv),
-              Route("/shot/{ident:int}", shot), Route("/compare", compare),
-              Route("/laws", laws),
+    def counted(handler: Any) -> Any:
+        """``handler`` counted as a request in flight (:meth:`Listing.request`)."""
+        def answer(request: Request) -> Response:
+            with listing.request():
+                return handler(request)
+        return answer
+
+    routes = [Route("/", home), Route("/shots", counted(shots)),
+              Route("/shots.csv", counted(shots_csv)), Route("/shot/{ident:int}", counted(shot)),
+              Route("/compare", counted(compare)), Route("/laws", counted(laws)),
               Mount("/static", StaticFiles(directory=str(_HERE / "static")), name="static")]
     allowed = [h.strip("[]") if h.count(":") > 1 else h for h in (*LOOPBACK, *hosts)]
-    return Starlette(routes=routes, middleware=[
+    app = Starlette(routes=routes, middleware=[
         Middleware(Guard), Middleware(TrustedHostMiddleware, allowed_hosts=allowed)])
+    app.state.listing = listing
+    return app
 
 
 def _verdict(root: Path, listed: dict[str, Any]) -> dict[str, Any]:
