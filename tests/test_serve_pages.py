@@ -139,6 +139,8 @@ def test_filters_by_lot_verdict_and_any_input_a_limit_within(server, lab):
     assert status == 200 and f"input_min={v3!r}".encode() in body
     assert b"input_min=228.943&" not in body and b"input_min=228.943\"" not in body
     rows = _csv(server, "lot=LOT-A")
+    assert [r["warning texts"] for r in rows] == ["; ".join(_summary(lab, s)["warnings"])
+                                                  for s in ("shot1.next", "shot3")]
     assert [r["lot"] for r in rows] == ["LOT-A", "LOT-A"]
     assert [r["recorded verdict"] for r in rows] == ["PASS", "FAIL"]
 

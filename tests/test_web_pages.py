@@ -82,3 +82,16 @@ def test_a_value_exactly_on_a_limit_is_within_it():
                                      "input_max": v}) == rows
     assert pages.selected(snapshot, {**base, "v0_min": math.nextafter(v, 1e9)}) == []
     assert pages.selected(snapshot, {**base, "v0_max": math.nextafter(v, 0)}) == []
+
+
+def test_a_run_with_warnings_is_drawn_in_a_series_that_says_so():
+    """The scatter's runs with warnings, and those whose warnings were not recorded, are
+    series of their own, named so (a figure the tool cannot vouch for is flagged where it is
+    drawn); each run is drawn once."""
+    rows = [{"id": k, "lot": "L", "warning_count": count, "inputs": {"A28": 240.0 + k},
+             "figures": {"peak_kg": 9.0 + k}} for k, count in enumerate((0, 2, None, 0))]
+    f = {**pages.filters(QueryParams("")), "colour": "lot"}
+    drawn = pages.scatter(rows, f)
+    assert [(s["name"], s["points"]) for s in drawn["series"]] == [
+        ("L", 2), ("L (warnings not recorded)", 1), ("L (with warnings)", 1)]
+    assert sorted(drawn["ids"]) == [0, 1, 2, 3]

@@ -174,8 +174,8 @@ def finite(value: Any, factor: float = 1.0) -> float | None:
 
 def scatter(rows: list[dict[str, Any]], f: dict[str, Any]) -> dict[str, Any]:
     """The shots page's scatter: a figure (``y``) against an input (``x``), a series a
-    group of ``colour``; on a log axis, a value that is not positive is left out and
-    counted."""
+    group of ``colour``, the runs with warnings (or none recorded) a series of their own,
+    named so; on a log axis, a value that is not positive is left out and counted."""
     known = cells()
     label, unit = known[f["x"]]
     fig = next(fig for fig in FIGURES if fig[0] == f["y"])
@@ -191,6 +191,9 @@ def scatter(rows: list[dict[str, Any]], f: dict[str, Any]) -> dict[str, Any]:
             left_out += 1
             continue
         name = (str(r.get(f["colour"]) or "none") if f["colour"] else "runs")
+        count = r.get("warning_count")
+        name += (" (warnings not recorded)" if count is None else " (with warnings)" if count
+                 else "")  # a figure the tool cannot vouch for is flagged where it is drawn
         groups.setdefault(name, []).append((x, y, r["id"]))
     names = sorted(groups)
     points = sorted((x, y, ident, k) for k, name in enumerate(names)

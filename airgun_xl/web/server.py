@@ -161,11 +161,13 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
         rows = pages.selected(snapshot, f)
         out = io.StringIO()
         writer = csv.writer(out, lineterminator="\n")
-        writer.writerow([f"{h} [{u}]" if u else h for _k, h, u, _f, _d in pages.COLUMNS])
+        writer.writerow([f"{h} [{u}]" if u else h for _k, h, u, _f, _d in pages.COLUMNS]
+                        + ["warning texts"])
         for r in rows:  # a text that a spreadsheet would run is written as text
             writer.writerow([_csv_text(r.get(k)) if d is None else
                              ("" if r.get(k) is None else repr(r[k] * factor))
-                             for k, _h, _u, factor, d in pages.COLUMNS])
+                             for k, _h, _u, factor, d in pages.COLUMNS]
+                            + [_csv_text("; ".join(r.get("warnings") or []))])
         return Response(out.getvalue(), media_type="text/csv; charset=utf-8", headers={
             "content-disposition": f'attachment; filename="{_file_name(label)}-shots.csv"'})
 
