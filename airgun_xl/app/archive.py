@@ -282,8 +282,8 @@ def show_entry(found: Archive, entry: str | Entry,
     """One run of an archive already open (``serve`` holds one, its index read-only): an
     entry named as ``show`` takes it, or one already found; ``rows``, the index's rows when
     the caller has just read them."""
-    e = found.checked(found.get(entry) if isinstance(entry, str) else entry, rows)
     # what verify would report is refused
+    e = found.checked(found.get(entry) if isinstance(entry, str) else entry, rows)
     doc = {"entry": e.ref, "id": e.id, "path": str(e.path), "created": e.created,
            "params": e.load("params.json"), "summary": e.load("summary.json"),
            "provenance": e.load("provenance.json"), "files": e.manifest()["files"]}
