@@ -915,6 +915,18 @@ def test_a_long_channel_is_read_around_its_pulse_and_said(pulse, tmp_path, monke
         airgun_xl.accept(TEMPLATE, path, **SPEC, **_accel(kind))
 
 
+def test_a_tdms_sample_that_is_not_finite_is_named_counting_from_one(tmp_path, capsys):
+    """As every other reader names it (a MAT file's 51st sample is sample 51): the 51st
+    sample of a TDMS waveform, NaN, is sample 51 in the one line; nothing is written."""
+    g = np.r_[np.ones(50), np.nan, np.ones(49)]
+    path = _write_long("tdms", tmp_path / "r", 1e-4 * np.arange(100), g)
+    out = tmp_path / "c.xlsx"
+    assert main(["compare-measured", str(TEMPLATE), str(path), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "channel 'accel' sample 51 is nan, expected finite" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.tdms"]
+
+
 @pytest.mark.parametrize("kind", WINDOWED)
 def test_a_file_past_the_input_cap_is_opened_by_the_reader(pulse, tmp_path, monkeypatch,
                                                            capsys, kind):

@@ -128,7 +128,7 @@ def read(path: str | Path, data: bytes | LargeFile, channel: str | None) -> Tabl
     bad = ~np.isfinite(accel)
     if bad.any():
         k = int(np.argmax(bad))
-        raise WorkbookError(f"{shown}: channel {chosen.name!r} sample {first + k} is "
+        raise WorkbookError(f"{shown}: channel {chosen.name!r} sample {first + k + 1:,} is "
                             f"{accel[k]}, expected finite numbers (no NaN or inf)")
     unit = str(chosen.properties.get("unit_string", ""))
     # the header is built for the unit alone: a channel named 'accel (z)' or 'accel [z]' must
