@@ -264,6 +264,10 @@ def test_the_laws_page_holds_each_version_its_runs_the_chain_and_the_outcomes(pa
     assert [r[2] for r in rows] == [e["verdict"] for e in expected] == ["FAIL", "PASS"]
     assert rows[0][3] == "n/a" and rows[1][3] == f"{expected[1]['predicted_before']:.3f}"
     assert [r[5] for r in rows] == [f"{e['next_A28']:.3f}" for e in expected]
+    # each P(PASS) with the warnings its proposal keeps (what it cannot vouch for)
+    kept = [record.get("warnings") or [] for _v, record in proposals(lab, "LOT-A")]
+    said = lot.locator("table.chain td.warnings").all_inner_texts()
+    assert [t.strip() for t in said] == ["\n".join(w) if w else "none" for w in kept]
     record = prediction_record(lab)
     assert page.text_content("#record") == (f"1 shot fired from next's proposals; Brier score "
                                             f"{record.brier:.4f}.")

@@ -322,23 +322,29 @@ def _intervals(given: Any) -> list[dict[str, Any]] | None:
     return out
 
 
-def _scales(root: Path, lots: list[str]) -> dict[str, tuple[float, float | None]]:
-    """Each law version ``next`` made: its scale on the lot's prior and that scale's standard
-    error, from the lot's proposals (a proposal that cannot be read: none)."""
+def _from_proposals(root: Path, lots: list[str]) -> tuple[
+        dict[str, tuple[float, float | None]], dict[str, list[str]]]:
+    """From the lots' proposals: each law version ``next`` made, with its scale on the lot's
+    prior and that scale's standard error; and each proposal's warnings (what its P(PASS)
+    cannot vouch for), by the proposal (``LOT@N``). A chain that cannot be read: none."""
     from ..archive.lots import proposals
     from ..errors import AirgunXlError
 
-    out: dict[str, tuple[float, float | None]] = {}
+    scales: dict[str, tuple[float, float | None]] = {}
+    warnings: dict[str, list[str]] = {}
     for lot in lots:
         try:
             chained = proposals(root, lot)
         except AirgunXlError:
             continue
-        for _version, record in chained:
+        for version, record in chained:
             scale = real(record.get("scale"))
             if isinstance(record.get("law"), str) and scale is not None:
-                out[record["law"]] = (scale, real(record.get("scale_error")))
-    return out
+                scales[record["law"]] = (scale, real(record.get("scale_error")))
+            said = record.get("warnings")
+            warnings[f"{lot}@{version}"] = [str(w) for w in said] if isinstance(said, list) \
+                else []
+    return scales, warnings
 
 
 def _laws(root: Path, snapshot: Any, pages: Any) -> dict[str, Any]:
@@ -349,7 +355,7 @@ def _laws(root: Path, snapshot: Any, pages: Any) -> dict[str, Any]:
     from ..errors import AirgunXlError
 
     lots: dict[str, dict[str, Any]] = {}
-    scales = _scales(root, snapshot.lots)
+    scales, warned = _from_proposals(root, snapshot.lots)
     for law in list_laws(root):
         name = law["ref"].rpartition("@")[0]
         lot = lots.setdefault(name, {"name": name, "versions": [], "curves": [],
@@ -373,7 +379,8 @@ def _laws(root: Path, snapshot: Any, pages: Any) -> dict[str, Any]:
                                      "chain_problem": None})
     for name, lot in lots.items():
         try:
-            lot["chain"] = chain(root, name)
+            lot["chain"] = [{**r, "warnings": warned.get(str(r["proposal"]), [])}
+                            for r in chain(root, name)]
         except AirgunXlError as exc:
             lot["chain_problem"] = str(exc) if "has no chain" not in str(exc) else None
         intervals = {v["ref"]: v.get("intervals") or [] for v in lot["versions"]}
