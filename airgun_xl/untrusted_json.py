@@ -108,7 +108,19 @@ SCHEMAS: dict[str, dict] = {
             "interval": {"type": "array", "items": _NUMBER, "minItems": 2, "maxItems": 2},
             "draws": {"type": "integer"}, "most_likely_to_fail": {"type": ["string", "null"]},
             "confidence": _NUMBER, "reached": {"type": "boolean"}, "sd": _TEXTS,
-            "gun": _TEXT,
+            "gun": _TEXT, "gun_name": _TEXT,
+            "launch": {"type": "array", "items": {
+                "type": "object",
+                "required": ["shot_sha256", "recording_sha256", "speed_m_s", "factor",
+                             "error"],
+                "properties": {"shot_sha256": {"type": "string", "pattern": "^[0-9a-f]{64}$"},
+                               "recording_sha256": {"type": "string",
+                                                    "pattern": "^[0-9a-f]{64}$"},
+                               "speed_m_s": {"type": "number", "exclusiveMinimum": 0},
+                               "factor": {"type": "number", "exclusiveMinimum": 0},
+                               "error": {"type": ["number", "null"], "minimum": 0}}},
+                "description": "each shot's launch velocity fitted: a factor on its set "
+                               "value, with its standard error"},
             "seed": {"type": "integer"}, "next_workbook": _TEXT,
             "next_sha256": {"type": "string", "pattern": "^[0-9a-f]{64}$"},
             "shots": {"type": "array", "items": {

@@ -2,7 +2,7 @@
 fired until PASS or 5 shots, once with `airgun-xl next` and once with the rule labs use by
 hand; how soon each passes, and whether next's predicted P(PASS) came true.
 
-    python benchmarks/bench_closed_loop.py [--lots N] [--draws N] [--vary CELL] [--quick]
+    python benchmarks/bench_closed_loop.py [--lots N] [--draws N] [--vary CELL] [--gun] [--quick]
     python benchmarks/bench_closed_loop.py --call [--quick]
 
 The lab, on shot A (the template):
@@ -124,19 +124,22 @@ def by_hand(lot, law, first, work, draws):
     return MOST_SHOTS + 1
 
 
-def with_next(lot, law, first, work, draws, n_draws, calls, vary=None):
+def with_next(lot, law, first, work, draws, n_draws, calls, vary=None, gun=None):
     """Shots to the first PASS by next; each (predicted P(PASS), passed) of a proposal
-    fired."""
+    fired. With ``gun``, every lot in one archive (``work``'s parent's) and the gun's
+    scatter pooled over them (``next --gun``); ``calls`` gets (seconds, the gun's words)."""
     shot = with_velocity(work / "next0.xlsx", first)
     predicted, record = None, []
+    archive = work / "archive" if gun is None else work.parent / "archive"
     for k in range(MOST_SHOTS):
         rec = fire(shot, law, draws[k], work / f"next{k}.csv")
         started = time.perf_counter()
-        out = airgun_xl.next_shot(shot, rec, archive=work / "archive", lot=f"LOT-{lot}",
+        out = airgun_xl.next_shot(shot, rec, archive=archive, lot=f"LOT-{lot}",
                                   new_lot=k == 0, sd=[f"A28={GUN:.1%}", f"E43={ZETA:.0%}"],
                                   shots=n_draws, seed=lot * 10 + k,
-                                  output=work / f"next{k + 1}.xlsx", vary=vary, **SPEC)
-        calls.append(time.perf_counter() - started)
+                                  output=work / f"next{k + 1}.xlsx", vary=vary, gun=gun,
+                                  **SPEC)
+        calls.append((time.perf_counter() - started, out.gun))
         if predicted is not None:
             record.append((predicted, out.verdict.passed))
         if out.verdict.passed:
@@ -222,6 +225,9 @@ def main():
     parser.add_argument("--lots", type=int, default=200)
     parser.add_argument("--draws", type=int, default=1000, help="next's draws a setting")
     parser.add_argument("--vary", metavar="CELL", help="next's second knob (E13, E16, A2)")
+    parser.add_argument("--gun", action="store_true",
+                        help="every lot in one archive, next --gun: the gun's scatter pooled "
+                             "over the lots once they hold 7 shots beyond each lot's first")
     parser.add_argument("--call", action="store_true",
                         help="time one next on a lot of 5 shots as a whole process")
     parser.add_argument("--quick", action="store_true",
@@ -251,7 +257,7 @@ def main():
             work = Path(tmp) / f"lot{lot}"
             work.mkdir()
             shots, record = with_next(lot, law, first, work, draws, n_draws, calls,
-                                      args.vary)
+                                      args.vary, "GUN-1" if args.gun else None)
             results["next"].append(shots)
             honest_record += record
             results["by hand"].append(by_hand(lot, law, first, work, draws))
@@ -270,11 +276,17 @@ def main():
           else f"{lots} lots, next with {n_draws:,} draws a setting; the first shot at "
                f"{first:.2f} m/s (design --confidence: P(PASS) {p_first:.3f} on the nominal "
                f"law); {time.perf_counter() - started:.0f} s, next"
-               f"{f' --vary {args.vary}' if args.vary else ''} "
-               f"{statistics.median(calls):.2f} s a call (median)\n")
+               f"{f' --vary {args.vary}' if args.vary else ''}"
+               f"{' --gun' if args.gun else ''} "
+               f"{statistics.median(c for c, _ in calls):.2f} s a call (median)\n")
     widths = [max(len(r[i]) for r in rows) for i in range(6)]
     for r in rows:
         print("  ".join(cell.ljust(w) for cell, w in zip(r, widths, strict=True)))
+    if args.gun:
+        pooled = [words for _, words in calls if "as given" not in words]
+        print(f"\nnext --gun: {len(calls) - len(pooled)} calls drew the scatter given, "
+              f"{len(pooled)} the pooled estimate; the last: "
+              f"{pooled[-1] if pooled else 'none'}")
     if honest_record:
         predicted, passed = zip(*honest_record, strict=True)
         print(f"\nnext's predictions, {len(predicted)} shots fired from its proposals: Brier "

@@ -12,7 +12,10 @@ This part updates the law's scale (a scale is what one shot, or shots at one spe
 The gun's scatter is the one given (``--sd A28=...``) until the lot has
 :data:`~airgun_xl.studies.closed_loop.GUN_SHOTS` shots; from then on each shot's launch
 velocity is fitted with the scale and the scatter is estimated from them (its source said
-with every P(PASS)). ``vary`` names a second knob set with
+with every P(PASS)). With ``gun``, the launch velocities are fitted from the lot's first shot
+and kept in its proposal, and the scatter is pooled over every lot of that gun in the
+archive (:func:`~airgun_xl.studies.closed_loop.pooled_scatter`). ``vary`` names a second knob
+set with
 the velocity (E13 or E16, for the duration; a lot stronger or weaker than the law the shot
 was designed on cannot meet both a peak and a duration by the velocity alone).
 """
@@ -66,6 +69,7 @@ class NextRequest:
     workers: int | None = None  # or on a local one of this many processes
     chunk: int | None = None  # shots a cluster task
     pdf: Path | None = None  # the next shot's report as a PDF too
+    gun: str | None = None  # the gun's name: its scatter pooled over the lots it fired
 
 
 #: The second knobs ``next --vary`` takes: the mitigator's geometry and the exchange mass
@@ -146,13 +150,18 @@ def run(request: NextRequest) -> NextOutcome:
     counted_once = any((s["shot_sha256"], s["recording_sha256"]) ==
                        (this["shot_sha256"], this["recording_sha256"]) for s in earlier)
     lot_shots = earlier if counted_once else [*earlier, this]
-    estimated = len(lot_shots) >= GUN_SHOTS
+    others, read_warnings = _gun_lots(request, lot_shots)
+    freedom = sum(len(launch) - 1 for _lot, launch in others) + len(lot_shots) - 1
+    estimated = freedom >= GUN_SHOTS - 1 if request.gun is not None else \
+        len(lot_shots) >= GUN_SHOTS
     sds = _scatter(request, estimated)
     verdict = _judge(request, spec)
     params, traces = _read_lot(lot_shots)
     update = update_scale(params, traces, prior, spec.judged.cfc, request.integrator,
-                          velocities=estimated)
-    sds, gun, gun_warnings = _gun(update, sds, len(lot_shots), shot.params.v31)
+                          velocities=estimated or request.gun is not None)
+    sds, gun, gun_warnings = _gun(request, update, sds, len(lot_shots), shot.params.v31,
+                                  others, freedom)
+    gun_warnings = [*read_warnings, *gun_warnings]
     p_next = shot.params.replace(crush_law=update.law)
     best, conf_warnings = _choose(request, spec, p_next, [*sds, law_scatter(update)],
                                   _noise(verdict))
@@ -185,6 +194,9 @@ def _checked(request: NextRequest) -> Path:
     if not request.lot or safe_name(request.lot) != request.lot:
         raise OptionError(f"--lot: found {request.lot!r}, expected a lot name of letters, "
                           "digits, '-', '_' and '.' (such as LOT-2026-07)")
+    if request.gun is not None and (not request.gun or safe_name(request.gun) != request.gun):
+        raise OptionError(f"--gun: found {request.gun!r}, expected a gun's name of letters, "
+                          "digits, '-', '_' and '.' (such as GUN-4IN)")
     if request.vary is not None:
         second_knob(request.vary)
     from .running import check_cluster
@@ -239,32 +251,45 @@ def _scatter(request: NextRequest, estimated: bool) -> list[Any]:
 
     sds = parse_sds(request.sd)
     if not estimated and not any(cell == address("v31") for cell, *_ in sds):
+        until = (f"lot has {GUN_SHOTS} shots to estimate it from" if request.gun is None else
+                 f"lots of the gun {request.gun} hold {GUN_SHOTS - 1} shots beyond each "
+                 "lot's first to estimate it from")
         raise OptionError("--sd: found no A28 scatter, expected the gun's shot-to-shot "
                           "scatter such as --sd A28=1.5% (and E43=10% for zeta's) until the "
-                          f"lot has {GUN_SHOTS} shots to estimate it from")
+                          + until)
     if any(cell == address("sigmay") for cell, *_ in sds):
         raise OptionError("--sd: found E40, expected the gun's (A28) and zeta's (E43) only: "
                           "the lot's crush strength is the law's, drawn from its update")
     return list(sds)
 
 
-def _gun(update: LawUpdate, sds: list[Any], shots: int,
-         velocity: float) -> tuple[list[Any], str, list[str]]:
+def _gun(request: NextRequest, update: LawUpdate, sds: list[Any], shots: int,
+         velocity: float, others: list[tuple[str, tuple[tuple[float, float, float], ...]]],
+         freedom: int) -> tuple[list[Any], str, list[str]]:
     """The gun's scatter drawn: estimated from the lot's launch velocities once it has
-    :data:`~airgun_xl.studies.closed_loop.GUN_SHOTS` shots, else the one given; with the
-    words saying which, and a warning when the given one lies outside the estimate's 95 %
-    interval."""
-    from ..studies.closed_loop import GUN_SHOTS, gun_scatter
+    :data:`~airgun_xl.studies.closed_loop.GUN_SHOTS` shots (with ``--gun``, from the launch
+    velocities of every lot of that gun, ``others`` and this one, once they hold one degree
+    of freedom less), else the one given; with the words saying which, and a warning when
+    the given one lies outside the estimate's 95 % interval."""
+    from ..studies.closed_loop import GUN_SHOTS, gun_scatter, pooled_scatter
 
     given = next((sd for sd in sds if sd[0] == address("v31")), None)
     shown = "" if given is None else (f"{given[0]}={given[2] * 100:g}%" if given[3]
                                       else f"{given[0]}={given[2]:g}")
-    found = gun_scatter(update)
+    if request.gun is None:
+        found = gun_scatter(update)
+    else:
+        found = pooled_scatter([*others, (request.lot, update.launch)], request.gun)
     if found is None:
         assert given is not None  # _scatter refused it otherwise
-        return sds, (f"the gun's scatter {shown} as given (--sd): the lot has {shots} "
-                     f"shot{'s' * (shots > 1)}, and it is estimated from the shots' launch "
-                     f"velocities from {GUN_SHOTS}"), []
+        if request.gun is None:
+            why = (f"the lot has {shots} shot{'s' * (shots > 1)}, and it is estimated from "
+                   f"the shots' launch velocities from {GUN_SHOTS}")
+        else:
+            why = (f"the lots of the gun {request.gun} hold {max(freedom, 0)} shot"
+                   f"{'s' * (freedom != 1)} beyond each lot's first, and it is estimated "
+                   f"from their launch velocities from {GUN_SHOTS - 1}")
+        return sds, f"the gun's scatter {shown} as given (--sd): {why}", []
     rest = [sd for sd in sds if sd[0] != address("v31")]
     cell, fields, _sd, _rel = given if given is not None else (
         address("v31"), ("v31", "v32", "v33"), 0.0, True)
@@ -276,9 +301,49 @@ def _gun(update: LawUpdate, sds: list[Any], shots: int,
         lo, hi = found.interval
         if not lo <= value <= hi:
             warnings.append(f"--sd {shown}: the gun's scatter given lies outside the "
-                            f"95 % interval estimated from the lot's shots ({lo:.2%}-{hi:.2%})"
-                            f"; the estimate, {found.sd:.2%}, is drawn")
+                            f"95 % interval estimated from the {'gun' if request.gun else 'lot'}"
+                            f"'s shots ({lo:.2%}-{hi:.2%}); the estimate, {found.sd:.2%}, is "
+                            "drawn")
     return [*rest, (cell, fields, found.sd, True)], words, warnings
+
+
+def _gun_lots(request: NextRequest, lot_shots: list[dict[str, Any]]
+              ) -> tuple[list[tuple[str, tuple[tuple[float, float, float], ...]]], list[str]]:
+    """With ``--gun``: every other lot's launch velocities fitted for that gun (its latest
+    proposal naming it), read back from the archive (untrusted: each entry checked, a shot of
+    this lot left out, a lot whose records cannot be read left out with a warning)."""
+    if request.gun is None:
+        return [], []
+    from ..archive.lots import gun_launches, lot_names
+    from ..errors import ArchiveError
+    from ..studies.calibrate import VELOCITY_REACH
+
+    mine = {(s["shot_sha256"], s["recording_sha256"]) for s in lot_shots}
+    seen = set(mine)
+    found, warnings = [], []
+    for lot in lot_names(request.archive):
+        if lot == request.lot:
+            continue
+        try:
+            launch = gun_launches(request.archive, lot, request.gun)
+        except ArchiveError as error:
+            warnings.append(f"the gun's scatter: the lot {lot} is left out: {error}")
+            continue
+        wild = [e["factor"] for e in launch if not abs(e["factor"] - 1) <= VELOCITY_REACH]
+        if wild:
+            warnings.append(f"the gun's scatter: the lot {lot} is left out: its record holds "
+                            f"a launch velocity factor of {wild[0]:.6g}, expected within 1 "
+                            f"+/- {VELOCITY_REACH:g} (the fit's bound)")
+            continue
+        kept = []
+        for entry in launch:
+            key = (entry["shot_sha256"], entry["recording_sha256"])
+            if key not in seen:  # a shot recorded in two lots counts once
+                seen.add(key)
+                kept.append((entry["speed_m_s"], entry["factor"], entry["error"]))
+        if len(kept) >= 2:
+            found.append((lot, tuple(kept)))
+    return found, warnings
 
 
 def _lot(request: NextRequest) -> tuple[Any, list[dict[str, Any]]]:
@@ -432,6 +497,14 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
                   "most_likely_to_fail": worst[0] if worst else None,
                   "confidence": request.confidence, "reached": reached,
                   "sd": list(request.sd), "gun": gun, "seed": request.seed,
+                  **({"gun_name": request.gun,
+                      "launch": [{"shot_sha256": s["shot_sha256"],
+                                  "recording_sha256": s["recording_sha256"],
+                                  "speed_m_s": v, "factor": f,
+                                  "error": e if math.isfinite(e) else None}
+                                 for s, (v, f, e) in zip(lot_shots, update.launch,
+                                                         strict=True)]}
+                     if request.gun is not None else {}),
                   "next_workbook": str(output), "next_sha256": file_sha256(output),
                   "shots": lot_shots, "warnings": warnings,
                   "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),

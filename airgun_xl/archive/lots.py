@@ -53,6 +53,24 @@ def proposals(root, lot):
     return out
 
 
+def gun_launches(root, lot, gun):
+    """The launch velocities fitted for the gun ``gun`` in the lot's latest proposal naming
+    it (``next --gun``): ``[{"shot_sha256", "recording_sha256", "speed_m_s", "factor",
+    "error"}]`` (the record's schema checked; an error null is NaN), or ``[]``.
+
+    Raises
+    ------
+    ArchiveError
+        A record that cannot be read (named).
+    """
+    for _version, path in reversed(versions(_folder(root, lot))):
+        record = read_record(root, path, "proposal")
+        if isinstance(record, dict) and record.get("gun_name") == gun:
+            return [{**entry, "error": float("nan") if entry["error"] is None
+                     else entry["error"]} for entry in record.get("launch") or []]
+    return []
+
+
 def lot_names(root):
     """The lots with a chain in the archive at ``root``."""
     base = Path(root) / LOTS

@@ -37,6 +37,10 @@ def add_parser(sub):
                    help="start the lot: its prior is the report's law")
     p.add_argument("--sd", action="append", metavar="CELL=SD",
                    help="the gun's scatter, A28=1.5%% (needed), and zeta's, E43=10%%")
+    p.add_argument("--gun", metavar="NAME", action=One,
+                   help="the gun that fires the lot: its scatter is estimated from the launch "
+                        "velocities of every lot fired with the same --gun (each lot's shots "
+                        "about their own mean) once they hold 7 shots beyond each lot's first")
     p.add_argument("--vary", metavar="CELL", action=One,
                    help="a second knob set with A28 for the duration: E13, E16 or A2 "
                         "(a lot whose strength differs from the law's cannot meet a peak "
@@ -68,7 +72,7 @@ def request_of(args):
                        args.time_unit, args.accel_unit, args.integrator,
                        Path(args.output) if args.output else None, args.force,
                        tuple(args.argv), args.vary, args.scheduler, args.workers,
-                       args.chunk, Path(args.pdf) if args.pdf else None)
+                       args.chunk, Path(args.pdf) if args.pdf else None, args.gun)
 
 
 def run(args):

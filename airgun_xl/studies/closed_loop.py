@@ -10,7 +10,8 @@ next setting chosen on what the lot is now known to be.
   :attr:`LawUpdate.note`).
 - :func:`gun_scatter`: the gun's shot-to-shot scatter, from the lot's shots' launch
   velocities fitted with the scale (:func:`update_scale` with ``velocities``) against their
-  set values, once :data:`GUN_SHOTS` shots exist.
+  set values, once :data:`GUN_SHOTS` shots exist; :func:`pooled_scatter`, the same from the
+  shots of every lot one gun fired (each lot's about its own mean).
 - :func:`law_scatter`: the scale's standard error as a scatter of the law (relative, around
   1), or the scale's and the tilt's covariance, drawn with the gun's and zeta's by
   :func:`~.first_shot.pass_probability` (the law known to its standard error: a posterior,
@@ -115,10 +116,11 @@ def update_scale(params, traces, prior, cfc=None, integrator="legacy", velocitie
                      cal.covariance[:2, :2] if math.isfinite(v_ref) else None)
 
 
-#: Shots of a lot from which the gun's scatter is estimated (:func:`gun_scatter`): with 7
-#: degrees of freedom the 95 % interval of a standard deviation is 0.66 to 2.0 times the
-#: estimate (chi-square); with fewer, one lucky shot can halve the estimate and the P(PASS)
-#: drawn from it would be over-confident.
+#: Shots of a lot from which the gun's scatter is estimated (:func:`gun_scatter`; pooled
+#: over lots, :func:`pooled_scatter`, one less degrees of freedom): with 7 degrees of
+#: freedom the 95 % interval of a standard deviation is 0.66 to 2.0 times the estimate
+#: (chi-square); with fewer, one lucky shot can halve the estimate and the P(PASS) drawn
+#: from it would be over-confident.
 GUN_SHOTS = 8
 
 
@@ -130,15 +132,23 @@ BIAS_SIGMAS = 2.0
 @dataclass(frozen=True)
 class GunScatter:
     """The gun's shot-to-shot scatter: a relative standard deviation of the launch velocity
-    [-], its 95 % interval, from ``shots`` shots; the mean launch velocity's offset from the
-    set value (the gun's bias) [-]."""
+    [-], its 95 % interval, from ``shots`` shots (of ``lots`` lots: each lot's shots about
+    their own mean, so ``shots - lots`` degrees of freedom); the mean launch velocity's
+    offset from the set value (the gun's bias) [-]; ``gun`` names the gun when the lots of
+    one gun were pooled (``next --gun``)."""
 
     sd: float
     interval: tuple[float, float]
     shots: int
     bias: float
     bias_error: float
-    at_bound: tuple[int, ...] = ()  # shots (from 1) whose launch velocity met its bound
+    at_bound: tuple[int | str, ...] = ()  # shots (from 1; "lot L's shot k" pooled) at the bound
+    lots: int = 1
+    gun: str = ""
+
+    def _whose(self) -> str:
+        return (f"the gun {self.gun}'s {self.shots} shots of {self.lots} lots" if self.gun
+                else f"the lot's {self.shots} shots")
 
     @property
     def warnings(self) -> list[str]:
@@ -146,53 +156,76 @@ class GunScatter:
 
         found = []
         if self.at_bound:
-            found.append(f"the gun's scatter: shot{'s' * (len(self.at_bound) > 1)} "
-                         f"{', '.join(map(str, self.at_bound))} of the lot fitted a launch "
+            which = ", ".join(map(str, self.at_bound))
+            if not self.gun:
+                which = f"shot{'s' * (len(self.at_bound) > 1)} {which} of the lot"
+            found.append(f"the gun's scatter: {which} fitted a launch "
                          f"velocity {VELOCITY_REACH:.0%} from the one set (the fit's bound): "
                          "not a gun's scatter (a wrong setting or recording?); the scatter "
                          "estimated from them is not to be trusted")
         if abs(self.bias) > BIAS_SIGMAS * self.bias_error:
             found.append(f"the gun fires {self.bias:+.2%} (+/- {self.bias_error:.2%}) off its "
-                         f"set velocity on average over the lot's {self.shots} shots: the "
+                         f"set velocity on average over {self._whose()}: the "
                          "setting proposed is the velocity to fire, which this gun reaches "
                          "set that much the other way; the draws assume no such offset")
         return found
 
     def words(self) -> str:
         lo, hi = self.interval
+        source = (f"{self.shots} shots' launch velocities" if not self.gun else
+                  f"the launch velocities of {self.shots} shots of {self.lots} lots fired "
+                  f"by the gun {self.gun} (each lot's about its own mean)")
         return (f"the gun's scatter {self.sd:.2%} (95 % interval {lo:.2%}-{hi:.2%}), estimated "
-                f"from {self.shots} shots' launch velocities fitted against their set values "
+                f"from {source} fitted against their set values "
                 f"(their mean {self.bias:+.2%} +/- {self.bias_error:.2%} off them)")
 
 
 def gun_scatter(update):
     """The gun's scatter from the lot's fitted launch velocities (:attr:`LawUpdate.launch`),
-    or None under :data:`GUN_SHOTS` shots.
+    or None under :data:`GUN_SHOTS` shots (:func:`pooled_scatter` of the one lot)."""
+    return pooled_scatter([("", update.launch)])
 
-    The factors' sample variance less the mean of their squared standard errors (what the
-    recordings' noise adds, not the gun): s^2 = var(f) - mean(se^2), at least 0; its 95 %
-    interval from the chi-square distribution of (n - 1) var / sigma^2."""
+
+def pooled_scatter(lots, gun=""):
+    """The gun's scatter from the launch velocities fitted in each of ``lots`` (``[(name,
+    launch)]``, ``launch`` as :attr:`LawUpdate.launch`), or None under ``GUN_SHOTS - 1``
+    degrees of freedom.
+
+    Each lot's factors are taken about their own mean: a lot's law absorbs part of a
+    launch velocity's offset (a lot of one shot tells nothing of the scatter), and what is
+    left is the shot-to-shot scatter. The pooled sample variance less what the fits' own
+    errors add, s^2 = sum (f - mean_lot f)^2 / sum (n_lot - 1) - sum se^2 (1 - 1/n_lot) /
+    sum (n_lot - 1), at least 0 (one lot: var(f) - mean(se^2)); its 95 % interval from the
+    chi-square distribution with sum (n_lot - 1) degrees of freedom. The bias is the mean
+    of the factors less 1, its error from their spread about that mean."""
     from scipy.stats import chi2
 
-    launch = update.launch
-    n = len(launch)
-    if n < GUN_SHOTS:
-        return None
-    factors = np.array([f for _v, f, _e in launch])
-    errors = np.array([e for _v, _f, e in launch])
-    errors = np.where(np.isfinite(errors), errors, 0.0)
-    spread = float(np.var(factors, ddof=1))
-    noise = float(np.mean(errors ** 2))
-    sd = math.sqrt(max(spread - noise, 0.0))
-    dof = n - 1
-    lo = math.sqrt(max(dof * spread / chi2.ppf(0.975, dof) - noise, 0.0))
-    hi = math.sqrt(max(dof * spread / chi2.ppf(0.025, dof) - noise, 0.0))
-    bias = float(np.mean(factors) - 1.0)
     from .calibrate import VELOCITY_REACH
 
-    at_bound = tuple(k + 1 for k, f in enumerate(factors)
-                     if abs(f - 1.0) >= VELOCITY_REACH * (1 - 1e-3))
-    return GunScatter(sd, (lo, hi), n, bias, math.sqrt(spread / n), at_bound)
+    kept = [(name, launch) for name, launch in lots if len(launch) >= 2]
+    dof = sum(len(launch) - 1 for _name, launch in kept)
+    if dof < GUN_SHOTS - 1:
+        return None
+    squares = noise = 0.0
+    factors, at_bound = [], []
+    for name, launch in kept:
+        f = np.array([x for _v, x, _e in launch], dtype=float)
+        e = np.array([x for _v, _f, x in launch], dtype=float)
+        e = np.where(np.isfinite(e), e, 0.0)
+        squares += float(np.sum((f - f.mean()) ** 2))
+        noise += float(np.sum(e ** 2)) * (1 - 1 / len(f))
+        factors.append(f)
+        at_bound += [f"lot {name}'s shot {k + 1}" if name else k + 1 for k, x in enumerate(f)
+                     if abs(x - 1.0) >= VELOCITY_REACH * (1 - 1e-3)]
+    spread, noise = squares / dof, noise / dof
+    sd = math.sqrt(max(spread - noise, 0.0))
+    lo = math.sqrt(max(dof * spread / chi2.ppf(0.975, dof) - noise, 0.0))
+    hi = math.sqrt(max(dof * spread / chi2.ppf(0.025, dof) - noise, 0.0))
+    every = np.concatenate(factors)
+    n = len(every)
+    bias = float(np.mean(every) - 1.0)
+    return GunScatter(sd, (lo, hi), n, bias, math.sqrt(float(np.var(every, ddof=1)) / n),
+                      tuple(at_bound), len(kept), gun)
 
 
 def law_scatter(update):
