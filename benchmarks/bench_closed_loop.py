@@ -24,8 +24,9 @@ this recorder's noise would be). Then:
 Both meet the same lots and the same draws of the gun, zeta and the recorder's noise.
 
 `--call` times one `airgun-xl next` as a whole process on a lot of 5 recorded shots (the
-fifth, with the default 2,000 draws a setting; alone and with `--vary E13`): its wall time
-(median of 5, after a warm-up) and peak RSS, against the issue's 10 s and 1 GB.
+fifth, with the default 2,000 draws a setting; alone, with `--vary E13`, and with `--gun`
+among 199 other lots of the gun, whose records it reads): its wall time (median of 5, after a
+warm-up) and peak RSS, against the issue's 10 s and 1 GB.
 
 It prints, for both, the share of lots passed by the first, second and third shot and the
 mean shots to the first PASS (a lot not passed in 5 counts as 6), and, for next, the observed
@@ -191,9 +192,26 @@ def timed(cmd, times):
     return walls, rss
 
 
+def with_gun(archive, lot, others, rng):
+    """``others`` lots of the gun GUN-1 beside ``lot`` in ``archive``: each a copy of the
+    lot's latest proposal (through the archive's own store) naming the gun, with the launch
+    velocities of 5 shots drawn at the gun's scatter, as next --gun keeps them."""
+    from airgun_xl.archive.lots import proposals, store_proposal
+
+    record = dict(proposals(archive, lot)[-1][1])
+    for k in range(others):
+        shots = [{**record["shots"][0], "shot_sha256": f"{k:032x}{j:032x}"} for j in range(5)]
+        launch = [{"shot_sha256": s["shot_sha256"], "recording_sha256": s["recording_sha256"],
+                   "speed_m_s": 240.0, "factor": 1 + GUN * rng.normal(), "error": 0.004}
+                  for s in shots]
+        store_proposal(archive, f"LOT-G{k:03d}", {**record, "lot": f"LOT-G{k:03d}",
+                                                  "shots": shots, "gun_name": "GUN-1",
+                                                  "launch": launch})
+
+
 def call(quick):
     """``next`` on a lot of 5 recorded shots, as a whole process: (label, wall [s], peak RSS
-    [MB]) alone and with --vary E13."""
+    [MB]) alone, with --vary E13 and with --gun among other lots of the gun."""
     rng = np.random.default_rng(7)
     law = true_law(rng)
     rows = []
@@ -213,8 +231,11 @@ def call(quick):
                 str(work / "n.xlsx"), "--force", "--quiet"]
         if quick:
             base += ["--shots", "200"]
+        others = 3 if quick else 199
+        with_gun(work / "archive", "LOT-T", others, rng)
         for label, extra in (("next, a lot of 5 shots", []),
-                             ("next --vary E13, a lot of 5 shots", ["--vary", "E13"])):
+                             ("next --vary E13, a lot of 5 shots", ["--vary", "E13"]),
+                             (f"next --gun, {others} other lots of the gun", ["--gun", "GUN-1"])):
             walls, rss = timed(base + extra, 1 if quick else 5)
             rows.append((label, statistics.median(walls), max(rss)))
     return rows
