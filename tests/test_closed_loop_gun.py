@@ -204,3 +204,29 @@ def test_a_bad_gun_name_is_one_line_and_nothing_is_written(fired, tmp_path, caps
     assert code == 2 and err.count("\n") == 1
     assert err.startswith("airgun-xl: error: --gun: found '../g', expected a gun's name")
     assert not (tmp_path / "arch").exists() and not (tmp_path / "n.xlsx").exists()
+
+
+def test_a_fit_that_gives_fewer_launch_velocities_than_counted_is_one_line(
+        fired, launches, tmp_path, monkeypatch, capsys):
+    """The gun's lots hold 7 shots beyond each lot's first, so --sd A28 is not asked; should
+    the fit then give no estimate (here pooled_scatter made to find none), next says so in
+    one line and exits 2, with nothing written or recorded (it was an assertion: exit 1 and a
+    traceback)."""
+    import airgun_xl.studies.closed_loop as closed_loop
+
+    folder, made = fired
+    archive = tmp_path / "arch"
+    for lot in ("LOT-P", "LOT-Q", "LOT-R"):
+        _kept(archive, lot, made[lot], launches[lot], "G1")
+    _kept(archive, "LOT-S", made["LOT-S"], launches["LOT-S"], "G1")
+    before = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*"))
+    monkeypatch.setattr(closed_loop, "pooled_scatter", lambda lots, gun="": None)
+    shot, rec, _ = made["LOT-T"][0]
+    code = main(["next", str(shot), str(rec), "--archive", str(archive), "--lot", "LOT-T",
+                 "--new-lot", "--gun", "G1", "--peak", "8.5kG:5%", "--duration", "4.5ms:15%",
+                 "-o", str(tmp_path / "n.xlsx")])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1, err
+    assert err.startswith("airgun-xl: error: --sd: found no A28 scatter, and the launch "
+                          "velocities fitted give no estimate of the gun's")
+    assert sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*")) == before

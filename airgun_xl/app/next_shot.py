@@ -280,8 +280,12 @@ def _gun(request: NextRequest, update: LawUpdate, sds: list[Any], shots: int,
         found = gun_scatter(update)
     else:
         found = pooled_scatter([*others, (request.lot, update.launch)], request.gun)
+    if found is None and given is None:  # counted enough shots, but their fit gave fewer
+        raise OptionError("--sd: found no A28 scatter, and the launch velocities fitted give "
+                          "no estimate of the gun's (fewer than the shots counted), expected "
+                          "--sd A28=... such as A28=1.5%")
     if found is None:
-        assert given is not None  # _scatter refused it otherwise
+        assert given is not None  # for mypy: refused just above
         if request.gun is None:
             why = (f"the lot has {shots} shot{'s' * (shots > 1)}, and it is estimated from "
                    f"the shots' launch velocities from {GUN_SHOTS}")
