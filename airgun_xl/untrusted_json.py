@@ -104,6 +104,11 @@ SCHEMAS: dict[str, dict] = {
             "scale_error": _NUMBER_OR_NULL, "setting_A28": _NUMBER,
             "second_cell": _TEXT, "second_value": _NUMBER, "tilt": _NUMBER,
             "tilt_error": _NUMBER_OR_NULL, "tilt_about": _NUMBER,
+            "whole": {"type": "boolean"}, "shape_chi2": _NUMBER_OR_NULL,
+            "shape_dof": {"type": "integer"}, "shape_p": _NUMBER_OR_NULL,
+            "whole_nodes": {"type": "array", "items": {"type": "object"},
+                            "description": "the law fitted whole at its nodes, with their "
+                                           "intervals"},
             "p_pass": {"type": "number", "minimum": 0, "maximum": 1},
             "interval": {"type": "array", "items": _NUMBER, "minItems": 2, "maxItems": 2},
             "draws": {"type": "integer"}, "most_likely_to_fail": {"type": ["string", "null"]},

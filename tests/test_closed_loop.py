@@ -344,12 +344,12 @@ def test_the_guns_scatter_is_estimated_from_eight_shots_launch_velocities(tmp_pa
     and their scatter, less what the fits' errors add, is the draws' own within 0.15 %
     (measured: within 0.05 % on four seeds); under 8 shots there is no estimate."""
     from airgun_xl.readers.recording import read_trace
-    from airgun_xl.studies.closed_loop import GUN_SHOTS, gun_scatter, update_scale
+    from airgun_xl.studies.closed_loop import GUN_SHOTS, gun_scatter, update_law
 
     made = _gun_lot(tmp_path, GUN_SHOTS)
     params = [airgun_xl.load(shot).params for shot, _, _ in made]
     traces = [read_trace(str(rec), None, None, 1.0, None) for _, rec, _ in made]
-    update = update_scale(params, traces, LEGACY_LAW, velocities=True)
+    update = update_law(params, traces, LEGACY_LAW, velocities=True)
     errors = np.array([e for _, _, e in made])
     fitted = np.array([f - 1 for _, f, _ in update.launch])
     assert np.max(np.abs(fitted - errors)) < 0.004
@@ -359,7 +359,7 @@ def test_the_guns_scatter_is_estimated_from_eight_shots_launch_velocities(tmp_pa
     assert gun.sd == pytest.approx(np.std(errors, ddof=1), abs=0.0015)
     assert gun.interval[0] < 0.015 < gun.interval[1]  # the true scatter inside its interval
     assert update.scale == pytest.approx(TRUE_SCALE, abs=3 * update.error)
-    fewer = update_scale(params[:-1], traces[:-1], LEGACY_LAW, velocities=True)
+    fewer = update_law(params[:-1], traces[:-1], LEGACY_LAW, velocities=True)
     assert gun_scatter(fewer) is None
 
 
@@ -414,7 +414,7 @@ def test_shots_at_two_speeds_pin_the_laws_tilt_with_its_covariance():
     correlation is what the covariance holds: positive, as a steeper law needs less scale at
     the faster shot). At one speed only the scale is fitted, and the note says the shape is
     the prior's."""
-    from airgun_xl.studies.closed_loop import law_scatter, update_scale
+    from airgun_xl.studies.closed_loop import law_scatter, update_law
     from airgun_xl.studies.first_shot import JOINT
 
     p0 = airgun_xl.load(TEMPLATE).params
@@ -425,7 +425,7 @@ def test_shots_at_two_speeds_pin_the_laws_tilt_with_its_covariance():
         traces.append(synthetic_measurement(p.replace(crush_law=truth), dt=1 / 51_200,
                                             seed=k))
         params.append(p)
-    update = update_scale(params, traces, LEGACY_LAW)
+    update = update_law(params, traces, LEGACY_LAW)
     assert update.tilted and update.v_ref == 220.0
     assert abs(update.scale - 1.05) < 3 * update.error and update.error < 0.01
     assert abs(update.tilt - 0.10) < 3 * update.tilt_error and update.tilt_error < 0.02
@@ -434,7 +434,7 @@ def test_shots_at_two_speeds_pin_the_laws_tilt_with_its_covariance():
     assert kind == JOINT and v_ref == 220.0 and covariance.shape == (2, 2)
     assert covariance[1, 1] == pytest.approx(update.tilt_error ** 2, rel=1e-9)
     assert covariance[0, 0] == pytest.approx((update.error / update.scale) ** 2, rel=1e-9)
-    one = update_scale(params[:1], traces[:1], LEGACY_LAW)
+    one = update_law(params[:1], traces[:1], LEGACY_LAW)
     assert not one.tilted and "its shape over speed stays the prior's" in one.note
     assert law_scatter(one)[3] is True
 

@@ -21,7 +21,7 @@ from airgun_xl.cli import main
 from airgun_xl.crush_law import LEGACY_LAW
 from airgun_xl.readers.recording import read_trace
 from airgun_xl.studies.calibrate import VELOCITY_REACH, synthetic_measurement
-from airgun_xl.studies.closed_loop import pooled_scatter, update_scale
+from airgun_xl.studies.closed_loop import pooled_scatter, update_law
 
 #: Each lot: its true scale, and how many shots it fired (12 shots, 5 lots: 7 beyond each
 #: lot's first, the 7 the estimate asks; the lot of one shot adds none).
@@ -66,7 +66,7 @@ def launches(fired):
     for lot, shots in made.items():
         params = [airgun_xl.load(book).params for book, _, _ in shots]
         traces = [read_trace(str(rec), None, None, 1.0, None) for _, rec, _ in shots]
-        out[lot] = update_scale(params, traces, LEGACY_LAW, velocities=True).launch
+        out[lot] = update_law(params, traces, LEGACY_LAW, velocities=True).launch
     return out
 
 

@@ -191,8 +191,7 @@ def _store(request: CalibrateRequest, root: Path, cal: Any) -> str:
     scores = [{"rms_before": b.rms, "rms_after": a.rms, "iso_before": plain(b.iso),
                "iso_after": plain(a.iso)}
               for b, a in zip(cal.before, cal.after, strict=True)]
-    intervals = [{"velocity": n.velocity, "value": n.value, "error": n.error, "low": n.low,
-                  "high": n.high, "weak": bool(n.weak)} for n in cal.law_intervals]
+    intervals = [n.record() for n in cal.law_intervals]
     assert request.name is not None
     return str(store_law(root, request.name, cal.params[0].crush_law, shots_record, scores,
                          [display(a) for a in request.argv], intervals))

@@ -8,16 +8,17 @@ options, the lot (unknown without ``new_lot``), the specification (it needs tole
 gun's scatter, the lot's earlier shots (each file unchanged since it was recorded), the
 recording and the output.
 
-This part updates the law's scale (a scale is what one shot, or shots at one speed, pins).
-The gun's scatter is the one given (``--sd A28=...``) until the lot has
+The law's update is :func:`~airgun_xl.studies.closed_loop.update_law`'s: its scale (what one
+shot, or shots at one speed, pins), its tilt once the shots spread over speed, and the law
+fitted whole where such shots show a shape the scale and tilt cannot follow. The gun's
+scatter is the one given (``--sd A28=...``) until the lot has
 :data:`~airgun_xl.studies.closed_loop.GUN_SHOTS` shots; from then on each shot's launch
 velocity is fitted with the scale and the scatter is estimated from them (its source said
 with every P(PASS)). With ``gun``, the launch velocities are fitted from the lot's first shot
 and kept in its proposal, and the scatter is pooled over every lot of that gun in the
 archive (:func:`~airgun_xl.studies.closed_loop.pooled_scatter`). ``vary`` names a second knob
-set with
-the velocity (E13 or E16, for the duration; a lot stronger or weaker than the law the shot
-was designed on cannot meet both a peak and a duration by the velocity alone).
+set with the velocity (E13 or E16, for the duration; a lot stronger or weaker than the law
+the shot was designed on cannot meet both a peak and a duration by the velocity alone).
 """
 from __future__ import annotations
 
@@ -111,6 +112,7 @@ class NextOutcome:
                     **({"tilt": self.update.tilt,
                         "tilt_standard_error": self.update.tilt_error,
                         "tilt_about_m_s": self.update.v_ref} if self.update.tilted else {}),
+                    **(_whole_record(self.update) if self.update.shape else {}),
                     "note": self.update.note},
             "next": {"A28_m_s": self.setting,
                      **({f"{self.second[0]}_{self.second[1]}": self.second[2]}
@@ -120,6 +122,16 @@ class NextOutcome:
                      "most_likely_to_fail": worst[0] if worst else None},
             "gun": self.gun, "confidence": self.confidence, "reached": self.reached,
             "proposal": self.proposal, "files": self.files, "warnings": self.warnings})
+
+
+def _whole_record(update: LawUpdate) -> dict[str, Any]:
+    """The law fitted whole and the test of the scale and tilt against it (``--json`` and the
+    proposal): whether it is the update's, the chi-square, its p, and its nodes' intervals."""
+    assert update.shape is not None
+    chi, dof, p = update.shape
+    return {"whole": update.is_whole, "shape_chi2": chi if math.isfinite(chi) else None,
+            "shape_dof": dof, "shape_p": p if math.isfinite(p) else None,
+            "whole_nodes": [n.record() for n in update.nodes]}
 
 
 def default_output(shot: Path) -> Path:
@@ -136,7 +148,7 @@ def run(request: NextRequest) -> NextOutcome:
     """
     from ..readers.recording import input_file
     from ..shot import Shot
-    from ..studies.closed_loop import GUN_SHOTS, law_scatter, update_scale
+    from ..studies.closed_loop import GUN_SHOTS, law_scatter, update_law
 
     output = _checked(request)
     shot = Shot.from_workbook(request.shot)
@@ -157,7 +169,7 @@ def run(request: NextRequest) -> NextOutcome:
     sds = _scatter(request, estimated)
     verdict = _judge(request, spec)
     params, traces = _read_lot(lot_shots)
-    update = update_scale(params, traces, prior, spec.judged.cfc, request.integrator,
+    update = update_law(params, traces, prior, spec.judged.cfc, request.integrator,
                           velocities=estimated or request.gun is not None)
     sds, gun, gun_warnings = _gun(request, update, sds, len(lot_shots), shot.params.v31,
                                   others, freedom)
@@ -476,7 +488,8 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
     try:
         with signals_held():
             ref = store_law(request.archive, request.lot, update.law, lot_shots,
-                            [{"shot": s["shot"]} for s in lot_shots], request.argv)
+                            [{"shot": s["shot"]} for s in lot_shots], request.argv,
+                            [n.record() for n in update.nodes] if update.is_whole else None)
             version = int(ref.rpartition("@")[2])
             done.append(StoredVerdict(Path(request.archive) / LAWS / request.lot /
                                       f"v{version:04d}.json", Archive(request.archive)))
@@ -493,6 +506,7 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
                   "law": ref, "scale": update.scale, "scale_error": update.error,
                   **({"tilt": update.tilt, "tilt_error": update.tilt_error,
                       "tilt_about": update.v_ref} if update.tilted else {}),
+                  **(_whole_record(update) if update.shape else {}),
                   "setting_A28": best.setting,
                   **({"second_cell": request.vary and second_knob(request.vary).cell,
                       "second_value": best.second} if request.vary else {}),
@@ -558,9 +572,7 @@ def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: V
              f"of the gun ({', '.join(request.sd)}) and the law), seed {request.seed}",
              gun,
              f"most likely to fail: {worst[0] if worst else 'none'}",
-             f"the lot's law {ref}: the prior scaled by {update.scale:.4f} +/- "
-             f"{update.error:.4f}{tilt_text(update)} on {update.shots} "
-             f"shot{'s' * (update.shots > 1)}; {update.note}",
+             f"the lot's law {ref}: {update_text(update)}; {update.note}",
              f"from {request.shot} ({verdict.word}), recording {request.recording}")
     assert designed.source is not None
     options = Options(request.integrator, force=request.force, command=request.argv,
@@ -579,6 +591,16 @@ def tilt_text(update: LawUpdate) -> str:
             f"{update.v_ref:.4g} m/s")
 
 
+def update_text(update: LawUpdate, errors: str = "") -> str:
+    """What the law's update is: the prior scaled (and tilted), or the law fitted whole."""
+    n = update.shots
+    shots = f"on {n} shot{'s' * (n > 1)}"
+    if update.is_whole:
+        return f"the law fitted whole at its {len(update.nodes)} nodes {shots}"
+    return (f"the prior scaled by {update.scale:.4f} +/- {update.error:.4f}{errors}"
+            f"{tilt_text(update)} {shots}")
+
+
 def lines(request: NextRequest, outcome: NextOutcome) -> list[str]:
     """What ``next`` prints: the fired shot's verdict, the law's update, the next setting
     with its P(PASS), the files and the archive's records."""
@@ -590,9 +612,8 @@ def lines(request: NextRequest, outcome: NextOutcome) -> list[str]:
     said = verdict_lines(outcome.verdict, f"{request.recording} against {request.shot}")
     if outcome.counted_once:
         said.append("  this shot was recorded in the lot before: counted once")
-    said += [f"lot {request.lot}: the law {outcome.law}, the prior scaled by {u.scale:.4f} "
-             f"+/- {u.error:.4f} (1 standard error){tilt_text(u)} on {u.shots} shot"
-             f"{'s' * (u.shots > 1)}", f"  {u.note}",
+    said += [f"lot {request.lot}: the law {outcome.law}, "
+             f"{update_text(u, ' (1 standard error)')}", f"  {u.note}",
              f"next: {setting_text(request, b)}, P(PASS) = {b.probability:.4f} "
              f"[{lo:.4f}, {hi:.4f}] over {b.shots:,} draws"
              + (f"; most likely to fail: {worst[0]}" if worst else ""),

@@ -273,9 +273,10 @@ def refine_law(pairs, law, integrator="legacy", degree=DEGREE):
 
     Returns
     -------
-    (CrushLaw, int, numpy.ndarray, numpy.ndarray, numpy.ndarray)
+    (CrushLaw, int, numpy.ndarray, numpy.ndarray, numpy.ndarray, numpy.ndarray)
         The law, the runs it took, the nodes [m/s], the standard errors of the law's values
-        there [-] and each shot's share in them (nodes x shots; :func:`error_budget`).
+        there [-], each shot's share in them (nodes x shots; :func:`error_budget`) and their
+        covariance (nodes x nodes).
     """
     from scipy.optimize import least_squares
 
@@ -298,10 +299,11 @@ def refine_law(pairs, law, integrator="legacy", degree=DEGREE):
     scale = np.concatenate([np.abs(x0[:len(nodes)]), np.full(len(pairs), 0.1)])
     fit = least_squares(residuals, x0, bounds=(lo, hi), x_scale=scale, diff_step=1e-4,
                         max_nfev=150)
-    errors, shares = error_budget(fit, residual_blocks([rec for _, rec in pairs]), residuals,
-                                  scale)
-    return (law_through(nodes, fit.x[:len(nodes)], law.v_range), evaluations[0], nodes,
-            errors[:len(nodes)], shares[:len(nodes)])
+    errors, shares, covariance = error_budget(fit, residual_blocks([rec for _, rec in pairs]),
+                                              residuals, scale, covariance=True)
+    k = len(nodes)
+    return (law_through(nodes, fit.x[:k], law.v_range), evaluations[0], nodes, errors[:k],
+            shares[:k], covariance[:k, :k])
 
 
 #: The standard error of a median of n samples of Gaussian noise sigma is this times
@@ -793,6 +795,7 @@ class Calibration:
     law_nodes: np.ndarray | None = None  # [m/s] where the law's standard errors are
     law_errors: np.ndarray | None = None  # [-] standard errors of the law's values there
     law_shares: np.ndarray | None = None  # [-] each shot's share in them (nodes x shots)
+    law_covariance: np.ndarray | None = None  # [-] of the law's values there (nodes x nodes)
     recordings: list = field(default_factory=list)  # each shot's measured Recording
     law_intervals: list = field(default_factory=list)  # NodeInterval of each law node
     warnings: list = field(default_factory=list)
@@ -941,11 +944,11 @@ def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objecti
 
     before = [score(align(run, r)) for run, r in zip(first, recs, strict=True)]
     counter["runs"] += len(params)
-    law_cal, nodes, law_errors, law_shares = None, None, None, None
+    law_cal, nodes, law_errors, law_shares, law_covariance = None, None, None, None, None
     if law:
         law_cal = calibrate_law(pairs, cfc, degree, integrator)
         counter["runs"] += len(law_cal.iterations) * len(pairs)
-        refined, evaluations, nodes, law_errors, law_shares = refine_law(
+        refined, evaluations, nodes, law_errors, law_shares, law_covariance = refine_law(
             pairs, law_cal.law, integrator, degree)
         counter["runs"] += evaluations * len(pairs)
         params = [p.replace(crush_law=refined) for p in params]
@@ -964,8 +967,8 @@ def calibrate(params, traces, law=True, fit=(), cfc=None, degree=DEGREE, objecti
     after = [score(a) for a in aligned]
     cal = Calibration(params, law_cal, fitted, start, before, after, aligned,
                       counter["runs"], time.perf_counter() - started, errors, bounds, nodes,
-                      law_errors, law_shares, recs, velocities=velocity_fit,
-                      covariance=covariance)
+                      law_errors, law_shares, law_covariance, recs,
+                      velocities=velocity_fit, covariance=covariance)
     for rec, run in zip(recs, runs, strict=True):  # the same runs, cross-checked
         cal.warnings += [f"{rec.trace.name}: {w}" for w in rec.warnings]
         ok = np.isfinite(run.accel_kg)
@@ -1028,6 +1031,16 @@ class NodeInterval:
     @property
     def high(self):
         return self.value + Z95 * self.error
+
+    def record(self):
+        """The node as the archive keeps it (a law's ``intervals``; a value that is not
+        finite, as an unpinned node's error, kept as null: JSON has no infinity)."""
+        def number(x):
+            return float(x) if np.isfinite(x) else None
+
+        return {"velocity": number(self.velocity), "value": number(self.value),
+                "error": number(self.error), "low": number(self.low),
+                "high": number(self.high), "weak": bool(self.weak)}
 
     def pinned_by(self):
         return ", ".join(f"shot {k} ({v:.1f} m/s, {share:.0%})" for k, v, share in self.shares)

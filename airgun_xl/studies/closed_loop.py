@@ -1,21 +1,24 @@
 """The closed loop (issue 45): a lot's crush law updated by every shot fired from it, and the
 next setting chosen on what the lot is now known to be.
 
-- :func:`update_scale`: the lot's prior law (its previous version, or the report's law for a
+- :func:`update_law`: the lot's prior law (its previous version, or the report's law for a
   new lot) scaled to every shot of the lot by least squares (:func:`~.calibrate.calibrate`
   with ``fit=("scale",)``), with the scale's standard error. A scale is what one shot, or
   shots at one speed, can pin. Once the shots' impact speeds spread over :data:`TILT_SPAN`,
   the law's tilt with speed is fitted with it (its first-order shape, about the shots' mean
   speed), with the two's covariance; the higher-order shape stays the prior's (said in
-  :attr:`LawUpdate.note`).
+  :attr:`LawUpdate.note`). From :data:`WHOLE_SHOTS` such shots the whole law is fitted too
+  (its 7 nodes and their covariance) and the scaled and tilted law tested against it
+  (:func:`shape_test`): where the shots show a shape the scale and tilt cannot follow, the
+  whole law is the update, drawn from its nodes' covariance.
 - :func:`gun_scatter`: the gun's shot-to-shot scatter, from the lot's shots' launch
-  velocities fitted with the scale (:func:`update_scale` with ``velocities``) against their
+  velocities fitted with the scale (:func:`update_law` with ``velocities``) against their
   set values, once :data:`GUN_SHOTS` shots exist; :func:`pooled_scatter`, the same from the
   shots of every lot one gun fired (each lot's about its own mean).
 - :func:`law_scatter`: the scale's standard error as a scatter of the law (relative, around
-  1), or the scale's and the tilt's covariance, drawn with the gun's and zeta's by
-  :func:`~.first_shot.pass_probability` (the law known to its standard error: a posterior,
-  not a shot-to-shot scatter).
+  1), the scale's and the tilt's covariance, or the whole law's nodes', drawn with the
+  gun's and zeta's by :func:`~.first_shot.pass_probability` (the law known to its standard
+  error: a posterior, not a shot-to-shot scatter).
 - :func:`brier` and :func:`reliability`: how honest the predictions were, once shots were
   fired at the settings proposed: the Brier score, and the observed pass rate in each band of
   predicted P(PASS) with its Wilson 95 % interval.
@@ -29,12 +32,28 @@ from typing import Any
 import numpy as np
 
 from .acceptance import wilson_interval
-from .first_shot import JOINT, LAW_FIELDS, LAW_SCALE
+from .first_shot import JOINT, LAW_FIELDS, LAW_SCALE, NODES
 
 #: The lot's shots' impact speeds must spread over this fraction of the fastest before the
 #: law's tilt with speed is fitted: shots at one speed pin a tilt only through each pulse's
 #: own sweep of speeds, which the scale mostly absorbs.
 TILT_SPAN = 0.05
+
+#: Shots (spread over :data:`TILT_SPAN`) from which the whole law is fitted too, at its 7
+#: nodes, and the scaled and tilted law tested against it: two shots leave its top node
+#: weakly pinned (over +/- 2 % at 95 %) on the recorder model; three pin every node but the
+#: lowest, where the crush ends.
+WHOLE_SHOTS = 3
+
+#: The scaled and tilted law is rejected for the whole law when their values at the whole
+#: law's nodes differ by a chi-square this improbable (5 degrees of freedom: 7 nodes less
+#: the scale and tilt). The whole law's covariance alone is used, which overstates the
+#: difference's (the two fits share the shots): on a lot whose law is a scaled and tilted
+#: prior, fired exactly, the chi-square is about 1.7 (three seeds). The gun's and zeta's
+#: scatter, which neither fit models, raise it: 1.4 to 12.4 (p 0.03), mean 5.6, on eight
+#: lots of 4 shots with 1.5 % and 10 %. A lot of the report's law times 1.05 and a 10 %
+#: bump about 150 m/s gives 120 and 123 (p 1e-24). Hence 0.001 (a chi-square of 20.5).
+SHAPE_P = 0.001
 
 
 @dataclass(frozen=True)
@@ -59,14 +78,37 @@ class LawUpdate:
     tilt_error: float = math.nan
     v_ref: float = math.nan
     covariance: Any = None
+    #: with :data:`WHOLE_SHOTS` shots spread over speed: the law fitted whole
+    #: (:func:`~.calibrate.calibrate` with ``law``), and the chi-square test of the scaled and
+    #: tilted law against it (:func:`shape_test`: chi-square, degrees of freedom, p)
+    whole: Any = None  # studies.calibrate.Calibration
+    shape: tuple[float, int, float] | None = None
 
     @property
     def tilted(self) -> bool:
         return math.isfinite(self.v_ref)
 
     @property
+    def is_whole(self) -> bool:
+        """The whole law is the update's (the scale and tilt were rejected)."""
+        return self.shape is not None and self.shape[2] < SHAPE_P
+
+    @property
+    def nodes(self) -> Any:
+        """The whole law's nodes [m/s] and the 95 % intervals there (NodeInterval)."""
+        return self.whole.law_intervals if self.whole is not None else []
+
+    @property
     def warnings(self) -> list[str]:
         said = list(self.calibration.warnings) if self.calibration is not None else []
+        if self.is_whole:
+            said += [w for w in self.whole.warnings if w not in said]
+            weak = [n for n in self.nodes if n.weak]
+            if weak:
+                said.append("the lot's law, fitted whole, is weakly pinned at "
+                            + ", ".join(f"{n.velocity:.1f} m/s (+/- {n.half_width:.1%})"
+                                        for n in weak)
+                            + ": P(PASS) draws it that widely there")
         if self.tilted and not np.all(np.isfinite(np.asarray(self.covariance, float))):
             said.append("the law's scale and tilt have no covariance (the fit could not "
                         "estimate one): P(PASS) draws the scale alone, and is optimistic")
@@ -77,10 +119,13 @@ class LawUpdate:
         return said
 
 
-def update_scale(params, traces, prior, cfc=None, integrator="legacy", velocities=False):
+def update_law(params, traces, prior, cfc=None, integrator="legacy", velocities=False,
+               whole=True):
     """The prior law scaled to the shots (``params`` each with its set values, ``traces``
     each its recording), by least squares on the filtered pulses; with ``velocities``, each
-    shot's launch velocity fitted with it (:attr:`LawUpdate.launch`).
+    shot's launch velocity fitted with it (:attr:`LawUpdate.launch`). Spread over speed, its
+    tilt is fitted too; from :data:`WHOLE_SHOTS` such shots (and ``whole``), the whole law
+    is fitted as well and replaces the scale and tilt where :func:`shape_test` rejects them.
 
     Returns
     -------
@@ -111,9 +156,47 @@ def update_scale(params, traces, prior, cfc=None, integrator="legacy", velocitie
         law = prior.scaled(scale)
     if velocities:
         note += "; each shot's launch velocity fitted with it"
+    fitted, shape = None, None
+    if whole and math.isfinite(v_ref) and n >= WHOLE_SHOTS:
+        fitted = calibrate([p.replace(crush_law=law) for p in params], traces, law=True,
+                           cfc=cfc, integrator=integrator)
+        shape = shape_test(law, fitted)
+        chi, dof, p_value = shape
+        if p_value < SHAPE_P:
+            law = fitted.params[0].crush_law
+            pinned = sum(not node.weak for node in fitted.law_intervals)
+            note = (f"{n} shots at {lo:.4g} to {hi:.4g} m/s pin the law whole ({pinned} of "
+                    f"its {len(fitted.law_intervals)} nodes within +/- 2 % at 95 %, over "
+                    f"{law.v_range[0]:.4g} to {law.v_range[1]:.4g} m/s): a scale and a tilt "
+                    f"of the prior cannot follow its shape (chi-square {chi:.3g} on {dof} "
+                    f"degrees of freedom, p = {p_value:.2g}); the law fitted whole is drawn "
+                    "from its nodes' covariance")
+        elif math.isfinite(p_value):
+            note += (f"; the law fitted whole agrees with them (chi-square {chi:.3g} on {dof} "
+                     f"degrees of freedom, p = {p_value:.2g})")
+        else:
+            note += "; the law fitted whole has no covariance to test them against"
     return LawUpdate(law, prior, scale, error, n, (lo, hi), cal, note,
                      tuple(tuple(v) for v in cal.velocities), tilt, tilt_error, v_ref,
-                     cal.covariance[:2, :2] if math.isfinite(v_ref) else None)
+                     cal.covariance[:2, :2] if math.isfinite(v_ref) else None, fitted, shape)
+
+
+def shape_test(law, whole):
+    """The scaled and tilted ``law`` against the law fitted ``whole`` (a Calibration with
+    its law's nodes and their covariance): (chi-square, degrees of freedom, p) of their
+    values' differences at the nodes, d^T C^+ d with C the whole law's covariance (its
+    pseudo-inverse: a node the shots leave unpinned weighs nothing), on the nodes less 2
+    degrees of freedom (scipy.stats.chi2); p NaN without a finite covariance."""
+    from scipy.stats import chi2
+
+    nodes = np.asarray(whole.law_nodes, dtype=float)
+    covariance = np.asarray(whole.law_covariance, dtype=float)
+    dof = len(nodes) - 2
+    if not np.all(np.isfinite(covariance)):
+        return math.nan, dof, math.nan
+    d = law.poly(nodes) - whole.params[0].crush_law.poly(nodes)
+    value = float(d @ np.linalg.pinv((covariance + covariance.T) / 2, hermitian=True) @ d)
+    return value, dof, float(chi2.sf(value, dof))
 
 
 #: Shots of a lot from which the gun's scatter is estimated (:func:`gun_scatter`; pooled
@@ -232,21 +315,32 @@ def law_scatter(update):
     """The ``sds`` entry that draws the law from its posterior: its scale around 1, with the
     standard error relative to the scale fitted; with a tilt, the scale (around 1) and the
     tilt (around 0, about ``v_ref``) drawn together from their covariance, to first order
-    relative to the law updated (an entry :data:`~.first_shot.JOINT`)."""
+    relative to the law updated (an entry :data:`~.first_shot.JOINT`); the law fitted whole,
+    a factor on each node's value from their covariance relative to the values (an entry
+    :data:`~.first_shot.NODES`)."""
+    if update.is_whole:
+        nodes = np.asarray(update.whole.law_nodes, dtype=float)
+        values = update.law.poly(nodes)
+        factors = np.asarray(update.whole.law_covariance, float) / np.outer(values, values)
+        if np.all(np.isfinite(factors)):
+            return (LAW_SCALE, LAW_FIELDS, (_drawable(factors), nodes), NODES)
     if update.tilted:
         cov = np.asarray(update.covariance, dtype=float)
         scaled = cov * np.array([[1 / update.scale ** 2, 1 / update.scale],
                                  [1 / update.scale, 1.0]])
         if update.scale > 0 and np.all(np.isfinite(scaled)):
-            # symmetric and positive semi-definite to the last bit (the sandwich's rounding
-            # would make numpy's multivariate normal warn, or draw NaN)
-            values, vectors = np.linalg.eigh((scaled + scaled.T) / 2)
-            scaled = (vectors * np.clip(values, 0.0, None)) @ vectors.T
-            return (LAW_SCALE, LAW_FIELDS, (scaled, update.v_ref), JOINT)
+            return (LAW_SCALE, LAW_FIELDS, (_drawable(scaled), update.v_ref), JOINT)
     relative = update.error / update.scale if update.scale > 0 else math.nan
     if not (math.isfinite(relative) and relative >= 0):
         relative = 0.0
     return (LAW_SCALE, LAW_FIELDS, relative, True)
+
+
+def _drawable(covariance):
+    """A covariance symmetric and positive semi-definite to the last bit (the sandwich's
+    rounding would make numpy's multivariate normal warn, or draw NaN)."""
+    values, vectors = np.linalg.eigh((covariance + covariance.T) / 2)
+    return (vectors * np.clip(values, 0.0, None)) @ vectors.T
 
 
 def brier(predicted, passed):

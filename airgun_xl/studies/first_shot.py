@@ -295,6 +295,12 @@ LAW_SCALE, LAW_FIELDS = "scale", ("crush_law",)
 #: draws, the second named :data:`LAW_TILT`.
 JOINT, LAW_TILT = "joint", ("crush_law_tilt",)
 
+#: An ``sds`` entry ``(LAW_SCALE, LAW_FIELDS, (covariance, nodes), NODES)`` draws the whole
+#: law: a factor (around 1) on its value at each of its ``nodes`` [m/s], together from their
+#: covariance (relative), and the law through the products (:func:`~.calibrate.law_through`):
+#: a column of the draws a node, each named :data:`LAW_NODE`.
+NODES, LAW_NODE = "nodes", ("crush_law_node",)
+
 
 def _mean(p, fields):
     return 1.0 if fields == LAW_FIELDS else getattr(p, fields[0])
@@ -315,6 +321,12 @@ def draws(p, sds, n, seed):
                                            method="eigh")
             columns += [pair[:, 0], pair[:, 1]]
             names += [LAW_FIELDS, LAW_TILT]
+        elif relative == NODES:  # the whole law: a factor on each node's value, together
+            covariance = np.asarray(sd[0], dtype=float)
+            factors = rng.multivariate_normal(np.ones(len(covariance)), covariance, n,
+                                              method="eigh")
+            columns += list(factors.T)
+            names += [LAW_NODE] * len(covariance)
         else:
             columns.append(rng.normal(_mean(p, fields), sd * abs(_mean(p, fields)) if relative
                                       else sd, n))
@@ -341,10 +353,13 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
     base = var.apply(p, setting) if var is not None and setting is not None else p
     first, second = setting if isinstance(setting, tuple) else (setting, math.nan)
     params, invalid = [], np.zeros(n, dtype=bool)
-    law = (LAW_FIELDS, LAW_TILT)
+    law = (LAW_FIELDS, LAW_TILT, LAW_NODE)
     offsets = [(fields, 0.0 if fields in law else
                 getattr(base, fields[0]) - getattr(p, fields[0])) for fields in fields_list]
     v_ref = next((sd[2][1] for sd in sds if sd[3] == JOINT), math.nan)
+    nodes = next((np.asarray(sd[2][1], float) for sd in sds if sd[3] == NODES), None)
+    at_nodes = base.crush_law.poly(nodes) if nodes is not None else None
+    is_node = np.array([fields == LAW_NODE for fields in fields_list], dtype=bool)
     for i in range(n):
         try:
             changes = {f: float(value + shift) for (fields, shift), value
@@ -352,7 +367,15 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
                        if fields not in law}
             drawn_law = {fields: float(value) for (fields, _), value
                          in zip(offsets, values[i], strict=True) if fields in law}
-            if LAW_FIELDS in drawn_law:  # a scale at or below 0 is no law: not a shot
+            if nodes is not None:  # the whole law through its drawn node values
+                from .calibrate import law_through
+
+                factors = values[i][is_node]
+                if not np.all(factors > 0):  # a law at or below 0 somewhere: not a shot
+                    raise DesignError(f"a drawn law factor of {float(np.min(factors)):.3g}")
+                changes["crush_law"] = law_through(nodes, at_nodes * factors,
+                                                   base.crush_law.v_range)
+            elif LAW_FIELDS in drawn_law:  # a scale at or below 0 is no law: not a shot
                 value = drawn_law[LAW_FIELDS]
                 if not value > 0:
                     raise DesignError(f"a drawn law scale of {value:.3g}")
