@@ -128,7 +128,8 @@ def by_hand(lot, law, first, work, draws):
 def with_next(lot, law, first, work, draws, n_draws, calls, vary=None, gun=None):
     """Shots to the first PASS by next; each (predicted P(PASS), passed) of a proposal
     fired. With ``gun``, every lot in one archive (``work``'s parent's) and the gun's
-    scatter pooled over them (``next --gun``); ``calls`` gets (seconds, the gun's words)."""
+    scatter pooled over them (``next --gun``); ``calls`` gets (seconds, the gun's words, the
+    law's update)."""
     shot = with_velocity(work / "next0.xlsx", first)
     predicted, record = None, []
     archive = work / "archive" if gun is None else work.parent / "archive"
@@ -140,7 +141,7 @@ def with_next(lot, law, first, work, draws, n_draws, calls, vary=None, gun=None)
                                   shots=n_draws, seed=lot * 10 + k,
                                   output=work / f"next{k + 1}.xlsx", vary=vary, gun=gun,
                                   **SPEC)
-        calls.append((time.perf_counter() - started, out.gun))
+        calls.append((time.perf_counter() - started, out.gun, out.update))
         if predicted is not None:
             record.append((predicted, out.verdict.passed))
         if out.verdict.passed:
@@ -299,12 +300,17 @@ def main():
                f"law); {time.perf_counter() - started:.0f} s, next"
                f"{f' --vary {args.vary}' if args.vary else ''}"
                f"{' --gun' if args.gun else ''} "
-               f"{statistics.median(c for c, _ in calls):.2f} s a call (median)\n")
+               f"{statistics.median(c for c, _, _ in calls):.2f} s a call (median)\n")
     widths = [max(len(r[i]) for r in rows) for i in range(6)]
     for r in rows:
         print("  ".join(cell.ljust(w) for cell, w in zip(r, widths, strict=True)))
+    updates = [u for _, _, u in calls]
+    print(f"\nthe law's updates: {sum(not u.tilted for u in updates)} a scale, "
+          f"{sum(u.tilted and not u.is_whole for u in updates)} a scale and tilt "
+          f"({sum(u.shape is not None and not u.is_whole for u in updates)} of them tested "
+          f"against the law fitted whole), {sum(u.is_whole for u in updates)} the law whole")
     if args.gun:
-        pooled = [words for _, words in calls if "as given" not in words]
+        pooled = [words for _, words, _ in calls if "as given" not in words]
         print(f"\nnext --gun: {len(calls) - len(pooled)} calls drew the scatter given, "
               f"{len(pooled)} the pooled estimate; the last: "
               f"{pooled[-1] if pooled else 'none'}")
