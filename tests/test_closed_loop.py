@@ -349,7 +349,7 @@ def test_the_guns_scatter_is_estimated_from_eight_shots_launch_velocities(tmp_pa
     made = _gun_lot(tmp_path, GUN_SHOTS)
     params = [airgun_xl.load(shot).params for shot, _, _ in made]
     traces = [read_trace(str(rec), None, None, 1.0, None) for _, rec, _ in made]
-    update = update_law(params, traces, LEGACY_LAW, velocities=True)
+    update = update_law(params, traces, LEGACY_LAW, velocities=True, whole=False)
     errors = np.array([e for _, _, e in made])
     fitted = np.array([f - 1 for _, f, _ in update.launch])
     assert np.max(np.abs(fitted - errors)) < 0.004
@@ -359,7 +359,8 @@ def test_the_guns_scatter_is_estimated_from_eight_shots_launch_velocities(tmp_pa
     assert gun.sd == pytest.approx(np.std(errors, ddof=1), abs=0.0015)
     assert gun.interval[0] < 0.015 < gun.interval[1]  # the true scatter inside its interval
     assert update.scale == pytest.approx(TRUE_SCALE, abs=3 * update.error)
-    fewer = update_law(params[:-1], traces[:-1], LEGACY_LAW, velocities=True)
+    fewer = update_law(params[:-1], traces[:-1], LEGACY_LAW, velocities=True,
+                       whole=False)
     assert gun_scatter(fewer) is None
 
 

@@ -170,7 +170,7 @@ def run(request: NextRequest) -> NextOutcome:
     verdict = _judge(request, spec)
     params, traces = _read_lot(lot_shots)
     update = update_law(params, traces, prior, spec.judged.cfc, request.integrator,
-                          velocities=estimated or request.gun is not None)
+                        velocities=estimated or request.gun is not None)
     sds, gun, gun_warnings = _gun(request, update, sds, len(lot_shots), shot.params.v31,
                                   others, freedom)
     gun_warnings = [*read_warnings, *gun_warnings]

@@ -14,11 +14,12 @@ NOT_REACHED = 3
 
 
 #: What ``next --help`` says the command does.
-DESCRIPTION = ("Judge the fired shot as accept does; update the lot's crush law (its scale, and "
-               "its tilt with speed once the shots spread over speed, with their covariance) "
-               "on every shot of the lot in the archive and this one; "
-               "choose the A28 most likely to pass with the gun's scatter (--sd, or estimated "
-               "from the shots of the lot or, with --gun, of every lot of that gun) and the law "
+DESCRIPTION = ("Judge the fired shot as accept does; update the lot's crush law on every shot "
+               "of the lot in the archive and this one (its scale; its tilt with speed once "
+               "the shots spread over speed; the law whole where 3 such shots show a shape "
+               "the scale and tilt cannot follow; each with its covariance); choose the A28 "
+               "most likely to pass with the gun's scatter (--sd, or estimated from the shots "
+               "of the lot or, with --gun, of every lot of that gun) and the law "
                "drawn from its update; write NEXT.xlsx (fill runs it as it is) and keep the "
                "verdict, the law's new version and the proposal in the archive. Exit 0 when "
                "P(PASS) reaches --confidence, 3 when not (the best is written).")
