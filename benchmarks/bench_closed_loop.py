@@ -309,6 +309,16 @@ def main():
           f"{sum(u.tilted and not u.is_whole for u in updates)} a scale and tilt "
           f"({sum(u.shape is not None and not u.is_whole for u in updates)} of them tested "
           f"against the law fitted whole), {sum(u.is_whole for u in updates)} the law whole")
+    for _, _, u in calls:
+        if u.shape is not None:
+            chi, dof, p = u.shape
+            print(f"  tested: {u.shots} shots at {u.speeds[0]:.1f} to {u.speeds[1]:.1f} m/s, "
+                  f"scale {u.scale:.4f}, tilt {u.tilt:+.4f}: chi-square {chi:.3g} on {dof}, "
+                  f"p {p:.2g}{' (the law whole)' if u.is_whole else ''}; nodes' half-widths "
+                  + ", ".join(f"{n.velocity:.0f}:{n.half_width:.1%}" for n in u.nodes)
+                  + "; shifts in standard errors "
+                  + ", ".join(f"{(u.law(n.velocity) - n.value) / n.error:+.1f}"
+                              if not u.is_whole else "-" for n in u.nodes))
     if args.gun:
         pooled = [words for _, words, _ in calls if "as given" not in words]
         print(f"\nnext --gun: {len(calls) - len(pooled)} calls drew the scatter given, "
