@@ -25,7 +25,8 @@ Both meet the same lots and the same draws of the gun, zeta and the recorder's n
 
 `--call` times one `airgun-xl next` as a whole process on a lot of 5 recorded shots (the
 fifth, with the default 2,000 draws a setting; alone, with `--vary E13`, and with `--gun`
-among 199 other lots of the gun, whose records it reads): its wall time (median of 5, after a
+among 199 other lots of the gun, whose records it reads; and on a lot of 5 shots spread over
+205 to 252 m/s, where the law is fitted whole and tested): its wall time (median of 5, after a
 warm-up) and peak RSS, against the issue's 10 s and 1 GB.
 
 It prints, for both, the share of lots passed by the first, second and third shot and the
@@ -239,7 +240,39 @@ def call(quick):
                              (f"next --gun, {others} other lots of the gun", ["--gun", "GUN-1"])):
             walls, rss = timed(base + extra, 1 if quick else 5)
             rows.append((label, statistics.median(walls), max(rss)))
+        # the same options on a lot spread over speed
+        spread = [*base[:3], *spread_lot(work / "spread", law, rng),
+                  *base[base.index("--sd"):]]
+        walls, rss = timed(spread, 1 if quick else 5)
+        rows.append(("next, 5 shots at 205-252 m/s (whole law)", statistics.median(walls),
+                     max(rss)))
     return rows
+
+
+def spread_lot(work, law, rng):
+    """A lot of 4 shots at 205, 220, 232 and 244 m/s recorded (its proposal through the
+    archive's own store, each file by its SHA-256) and a fifth at 252 m/s: the arguments of
+    next on the fifth, the law fitted whole and tested (from 3 shots spread over speed)."""
+    import hashlib
+
+    from airgun_xl.archive.lots import proposals, store_proposal
+
+    work.mkdir()
+    files = []
+    for k, v in enumerate((205.0, 220.0, 232.0, 244.0, 252.0)):
+        shot = with_velocity(work / f"s{k}.xlsx", v)
+        files.append((shot, fire(shot, law, (rng.normal(), rng.normal(), k), work / f"r{k}.csv")))
+    archive = work / "archive"
+    airgun_xl.next_shot(*files[0], archive=archive, lot="LOT-W", new_lot=True,
+                        sd=f"A28={GUN:.1%}", shots=200, output=work / "n0.xlsx", **SPEC)
+    record = dict(proposals(archive, "LOT-W")[-1][1])
+    record["shots"] = [{"shot": str(s), "recording": str(r), "sign": 1.0,
+                        "shot_sha256": hashlib.sha256(s.read_bytes()).hexdigest(),
+                        "recording_sha256": hashlib.sha256(r.read_bytes()).hexdigest()}
+                       for s, r in files[:4]]
+    store_proposal(archive, "LOT-W", record)
+    return ["next", str(files[4][0]), str(files[4][1]), "--archive", str(archive), "--lot",
+            "LOT-W"]
 
 
 def main():

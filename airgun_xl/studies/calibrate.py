@@ -837,6 +837,14 @@ POOR_FIT = 0.10
 AT_BOUND = 0.01
 
 
+def at_bound(cal):
+    """The names of ``cal``'s fitted values within :data:`AT_BOUND` of their range from a
+    bound (a Calibration's ``fitted`` and ``bounds``)."""
+    return [name for name, value in cal.fitted.items()
+            if min(value - cal.bounds[name][0], cal.bounds[name][1] - value)
+            <= AT_BOUND * (cal.bounds[name][1] - cal.bounds[name][0])]
+
+
 def verdict(cal, cfc, objective, p0):
     """(warnings, notes) of a calibration.
 
@@ -848,12 +856,13 @@ def verdict(cal, cfc, objective, p0):
     from ..engine.summary import natural_frequencies
 
     found, notes = [], []
+    bounded = at_bound(cal)
     for name, value in cal.fitted.items():
         lo, hi = cal.bounds[name]
         error = cal.errors.get(name, np.inf)
         # the tilt is no --fit name: next fits it with the scale (docs/studies.md)
         shown = "the law's tilt with speed" if name == "tilt" else f"--fit {name}"
-        if min(value - lo, hi - value) <= AT_BOUND * (hi - lo):
+        if name in bounded:
             found.append(f"{shown}: {value:.6g} is at its bound ({lo:.4g}..{hi:.4g}): "
                          "not identified by these pulses")
         elif not error <= UNIDENTIFIED * (TILT_REACH if name == "tilt" else abs(value)):
