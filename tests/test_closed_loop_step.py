@@ -92,3 +92,22 @@ def test_next_sets_the_gun_to_its_step_and_says_what_it_rounded(tmp_path):
     book = openpyxl.load_workbook(out.output, read_only=True)
     text = [str(c) for row in book["Summary"].iter_rows(values_only=True) for c in row if c]
     assert any(said in t for t in text)
+
+
+def test_a_pair_is_set_on_both_knobs_grids():
+    """--vary E13 with --step A28=0.5 and --step E13=0.001 (1 mm of the radius): the four
+    settable neighbours of the best pair found are each run on the same draws, and the pair
+    chosen is the one most likely to pass among them (shot A, 200 draws, the duration to
+    10 %: the velocity alone cannot meet it on a stronger lot, so the radius moves)."""
+    shot = airgun_xl.load(TEMPLATE)
+    spec = resolve(shot, keyword_fields("test", {"peak": "8.5kG:5%",
+                                                  "duration": "4.5ms:10%"}))
+    found = solve_confidence(shot.params, spec, variable("A28"), parse_sds(GUN), 200, 1,
+                             keep_middle=False, second=variable("E13"), steps=(0.5, 0.001))
+    at = (found.unrounded.setting, found.unrounded.second)
+    near = settable(at, (0.5, 0.001), [RANGE, variable("E13").bounds(shot.params)])
+    assert len(near) == 4 and at not in near
+    grid = found.tried[-4:]
+    assert [(r.setting, r.second) for r in grid] == near
+    assert (found.best.setting, found.best.second) in near
+    assert found.best.probability == max(r.probability for r in grid)
