@@ -640,13 +640,15 @@ def next_shot(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *
               vary: str | None = None, scheduler: str | None = None,
               workers: int | None = None, chunk: int | None = None,
               pdf: str | os.PathLike[str] | None = None, gun: str | None = None,
+              step: str | Sequence[str] = (),
               **spec: Unpack[SpecKeywords]) -> NextOutcome:
     """The closed loop, as ``airgun-xl next`` runs it: judge the fired ``shot``'s
     ``recording``, update ``lot``'s law in ``archive`` on every shot of the lot, choose the
     A28 (with ``vary``, also a second knob: ``"E13"``, ``"E16"`` or ``"A2"``) most likely to
     pass with the gun's scatter (``sd=["A28=1.5%"]``) and the law drawn from its update
     (on a Dask cluster with ``scheduler`` or ``workers``, ``chunk`` shots a task; with
-    ``gun``, the gun's scatter estimated from every lot that gun fired), write the
+    ``gun``, the gun's scatter estimated from every lot that gun fired; with ``step``, such
+    as ``["A28=0.5"]``, the best setting the knobs can be set to), write the
     next shot's workbook (``output``, else SHOT.next.xlsx) and keep the verdict, the law's
     version and the proposal in the archive.
 
@@ -677,7 +679,8 @@ def next_shot(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *
         None if vary is None else str(vary), None if scheduler is None else str(scheduler),
         None if workers is None else _whole("--workers", workers),
         None if chunk is None else _whole("--chunk", chunk),
-        None if pdf is None else _path("--pdf", pdf), None if gun is None else str(gun)))
+        None if pdf is None else _path("--pdf", pdf), None if gun is None else str(gun),
+        _texts(step)))
 
 
 __all__ = [

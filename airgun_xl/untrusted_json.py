@@ -113,7 +113,12 @@ SCHEMAS: dict[str, dict] = {
             "interval": {"type": "array", "items": _NUMBER, "minItems": 2, "maxItems": 2},
             "draws": {"type": "integer"}, "most_likely_to_fail": {"type": ["string", "null"]},
             "confidence": _NUMBER, "reached": {"type": "boolean"}, "sd": _TEXTS,
-            "gun": _TEXT, "gun_name": _TEXT,
+            "gun": _TEXT, "gun_name": _TEXT, "step": _TEXTS,
+            "unrounded": {"type": "object", "required": ["A28_m_s", "p_pass"],
+                          "properties": {"A28_m_s": _NUMBER,
+                                         "p_pass": {"type": "number", "minimum": 0,
+                                                    "maximum": 1}},
+                          "description": "the best found between the knobs' steps"},
             "launch": {"type": "array", "items": {
                 "type": "object",
                 "required": ["shot_sha256", "recording_sha256", "speed_m_s", "factor",

@@ -198,7 +198,9 @@ def test_a_second_knob_passes_a_lot_the_velocity_alone_cannot(tmp_path):
 @pytest.mark.parametrize("case", ["unknown lot", "no tolerances", "no peak or duration",
                                   "empty recording", "changed shot", "no gun scatter",
                                   "vary A28", "vary E40", "vary unknown",
-                                  "chunk without a cluster"])
+                                  "chunk without a cluster", "step zero",
+                                  "step of a knob not set", "step twice",
+                                  "step past the range"])
 def test_bad_input_is_one_line_and_nothing_is_written_or_recorded(lot, tmp_path, case,
                                                                    capsys):
     work, first, _ = lot
@@ -221,6 +223,10 @@ def test_bad_input_is_one_line_and_nothing_is_written_or_recorded(lot, tmp_path,
         argv[8] = "E43=10%"
     elif case == "chunk without a cluster":
         argv += ["--chunk", "64"]
+    elif case.startswith("step"):
+        argv += {"step zero": ["--step", "A28=0"], "step of a knob not set": ["--step", "E13=1"],
+                 "step twice": ["--step", "A28=0.5", "--step", "A29=1"],
+                 "step past the range": ["--step", "A28=300"]}[case]
     elif case.startswith("vary"):
         argv += ["--vary", {"vary A28": "A28", "vary E40": "E40", "vary unknown": "Q9"}[case]]
     else:  # a shot of the lot edited after it was recorded
@@ -244,7 +250,12 @@ def test_bad_input_is_one_line_and_nothing_is_written_or_recorded(lot, tmp_path,
                 "vary A28": "--vary: found 'A28', expected a second knob",
                 "vary E40": "--vary: found 'E40', expected a second knob",
                 "vary unknown": "--vary: found 'Q9', expected one of",
-                "chunk without a cluster": "--chunk: found it without --scheduler"}[case]
+                "chunk without a cluster": "--chunk: found it without --scheduler",
+                "step zero": "--step: found 'A28=0', expected CELL=STEP with CELL one of A28",
+                "step of a knob not set": "--step: found 'E13=1', expected CELL=STEP",
+                "step twice": "--step: found A28 twice",
+                "step past the range": "--step: found 'A28=300', which has no multiple in "
+                                       "the range A28 is searched over (10 to 260 m/s)"}[case]
     assert expected in err[0], err[0]
     assert not math.isnan(first.best.probability)
 

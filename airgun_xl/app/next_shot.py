@@ -71,6 +71,7 @@ class NextRequest:
     chunk: int | None = None  # shots a cluster task
     pdf: Path | None = None  # the next shot's report as a PDF too
     gun: str | None = None  # the gun's name: its scatter pooled over the lots it fired
+    step: tuple[str, ...] = ()  # what the knobs can be set to: A28=0.5 (m/s), E13=...
 
 
 #: The second knobs ``next --vary`` takes: the mitigator's geometry and the exchange mass
@@ -97,6 +98,8 @@ class NextOutcome:
     warnings: tuple[str, ...]
     second: tuple[str, str, float] | None = None  # (cell, unit, value) set with A28 (vary)
     gun: str = ""  # the gun's scatter drawn, and where it came from
+    #: with ``step``: the best found between the steps (``best`` is the best on them)
+    unrounded: PassProbability | None = None
 
     def to_json(self) -> str:
         """``next --json``: the verdict, the law's update, the setting and its P(PASS)."""
@@ -119,7 +122,9 @@ class NextOutcome:
                         if self.second else {}),
                      "p_pass": self.best.probability,
                      "interval": [lo, hi], "draws": self.best.shots,
-                     "most_likely_to_fail": worst[0] if worst else None},
+                     "most_likely_to_fail": worst[0] if worst else None,
+                     **({"unrounded": unrounded_record(self.unrounded, self.second)}
+                        if self.unrounded is not None else {})},
             "gun": self.gun, "confidence": self.confidence, "reached": self.reached,
             "proposal": self.proposal, "files": self.files, "warnings": self.warnings})
 
@@ -132,6 +137,69 @@ def _whole_record(update: LawUpdate) -> dict[str, Any]:
     return {"whole": update.is_whole, "shape_chi2": chi if math.isfinite(chi) else None,
             "shape_dof": dof, "shape_p": p if math.isfinite(p) else None,
             "whole_nodes": [n.record() for n in update.nodes]}
+
+
+def unrounded_record(unrounded: PassProbability,
+                     second: tuple[str, str, float] | None) -> dict[str, Any]:
+    """The best found between the knobs' steps (``--json`` and the proposal)."""
+    return {"A28_m_s": unrounded.setting,
+            **({f"{second[0]}_{second[1]}": unrounded.second} if second else {}),
+            "p_pass": unrounded.probability}
+
+
+#: The finest ``--step`` taken, in the knob's unit (SI: 1 nm of a radius, 1 nm/s of A28):
+#: below it a step is no setting a knob has, and the grid's count would overflow.
+STEP_FLOOR = 1e-9
+
+
+def steps_of(request: NextRequest, p: Any = None) -> tuple[float | None, ...] | None:
+    """``--step``: what A28 and the ``--vary`` knob can be set to, each a step in its unit
+    (None: any value); None without ``--step``. One line for a step that is not a positive
+    number, a cell that is neither, a cell given twice, or (with the shot's parameters
+    ``p``) a step with no multiple in the range its knob is searched over."""
+    import re
+
+    from ..studies.design import variable
+
+    if not request.step:
+        return None
+    knobs = [address("v31")] + ([second_knob(request.vary).cell] if request.vary else [])
+    steps: list[float | None] = [None] * len(knobs)
+    for text in request.step:
+        match = re.fullmatch(r"\s*([A-Za-z]+[0-9]+)\s*=\s*([0-9.eE+-]+)\s*", str(text))
+        value = math.nan
+        if match is not None:
+            try:
+                value = float(match.group(2))
+            except ValueError:
+                pass
+        cell = match.group(1).upper() if match is not None else ""
+        if cell in (address("v32"), address("v33")):
+            cell = address("v31")
+        if not (math.isfinite(value) and value >= STEP_FLOOR) or cell not in knobs:
+            raise OptionError(f"--step: found {text!r}, expected CELL=STEP with CELL one of "
+                              f"{', '.join(knobs)} (A28, and the --vary knob) and STEP a "
+                              f"number of at least {STEP_FLOOR:g} in its unit, such as "
+                              "A28=0.5 (m/s)")
+        k = knobs.index(cell)
+        if steps[k] is not None:
+            raise OptionError(f"--step: found {cell} twice, expected one step a knob")
+        steps[k] = value
+        if p is not None:
+            lo, hi = variable(cell).bounds(p)
+            if not math.ceil(lo / value) * value <= hi:
+                raise OptionError(f"--step: found {text!r}, which has no multiple in the range "
+                                  f"{cell} is searched over ({lo:.6g} to {hi:.6g} "
+                                  f"{variable(cell).unit}); expected a step it can be set to "
+                                  "within it")
+    return tuple(steps)
+
+
+def rounded_text(request: NextRequest, unrounded: PassProbability) -> str:
+    """What ``--step`` did to the setting: the steps, and the best found between them."""
+    return (f"set to the knobs' steps ({', '.join(request.step)}): the best between them, "
+            f"{setting_text(request, unrounded)}, had P(PASS) = "
+            f"{unrounded.probability:.4f} on the same draws")
 
 
 def default_output(shot: Path) -> Path:
@@ -154,6 +222,7 @@ def run(request: NextRequest) -> NextOutcome:
     shot = Shot.from_workbook(request.shot)
     spec = require(resolve(shot, request.spec), request.shot)
     _tolerances(spec)
+    steps_of(request, shot.params)
     prior, earlier = _lot(request)
     this = {"shot": str(request.shot), "shot_sha256": _sha256(request.shot, "workbook"),
             "recording": str(request.recording),
@@ -175,8 +244,8 @@ def run(request: NextRequest) -> NextOutcome:
                                   others, freedom)
     gun_warnings = [*read_warnings, *gun_warnings]
     p_next = shot.params.replace(crush_law=update.law)
-    best, conf_warnings = _choose(request, spec, p_next, [*sds, law_scatter(update)],
-                                  _noise(verdict))
+    best, unrounded, conf_warnings = _choose(request, spec, p_next,
+                                             [*sds, law_scatter(update)], _noise(verdict))
     reached = best.probability >= request.confidence and best.interval[1] >= request.confidence
     warnings = list(dict.fromkeys([*map(str, shot.warnings), *verdict.warnings,
                                    *update.warnings, *gun_warnings, *conf_warnings]))
@@ -185,7 +254,7 @@ def run(request: NextRequest) -> NextOutcome:
                         f" reaches P(PASS) = {request.confidence:g}; the best found is "
                         f"{best.probability:.4f} at {setting_text(request, best)}")
     return _publish(request, output, shot, spec, verdict, update, best, reached, lot_shots,
-                    counted_once, warnings, gun)
+                    counted_once, warnings, gun, unrounded)
 
 
 def _checked(request: NextRequest) -> Path:
@@ -211,6 +280,7 @@ def _checked(request: NextRequest) -> Path:
                           "digits, '-', '_' and '.' (such as GUN-4IN)")
     if request.vary is not None:
         second_knob(request.vary)
+    steps_of(request)
     from .running import check_cluster
 
     check_cluster(request.scheduler, request.workers, request.chunk)  # before the law's fit
@@ -453,11 +523,12 @@ def _noise(verdict: Verdict) -> float:
     return noise if math.isfinite(noise) and noise > 0 else 0.0
 
 
-def _choose(request: NextRequest, spec: Any, p: Any, sds: list[Any],
-            noise: float) -> tuple[PassProbability, list[str]]:
+def _choose(request: NextRequest, spec: Any, p: Any, sds: list[Any], noise: float
+            ) -> tuple[PassProbability, PassProbability | None, list[str]]:
     """The A28 most likely to pass, drawing the gun, zeta and the law, each prediction judged
     as a recording of the fired shot's noise would be (on the batch lanes, or a Dask
-    cluster: the same draws, the same shots, the same P(PASS))."""
+    cluster: the same draws, the same shots, the same P(PASS)); with ``step``, the best the
+    knobs can be set to, and the best found between their steps."""
     from ..studies.design import variable
     from ..studies.first_shot import solve_confidence
     from .running import cluster_runner
@@ -466,14 +537,16 @@ def _choose(request: NextRequest, spec: Any, p: Any, sds: list[Any],
     with cluster_runner(request.scheduler, request.workers, request.chunk) as runner:
         found = solve_confidence(p, spec, variable(address("v31")), sds, request.shots,
                                  request.seed, integrator=request.integrator, noise=noise,
-                                 runner=runner, second=second, keep_middle=False)
-    return found.best, list(found.warnings)
+                                 runner=runner, second=second, keep_middle=False,
+                                 steps=steps_of(request))
+    return found.best, found.unrounded, list(found.warnings)
 
 
 def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: Verdict,
              update: LawUpdate, best: PassProbability, reached: bool,
              lot_shots: list[dict[str, Any]], counted_once: bool,
-             warnings: list[str], gun: str) -> NextOutcome:
+             warnings: list[str], gun: str,
+             unrounded: PassProbability | None = None) -> NextOutcome:
     """Store the law's new version, write the next shot's workbook, keep the verdict and the
     proposal; a failure takes back what was done."""
     from ..archive import Archive
@@ -494,7 +567,8 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
             done.append(StoredVerdict(Path(request.archive) / LAWS / request.lot /
                                       f"v{version:04d}.json", Archive(request.archive)))
         law = CrushLaw(update.law.coefficients, update.law.v_range, "fitted", source=ref)
-        _write(request, output, shot, spec, verdict, update, best, law, ref, warnings, gun)
+        _write(request, output, shot, spec, verdict, update, best, law, ref, warnings, gun,
+               unrounded)
         done += [output] + ([request.pdf] if request.pdf is not None else [])
         with signals_held():
             done.append(store_verdict(request.archive, shot, verdict, request.recording,
@@ -513,6 +587,9 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
                   "p_pass": best.probability,
                   "interval": [lo, hi], "draws": best.shots,
                   "most_likely_to_fail": worst[0] if worst else None,
+                  **({"step": list(request.step),
+                      "unrounded": unrounded_record(unrounded, knob_value(request, unrounded))}
+                     if unrounded is not None else {}),
                   "confidence": request.confidence, "reached": reached,
                   "sd": list(request.sd), "gun": gun, "seed": request.seed,
                   **({"gun_name": request.gun,
@@ -537,17 +614,23 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
                 thing.take_back()
         raise
     proposal = f"{request.lot}@{int(stored.path.stem[1:])}"
-    knob = second_knob(request.vary) if request.vary is not None else None
     files = (output,) + ((request.pdf,) if request.pdf is not None else ())
     return NextOutcome(verdict, update, ref, best.setting, best, request.confidence, reached,
                        counted_once, output, proposal, files, tuple(warnings),
-                       (knob.cell, knob.unit, best.second) if knob is not None else None,
-                       gun)
+                       knob_value(request, best), gun, unrounded)
+
+
+def knob_value(request: NextRequest, best: PassProbability) -> tuple[str, str, float] | None:
+    """The ``--vary`` knob's (cell, unit, value) at ``best``; None without ``--vary``."""
+    if request.vary is None:
+        return None
+    knob = second_knob(request.vary)
+    return knob.cell, knob.unit, best.second
 
 
 def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: Verdict,
            update: LawUpdate, best: PassProbability, law: Any, ref: str,
-           warnings: list[str], gun: str) -> None:
+           warnings: list[str], gun: str, unrounded: PassProbability | None = None) -> None:
     """The next shot's workbook: the chosen A28..A30, the lot's law (its Crush law sheet),
     and on its Summary the prediction of P(PASS) and where it came from."""
     from ..outputs import from_sheet
@@ -570,6 +653,7 @@ def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: V
     notes = (f"next shot of lot {request.lot}: {setting_text(request, best)}, P(PASS) = "
              f"{best.probability:.4f} (95 % interval {lo:.4f}-{hi:.4f}, {best.shots:,} draws "
              f"of the gun ({', '.join(request.sd)}) and the law), seed {request.seed}",
+             *([rounded_text(request, unrounded)] if unrounded is not None else []),
              gun,
              f"most likely to fail: {worst[0] if worst else 'none'}",
              f"the lot's law {ref}: {update_text(update)}; {update.note}",
@@ -617,6 +701,8 @@ def lines(request: NextRequest, outcome: NextOutcome) -> list[str]:
              f"next: {setting_text(request, b)}, P(PASS) = {b.probability:.4f} "
              f"[{lo:.4f}, {hi:.4f}] over {b.shots:,} draws"
              + (f"; most likely to fail: {worst[0]}" if worst else ""),
+             *([f"  {rounded_text(request, outcome.unrounded)}"]
+               if outcome.unrounded is not None else []),
              f"  {outcome.gun}",
              f"  {'reaches' if outcome.reached else 'does NOT reach'} --confidence "
              f"{outcome.confidence:g}",

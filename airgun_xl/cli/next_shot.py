@@ -48,6 +48,10 @@ def add_parser(sub):
                    help="a second knob set with A28 for the duration: E13, E16 or A2 "
                         "(a lot whose strength differs from the law's cannot meet a peak "
                         "and a duration by A28 alone)")
+    p.add_argument("--step", action="append", metavar="CELL=STEP",
+                   help="what a knob can be set to: A28=0.5 (m/s) sets A28 to a multiple of "
+                        "0.5 (and the --vary knob, in its unit); the best of the settable "
+                        "neighbours of the best found, on the same draws")
     p.add_argument("--confidence", type=float, default=0.9, metavar="P",
                    help="the P(PASS) asked of the next shot (default 0.9): exit 3 below it")
     p.add_argument("--shots", type=int, default=2000, metavar="N",
@@ -75,7 +79,8 @@ def request_of(args):
                        args.time_unit, args.accel_unit, args.integrator,
                        Path(args.output) if args.output else None, args.force,
                        tuple(args.argv), args.vary, args.scheduler, args.workers,
-                       args.chunk, Path(args.pdf) if args.pdf else None, args.gun)
+                       args.chunk, Path(args.pdf) if args.pdf else None, args.gun,
+                       tuple(args.step or ()))
 
 
 def run(args):

@@ -17,6 +17,7 @@ The SRS criterion is judged on single pulses only: a probability says when it le
 """
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -24,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..engine.batch import run_batch
-from ..errors import AirgunXlError, DesignError
+from ..errors import AirgunXlError, DesignError, OptionError
 from ..models import apply_model
 from ..specification import Specification
 from .acceptance import BLOCK_VALUES, BlockJudge, flags_of, wilson_interval
@@ -408,6 +409,8 @@ class ConfidenceDesign:
     tried: list[PassProbability]
     shots: int
     warnings: list[str] = field(default_factory=list)
+    #: with ``steps``: the best found between them (``best`` is then the best on them)
+    unrounded: PassProbability | None = None
 
 
 def _span(middle):
@@ -422,16 +425,50 @@ def _span(middle):
     return sorted({float(x) for x in span} | {middle.value})
 
 
+def settable(best, steps, ranges):
+    """The settings a knob can be set to nearest ``best`` (one value, or a pair's two): on
+    each variable's grid of ``steps`` (multiples of the step, in its unit; None: any value),
+    the step below and the one above, within ``ranges`` (lo, hi); a grid with no value in
+    its range near ``best`` is refused in one line.
+
+    Returns
+    -------
+    list
+        The settings (floats, or tuples for a pair), the grid's values rounded to 12
+        significant digits (a multiple of 0.1 reads as written).
+    """
+    values = best if isinstance(best, tuple) else (best,)
+    axes = []
+    for value, step, (lo, hi) in zip(values, steps, ranges, strict=True):
+        if step is None:
+            axes.append([value])
+            continue
+        k = math.floor(value / step)
+        near = sorted({float(f"{j * step:.12g}") for j in (k, k + 1)})
+        inside = [v for v in near if lo <= v <= hi]
+        if not inside:
+            raise OptionError(f"--step: found a step of {step:g}, whose settings nearest the "
+                              f"best {value:.6g} ({', '.join(f'{v:g}' for v in near)}) are "
+                              f"outside the range searched, {lo:g} to {hi:g}; expected a "
+                              "step the knob can be set to within it")
+        axes.append(inside)
+    grid = [tuple(x) for x in itertools.product(*axes)]
+    return grid if isinstance(best, tuple) else [x[0] for x in grid]
+
+
 def solve_confidence(p, spec, var, sds, n, seed=1, bounds=None, integrator="legacy",
                      model="4-mass", runner=None, progress=None, noise=0.0, second=None,
-                     keep_middle=True):
+                     keep_middle=True, steps=None):
     """The setting of ``var`` most likely to pass (see the module's notes); ``noise`` [kG]:
     the rest noise of the recordings the shots will be judged on (:class:`BlockJudge`).
 
     ``second``: a second variable set with ``var`` (a :class:`Pair`, candidates from
     :func:`solve_middle_pair`); the results' ``second`` holds its setting. ``keep_middle``
     False runs only the first round's best with every shot (the middle design's probability
-    is then not known)."""
+    is then not known). ``steps``: what each knob can be set to (the step of ``var``'s and
+    of ``second``'s grids, None for any value): the best is then the highest P(PASS) among
+    the settable neighbours of the best found between them (:func:`settable`), on the final
+    round's draws, a tie to the nearest; the result's ``unrounded`` keeps the best found."""
     if second is None:
         middle = solve_middle(p, spec, var, bounds, integrator, model, runner, noise)
         knobs, candidates = var, _span(middle)
@@ -455,10 +492,22 @@ def solve_confidence(p, spec, var, sds, n, seed=1, bounds=None, integrator="lega
     best = max(final, key=lambda r: r.probability)
     mid = (final[sorted(finalists).index(middle.value)] if middle.value in finalists
            else None)
+    unrounded = None
+    if steps is not None and any(step is not None for step in steps):
+        at = (best.setting, best.second) if second is not None else best.setting
+        ranges = [bounds or var.bounds(p)] + ([second.bounds(p)] if second is not None else [])
+        near = settable(at, steps, ranges)
+        if at not in near:  # the best found is between the grids' values
+            on_grid = [pass_probability(p, spec, sds, n, seed + 1, knobs, x, integrator,
+                                        model, runner, progress, drawn, noise) for x in near]
+            unrounded, best = best, max(on_grid, key=lambda r: (
+                r.probability, -abs(r.setting - best.setting),
+                -abs(r.second - best.second) if second is not None else 0.0))
+            final += on_grid
     warnings = []
     if spec.srs is not None:
         warnings.append("the SRS criterion is not in the probability: it is judged on the "
                         "designed shot's prediction only")
     if noise == 0 and spec.resolved().judged.is_default:
         warnings.append(QUIET_RECORD_WARNING)
-    return ConfidenceDesign(best, mid, middle, first + final, n, warnings)
+    return ConfidenceDesign(best, mid, middle, first + final, n, warnings, unrounded)

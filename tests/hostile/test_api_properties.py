@@ -98,7 +98,8 @@ def test_a_sign_that_is_not_one_is_refused_by_every_function_alike(sign):
 @settings(max_examples=12, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(given=st.dictionaries(st.sampled_from(["sd", "confidence", "shots", "lot", "seed",
-                                              "sign", "cfc", "vary", "gun"]), NOISE,
+                                              "sign", "cfc", "vary", "gun", "step"]),
+                             NOISE,
                              max_size=2))
 def test_next_given_random_input_writes_what_it_says_or_nothing(given):
     """airgun_xl.next_shot with random keywords: an outcome whose files are what was
