@@ -40,18 +40,7 @@ def add_parser(sub):
                    help="start the lot: its prior is the report's law")
     p.add_argument("--sd", action="append", metavar="CELL=SD",
                    help="the gun's scatter, A28=1.5%% (needed), and zeta's, E43=10%%")
-    p.add_argument("--gun", metavar="NAME", action=One,
-                   help="the gun that fires the lot: its scatter is estimated from the launch "
-                        "velocities of every lot fired with the same --gun (each lot's shots "
-                        "about their own mean) once they hold 7 shots beyond each lot's first")
-    p.add_argument("--vary", metavar="CELL", action=One,
-                   help="a second knob set with A28 for the duration: E13, E16 or A2 "
-                        "(a lot whose strength differs from the law's cannot meet a peak "
-                        "and a duration by A28 alone)")
-    p.add_argument("--step", action="append", metavar="CELL=STEP",
-                   help="what a knob can be set to: A28=0.5 (m/s) sets A28 to a multiple of "
-                        "0.5 (and the --vary knob, in its unit); the best of the settable "
-                        "neighbours of the best found, on the same draws")
+    _add_knobs(p)
     p.add_argument("--confidence", type=float, default=0.9, metavar="P",
                    help="the P(PASS) asked of the next shot (default 0.9): exit 3 below it")
     p.add_argument("--shots", type=int, default=2000, metavar="N",
@@ -67,6 +56,22 @@ def add_parser(sub):
     add_cluster_options(p)
     add_json(p, "the verdict, the law's update and the next setting")
     p.set_defaults(run=run)
+
+
+def _add_knobs(p):
+    """The gun, the second knob and what each can be set to."""
+    p.add_argument("--gun", metavar="NAME", action=One,
+                   help="the gun that fires the lot: its scatter is estimated from the launch "
+                        "velocities of every lot fired with the same --gun (each lot's shots "
+                        "about their own mean) once they hold 7 shots beyond each lot's first")
+    p.add_argument("--vary", metavar="CELL", action=One,
+                   help="a second knob set with A28 for the duration: E13, E16 or A2 "
+                        "(a lot whose strength differs from the law's cannot meet a peak "
+                        "and a duration by A28 alone)")
+    p.add_argument("--step", action="append", metavar="CELL=STEP",
+                   help="what a knob can be set to: A28=0.5 (m/s) sets A28 to a multiple of "
+                        "0.5 (and the --vary knob, in its unit); the best of the settable "
+                        "neighbours of the best found, on the same draws")
 
 
 def request_of(args):
