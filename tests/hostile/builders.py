@@ -234,3 +234,31 @@ def corrupt_deflate(rows=20_000, good=200_000):
     # 0xff bytes: a final block of the reserved type 11, "invalid block type"
     data[start:start + info.compress_size] = head + b"\xff" * (info.compress_size - len(head))
     return bytes(data)
+
+
+# -- MATLAB v7.3 (HDF5) recordings --------------------------------------------------------------
+
+#: MATLAB's 116-byte text header of a v7.3 file, then its version and endian marks.
+MAT73_HEADER = (b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Fri Nov 27 00:00:00 2026 "
+                b"HDF5 schema 1.00 .").ljust(116) + bytes(8) + b"\x00\x02IM"
+
+
+def mat73(path, build):
+    """A MATLAB v7.3 file at ``path``: HDF5 after a 512-byte user block holding MATLAB's
+    header; ``build(f)`` adds the variables to the open h5py.File."""
+    import h5py
+
+    with h5py.File(path, "w", userblock_size=512) as f:
+        build(f)
+    with open(path, "r+b") as fh:
+        fh.write(MAT73_HEADER.ljust(512, b"\x00"))
+    return path
+
+
+def matlab_double(f, name, values):
+    """A MATLAB double variable (a column vector is stored 1 x n)."""
+    import numpy as np
+
+    ds = f.create_dataset(name, data=np.asarray(values, dtype=float).reshape(1, -1))
+    ds.attrs["MATLAB_class"] = np.bytes_("double")
+    return ds

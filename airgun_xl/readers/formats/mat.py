@@ -11,6 +11,14 @@ recorder's export writes them (docs/recordings.md):
   ``t0`` the first sample's time when given;
 - a variable's declared size is read (``whosmat``, an HDF5 dataset's shape) and checked
   before any of its samples is; only the chosen channel and its time are loaded.
+
+A v7.3 file is HDF5, whose library reads data from other files when the file asks it to: a
+dataset's external storage (its raw samples in a named file), a virtual dataset (mapped from
+other files' datasets) and an external link (a variable that is another file's object). So
+before any variable is listed or read, every top-level link is looked at without being
+followed and every dataset's storage is vetted (:func:`_vet`): only hard links, and only
+datasets whose samples are in the file itself, through HDF5's built-in filters (a filter it
+would look for as a plugin library is refused too). MATLAB writes nothing else.
 """
 from __future__ import annotations
 
@@ -64,7 +72,7 @@ class _Variables:
             with warnings.catch_warnings():  # scipy's MatReadWarning: our checks follow
                 warnings.simplefilter("ignore")
                 self._list()
-        except OptionError:
+        except (OptionError, WorkbookError):
             raise
         except MatError as exc:
             raise WorkbookError(f"{self.shown}: is not a readable MATLAB file ({exc}), "
@@ -80,8 +88,9 @@ class _Variables:
                 self.sizes[name] = (v.shape, v.kind)
             return
         self._h5 = self._open_h5()
-        for name, item in self._h5.items():
-            if hasattr(item, "shape") and hasattr(item, "dtype"):  # a dataset, not a group
+        for name in list(self._h5.keys()):  # keys only: items() would follow the links
+            item = _vet(self.shown, self._h5, name)
+            if item is not None:  # a dataset, not a group
                 kind = item.attrs.get("MATLAB_class", b"")
                 kind = kind.decode("ascii", "replace") if isinstance(kind, bytes) else str(kind)
                 self.sizes[name] = (tuple(int(n) for n in item.shape), kind)
@@ -143,6 +152,55 @@ class _Variables:
         if np.iscomplexobj(value) or not np.issubdtype(value.dtype, np.number):
             return None
         return float(value.ravel()[0])
+
+
+#: The filters built into HDF5 (deflate, shuffle, Fletcher32, szip, n-bit, scale-offset): any
+#: other is looked for as a plugin library on HDF5's plugin path before a sample is read.
+BUILT_IN_FILTERS = frozenset(range(1, 7))
+
+#: The layout of a virtual dataset (H5D_VIRTUAL), whose samples are other files' datasets.
+_VIRTUAL_LAYOUT = 3
+
+
+def _vet(shown: str, root: Any, name: str) -> Any:
+    """The top-level dataset ``name`` of the HDF5 file ``root`` once it is shown to keep its
+    samples inside the file (None for a group); no sample is read and no link followed.
+
+    Raises
+    ------
+    WorkbookError
+        For a soft or external link, a virtual dataset, a dataset with external storage, or a
+        filter that is not built into HDF5.
+    """
+    import h5py
+
+    expected = "expected a recording whose data is inside the file"
+    link = root.get(name, getlink=True)
+    if isinstance(link, h5py.ExternalLink):
+        raise WorkbookError(f"{shown}: variable {name!r} is an external link to "
+                            f"{link.filename!r}, {expected}")
+    if not isinstance(link, h5py.HardLink):  # a soft link may lead through an external one
+        raise WorkbookError(f"{shown}: variable {name!r} is a {type(link).__name__}, "
+                            f"{expected} (MATLAB writes every variable as a hard link)")
+    item = root[name]
+    if not isinstance(item, h5py.Dataset):
+        return None
+    plist = item.id.get_create_plist()
+    if plist.get_layout() == _VIRTUAL_LAYOUT:
+        raise WorkbookError(f"{shown}: variable {name!r} is a virtual dataset (mapped from "
+                            f"other files' data), {expected}")
+    if plist.get_external_count() > 0:
+        outside = plist.get_external(0)[0].decode("utf-8", "replace")
+        raise WorkbookError(f"{shown}: variable {name!r} keeps its samples in the outside "
+                            f"file {outside!r} (HDF5 external storage), {expected}")
+    for index in range(plist.get_nfilters()):
+        code = int(plist.get_filter(index)[0])
+        if code not in BUILT_IN_FILTERS:
+            raise WorkbookError(f"{shown}: variable {name!r} is stored through HDF5 filter "
+                                f"{code}, which HDF5 would load as a plugin library, "
+                                "expected one of HDF5's built-in filters (deflate, shuffle, "
+                                "Fletcher32, szip, n-bit, scale-offset)")
+    return item
 
 
 def _channels(variables: _Variables) -> list[str]:
