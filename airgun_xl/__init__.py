@@ -9,8 +9,10 @@ Load a shot from a workbook in the report's layout, run it, and get the result::
 """
 from __future__ import annotations
 
+import functools
+import inspect
 import os
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from .errors import (
     AirgunXlError,
@@ -67,6 +69,45 @@ def __getattr__(name: str) -> object:
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
+_F = TypeVar("_F")
+
+
+def _paths_checked(function: _F) -> _F:
+    """``function`` with each argument its signature types as a path (``os.PathLike``)
+    checked before the call: a path given as text or a path, a sequence of them where the
+    signature takes one, None where it allows None; anything else is one
+    :class:`OptionError` naming the argument (it was a raw TypeError from deep inside)."""
+    signature = inspect.signature(function)  # type: ignore[arg-type]
+    typed = {name: str(parameter.annotation) for name, parameter in signature.parameters.items()
+             if "PathLike" in str(parameter.annotation)}
+
+    def check(name: str, value: object) -> None:
+        text = typed[name]
+        if value is None and "None" in text:
+            return
+        values = value if "Sequence" in text and isinstance(value, (list, tuple)) else [value]
+        for one in values:
+            if not isinstance(one, (str, os.PathLike)):
+                raise OptionError(f"{name}: found {one!r}, expected a file's path (text or "
+                                  "a path)")
+
+    @functools.wraps(function)  # type: ignore[arg-type]
+    def checked(*args: Any, **kwargs: Any) -> Any:
+        try:
+            bound = signature.bind(*args, **kwargs)
+        except TypeError as exc:  # a missing or unknown argument: the caller's own error
+            raise TypeError(f"{function.__name__}(): {exc}") from None  # type: ignore[attr-defined]
+        for name, value in bound.arguments.items():
+            if name in typed:
+                kind = signature.parameters[name].kind
+                for one in (value if kind is inspect.Parameter.VAR_POSITIONAL else [value]):
+                    check(name, one)
+        return function(*args, **kwargs)  # type: ignore[operator]
+
+    return checked  # type: ignore[return-value]
+
+
+@_paths_checked
 def load(path: str | os.PathLike[str]) -> Shot:
     """Read a :class:`Shot` from a workbook (see :meth:`Shot.from_workbook`)."""
     from .shot import Shot
@@ -74,6 +115,7 @@ def load(path: str | os.PathLike[str]) -> Shot:
     return Shot.from_workbook(path)
 
 
+@_paths_checked
 def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
            output: str | os.PathLike[str] | None = None, force: bool = False,
            archive: str | os.PathLike[str] | None = None, channel: str | None = None,
@@ -132,6 +174,7 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
         _path("--pdf", pdf) if pdf is not None else None, bool(reproducible)))
 
 
+@_paths_checked
 def calibrate(*files: str | os.PathLike[str], law: bool = False,
               fit: str | Sequence[str] | None = None, objective: str = "l2",
               degree: int = 6, cfc: int | str | None = None, sign: float = 1.0,
@@ -179,6 +222,7 @@ def calibrate(*files: str | os.PathLike[str], law: bool = False,
         Path(archive) if archive is not None else None, name, ("calibrate",)))
 
 
+@_paths_checked
 def design(shot: str | os.PathLike[str], *, target_peak: str | None = None,
            target_duration: str | None = None,
            target_srs: str | os.PathLike[str] | None = None, vary: str | Sequence[str] = (),
@@ -238,6 +282,7 @@ def design(shot: str | os.PathLike[str], *, target_peak: str | None = None,
         ("design",), None if pdf is None else _path("--pdf", pdf)))
 
 
+@_paths_checked
 def srs(shot: str | os.PathLike[str], *, q: float | str = 10.0, cfc: int | str | None = None,
         lo: float = 100.0, hi: float = 10_000.0, integrator: str = "legacy",
         model: str = "4-mass", output: str | os.PathLike[str] | None = None,
@@ -271,6 +316,7 @@ def srs(shot: str | os.PathLike[str], *, q: float | str = 10.0, cfc: int | str |
                           Path(archive) if archive is not None else None))
 
 
+@_paths_checked
 def compare_measured(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
                      cfc: int | str | None = None, align: str = "threshold",
                      anti_alias: str | float = "auto", sign: float = 1.0,
@@ -307,6 +353,7 @@ def compare_measured(shot: str | os.PathLike[str], recording: str | os.PathLike[
         force, crush_law, Path(archive) if archive is not None else None))
 
 
+@_paths_checked
 def convergence(shot: str | os.PathLike[str], levels: str | Sequence[str] | None = None, *,
                 integrators: str | Sequence[str] = ("legacy",), rtol: float | str = 1e-3,
                 output: str | os.PathLike[str] | None = None, force: bool = False,
@@ -340,6 +387,7 @@ def convergence(shot: str | os.PathLike[str], levels: str | Sequence[str] | None
         Path(archive) if archive is not None else None))
 
 
+@_paths_checked
 def check(shot: str | os.PathLike[str], *, integrator: str = "legacy") -> CheckOutcome:
     """Can this shot's run be trusted, as ``airgun-xl check`` says: the scheme's critical
     time step (``critical.dt_crit`` [s], ``critical.ratio``, ``stable``) and what the shot
@@ -357,6 +405,7 @@ def check(shot: str | os.PathLike[str], *, integrator: str = "legacy") -> CheckO
     return run(CheckRequest(Path(shot), integrator))
 
 
+@_paths_checked
 def diff(legacy: str | os.PathLike[str], new: str | os.PathLike[str], *,
          rtol: float = 1e-12, atol: float = 0.0,
          report: str | os.PathLike[str] | None = None, force: bool = False) -> DiffOutcome:
@@ -381,6 +430,7 @@ def diff(legacy: str | os.PathLike[str], new: str | os.PathLike[str], *,
                _number("--atol", atol), None if report is None else os.fspath(report), force)
 
 
+@_paths_checked
 def recording(path: str | os.PathLike[str]) -> RecordingOutcome:
     """What a recording file holds, as ``airgun-xl recording`` lists it: its ``format`` and
     its ``channels`` (each one's ``name``, ``unit`` as the file states it, ``rate`` [Hz],
@@ -397,6 +447,7 @@ def recording(path: str | os.PathLike[str]) -> RecordingOutcome:
     return run(os.fspath(path))
 
 
+@_paths_checked
 def serve(archive: str | os.PathLike[str], *, host: str = "127.0.0.1",
           port: int = 8765) -> None:
     """Serve the archive's read-only view in a browser until Ctrl-C, as ``airgun-xl serve``
@@ -411,9 +462,10 @@ def serve(archive: str | os.PathLike[str], *, host: str = "127.0.0.1",
     """
     from .web.server import serve as run
 
-    run(os.fspath(archive), host, port)
+    run(os.fspath(archive), host, _whole("port", port))
 
 
+@_paths_checked
 def template(output: str | os.PathLike[str], *, force: bool = False) -> os.PathLike[str]:
     """Write a fresh shot A workbook in the report's layout, as ``airgun-xl template``
     does; the path written."""
@@ -459,6 +511,7 @@ def _whole(option: str, value: object) -> int:
     return int(number)
 
 
+@_paths_checked
 def sweep(shot: str | os.PathLike[str], vary: str | Sequence[str] = (), *,
           mc: int | str | None = None, sd: str | Sequence[str] = (),
           sobol: int | str | None = None, seed: int = 1, integrator: str = "legacy",
@@ -524,6 +577,7 @@ def _fill_settings(command: str, output: str | os.PathLike[str] | None,
         **options)  # type: ignore[arg-type]
 
 
+@_paths_checked
 def fill(shot: str | os.PathLike[str], *, output: str | os.PathLike[str] | None = None,
          force: bool = False, host: str = "excel", only: str | None = None,
          no_charts: bool = False, every: int | str | None = None,
@@ -566,6 +620,7 @@ def fill(shot: str | os.PathLike[str], *, output: str | os.PathLike[str] | None 
     return run(FillRequest(os.fspath(shot), settings))
 
 
+@_paths_checked
 def campaign(shots: str | os.PathLike[str] | Sequence[str | os.PathLike[str]], *,
              jobs: int | str | None = None, summary: str | os.PathLike[str] | None = None,
              force: bool = False, integrator: str = "legacy", model: str = "4-mass",
@@ -591,6 +646,7 @@ def campaign(shots: str | os.PathLike[str] | Sequence[str | os.PathLike[str]], *
                                os.fspath(summary) if summary is not None else None))
 
 
+@_paths_checked
 def history(archive: str | os.PathLike[str] | None = None, *, shot: str | None = None,
             since: str | None = None, where: str | Sequence[str] = (),
             output: str | os.PathLike[str] | None = None,
@@ -607,6 +663,7 @@ def history(archive: str | os.PathLike[str] | None = None, *, shot: str | None =
                                  os.fspath(output) if output is not None else None, force))
 
 
+@_paths_checked
 def show(entry: str, archive: str | os.PathLike[str] | None = None) -> ShowOutcome:
     """One archived run (``"SHOT"``, ``"SHOT@VERSION"`` or ``"#ID"``): ``doc`` holds its
     inputs, figures, provenance and files as stored; refused when ``archive verify`` would
@@ -616,6 +673,7 @@ def show(entry: str, archive: str | os.PathLike[str] | None = None) -> ShowOutco
     return shown(entry, os.fspath(archive) if archive is not None else None)
 
 
+@_paths_checked
 def compare(entry1: str, entry2: str, archive: str | os.PathLike[str] | None = None, *,
             rtol: float = 1e-12, atol: float = 0.0,
             report: str | os.PathLike[str] | None = None,
@@ -631,6 +689,7 @@ def compare(entry1: str, entry2: str, archive: str | os.PathLike[str] | None = N
         os.fspath(report) if report is not None else None, force))
 
 
+@_paths_checked
 def next_shot(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
               archive: str | os.PathLike[str], lot: str, new_lot: bool = False,
               sd: str | Sequence[str] = (), confidence: float = 0.9, shots: int = 2000,

@@ -57,6 +57,23 @@ MAX_WINDOWED_BYTES = 256 * 2**30
 #: Most samples a measured recording may hold: 40 s at 50 kHz, 32 MB as two float columns.
 MAX_SAMPLES = 2_000_000
 
+#: Monte Carlo draws a setting of ``design --confidence`` and ``next`` (--shots): a
+#: P(PASS) to +/- 0.0003 at a million; more only costs minutes and memory.
+MIN_DRAWS, MAX_DRAWS = 100, 10**6
+
+#: Largest seed of a study's draws (numpy's SeedSequence takes any whole number >= 0).
+MAX_SEED = 2**128 - 1
+
+#: The smallest peak a recording may have to be judged [kG] (about 0.001 g): below it there
+#: is no shock to measure, and a record of subnormal numbers (5e-324) breaks every ratio.
+MIN_RECORDED_PEAK_KG = 1e-6
+
+#: A recording's sample step, in every format [s]: at most 1 GHz (no shock recorder samples
+#: faster; the SRS's decimation keeps a rest of 16 x 1/(40 x f x dt) samples, 320 MB at
+#: 1 THz) and at least 1 Hz (a pulse of milliseconds has no sample at a slower rate).
+MIN_SAMPLE_STEP = 1e-9
+MAX_SAMPLE_STEP = 1.0
+
 #: Most octaves an SRS spans (12 natural frequencies an octave): 1 Hz to 1 GHz is 30.
 MAX_SRS_OCTAVES = 40
 

@@ -511,9 +511,10 @@ def test_a_unit_given_over_the_files_is_named_where_the_figures_go(pulse, tmp_pa
     assert given.verdict.word == "FAIL"  # a thousandth of the pulse: the peak far below
     same = airgun_xl.accept(TEMPLATE, files["csv"], **SPEC, accel_unit="kG")
     assert not [w for w in same.verdict.warnings if "replaces the unit" in w]
-    spelled = tmp_path / "us.csv"
-    spelled.write_text(files["csv"].read_text().replace("time [s]", "time [µs]").replace(
-        "acceleration [kG]", "acceleration [m/s2]"))
+    spelled = tmp_path / "us.csv"  # the times in µs, so that the rate stays the recorder's
+    spelled.write_text("time [µs],acceleration [m/s2]\n" + "".join(
+        f"{t * 1e6!r},{a!r}\n" for t, a in zip(trace.time.tolist(), trace.accel_kg.tolist(),
+                                              strict=True)))
     from airgun_xl.readers.recording import read_trace
 
     assert read_trace(spelled, time_unit="us", accel_unit="m/s^2").notes == []

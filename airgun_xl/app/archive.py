@@ -95,7 +95,12 @@ def history_rows(entries: Iterable[Entry], where: Sequence[Where] = ()) -> list[
     """The campaign-table row of each entry (its summary.json figures and provenance) that
     ``where`` selects."""
     rows = []
+    folders: dict[Path, int] = {}
     for e in entries:
+        misnamed = _misnamed(e, folders)
+        if misnamed:  # a row of the index that names another entry's folder: flagged
+            rows.append(_unreadable_row(e, ArchiveError(misnamed)))
+            continue
         try:
             if where and not _matches(e.load("params.json"), where):
                 continue
@@ -106,6 +111,21 @@ def history_rows(entries: Iterable[Entry], where: Sequence[Where] = ()) -> list[
             continue
         rows.append(history_row(e, s, prov))
     return rows
+
+
+def _misnamed(e: Entry, folders: dict[Path, int]) -> str:
+    """Why an index row cannot be listed as the entry it says (its folder is another
+    entry's, or a folder an earlier row named), or ''; ``folders`` holds the rows seen."""
+    named = (e.path.parent.name, int(e.path.name[1:]))
+    folder = f"{named[0]}/{e.path.name}"
+    if named != (e.shot, e.version):
+        return (f"row #{e.id}: it says {e.ref}, but its folder {folder} is "
+                f"{named[0]}@{named[1]}'s (see airgun-xl archive verify)")
+    if e.path in folders:
+        return (f"row #{e.id}: names the folder of row #{folders[e.path]} ({folder}): two "
+                "rows on one folder (see airgun-xl archive verify)")
+    folders[e.path] = e.id
+    return ""
 
 
 def history_row(e: Entry, s: dict[str, Any], prov: dict[str, Any]) -> Row:

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from .. import limits
 from ..cells import address
 from ..errors import OptionError
 from ..specification import parse_target
@@ -251,15 +252,17 @@ def _check_spec_options(request: DesignRequest) -> list[Any]:
     if request.confidence is not None and not 0 < request.confidence < 1:
         raise OptionError(f"--confidence: found {request.confidence!r}, expected a probability "
                           "between 0 and 1, such as 0.95")
-    if request.confidence is not None and not 100 <= request.shots <= 10**6:
-        raise OptionError(f"--shots: found {request.shots!r}, expected 100 to 1,000,000")
+    if request.confidence is not None and \
+            not limits.MIN_DRAWS <= request.shots <= limits.MAX_DRAWS:
+        raise OptionError(f"--shots: found {request.shots!r}, expected {limits.MIN_DRAWS} to "
+                          f"{limits.MAX_DRAWS:,}")
     sds: list[Any] = parse_sds(list(request.sd))
     if request.confidence is not None and not sds:
         raise OptionError("--confidence: found no --sd, expected the scatter to design "
                           "against (--sd A28=1.5% --sd E40=5%)")
     if request.confidence is None and sds:
         raise OptionError("--sd: found without --confidence, expected both")
-    if not 0 <= request.seed < 2**128:
+    if not 0 <= request.seed <= limits.MAX_SEED:
         raise OptionError(f"--seed: found {request.seed}, expected a whole number from 0 to "
                           "2**128 - 1")
     return sds

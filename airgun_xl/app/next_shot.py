@@ -29,8 +29,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from .. import limits
 from ..cells import address
-from ..errors import OptionError
+from ..errors import ArchiveError, OptionError
+from ..transaction.stages import stage
 from .specifying import SpecFields, require, resolve
 
 if TYPE_CHECKING:
@@ -223,7 +225,7 @@ def run(request: NextRequest) -> NextOutcome:
     spec = require(resolve(shot, request.spec), request.shot)
     _tolerances(spec)
     steps_of(request, shot.params)
-    prior, earlier = _lot(request)
+    prior, earlier, proposal = _lot(request)
     this = {"shot": str(request.shot), "shot_sha256": _sha256(request.shot, "workbook"),
             "recording": str(request.recording),
             "recording_sha256": _sha256(input_file(request.recording), "recording"),
@@ -240,6 +242,7 @@ def run(request: NextRequest) -> NextOutcome:
     params, traces = _read_lot(lot_shots)
     update = update_law(params, traces, prior, spec.judged.cfc, request.integrator,
                         velocities=estimated or request.gun is not None)
+    _described(request, update, lot_shots)
     sds, gun, gun_warnings = _gun(request, update, sds, len(lot_shots), shot.params.v31,
                                   others, freedom)
     gun_warnings = [*read_warnings, *gun_warnings]
@@ -254,7 +257,35 @@ def run(request: NextRequest) -> NextOutcome:
                         f" reaches P(PASS) = {request.confidence:g}; the best found is "
                         f"{best.probability:.4f} at {setting_text(request, best)}")
     return _publish(request, output, shot, spec, verdict, update, best, reached, lot_shots,
-                    counted_once, warnings, gun, unrounded)
+                    counted_once, warnings, gun, unrounded, proposal=proposal)
+
+
+def _described(request: NextRequest, update: LawUpdate,
+               lot_shots: list[dict[str, Any]]) -> None:
+    """Refuse, before anything is written, a lot's law fitted on a recording the model does
+    not describe (the fit still misses it by over calibrate.POOR_FIT RMS of its peak: noise,
+    a wrong unit, channel or sign) or one no honeycomb of the report's kind has
+    (closed_loop.LOT_LAW_RATIO): the tool says so, so it does not store it."""
+    from ..errors import WorkbookError
+    from ..studies.calibrate import POOR_FIT
+    from ..studies.closed_loop import implausible
+
+    misses = [(after.rms, s["recording"]) for s, after in
+              zip(lot_shots, update.calibration.after, strict=True)]
+    rms, worst = max(misses)
+    if rms > POOR_FIT:
+        which = "it" if worst == str(request.recording) else f"the lot's {worst}"
+        raise WorkbookError(f"{request.recording}: the lot's law fitted to the lot's "
+                            f"recordings with it still misses {which} by {rms:.1%} RMS of its "
+                            f"peak (over {POOR_FIT:.0%}), expected a recording of the shot "
+                            "that the model describes (check its units, channel and sign): "
+                            "the lot's law is not updated from it")
+    why = implausible(update.law)
+    if why:
+        raise WorkbookError(f"{request.recording}: the lot's law fitted to the lot's "
+                            f"recordings with it would be {why}, expected a recording of the "
+                            "shot (check its units, channel and sign): the lot's law is not "
+                            "updated from it")
 
 
 def _checked(request: NextRequest) -> Path:
@@ -269,9 +300,12 @@ def _checked(request: NextRequest) -> Path:
     if not 0 < request.confidence < 1:
         raise OptionError(f"--confidence: found {request.confidence!r}, expected a probability "
                           "above 0 and below 1, such as 0.9")
-    if request.shots < 100:
-        raise OptionError(f"--shots: found {request.shots}, expected at least 100 Monte Carlo "
-                          "shots a setting")
+    if not limits.MIN_DRAWS <= request.shots <= limits.MAX_DRAWS:
+        raise OptionError(f"--shots: found {request.shots}, expected {limits.MIN_DRAWS} to "
+                          f"{limits.MAX_DRAWS:,} Monte Carlo shots a setting")
+    if not 0 <= request.seed <= limits.MAX_SEED:
+        raise OptionError(f"--seed: found {request.seed}, expected a whole number from 0 to "
+                          "2**128 - 1")
     if not request.lot or safe_name(request.lot) != request.lot:
         raise OptionError(f"--lot: found {request.lot!r}, expected a lot name of letters, "
                           "digits, '-', '_' and '.' (such as LOT-2026-07)")
@@ -432,28 +466,43 @@ def _gun_lots(request: NextRequest, lot_shots: list[dict[str, Any]]
     return found, warnings
 
 
-def _lot(request: NextRequest) -> tuple[Any, list[dict[str, Any]]]:
-    """The lot's prior law (its latest version, or the report's law for a new lot) and its
-    shots so far (each file checked unchanged)."""
-    from ..archive.laws import LAWS, load_law
-    from ..archive.lots import proposals
-    from ..archive.records import versions
+def _lot(request: NextRequest) -> tuple[Any, list[dict[str, Any]], int]:
+    """The lot's prior law (its latest version the archive holds, or the report's law for a
+    new lot), its shots so far (each file checked unchanged) and the version its next
+    proposal must take (the one after the chain read: the call's commit point, refused if
+    another call takes it first)."""
+    from ..archive.laws import load_law
+    from ..archive.lots import proposals, shot_keys
     from ..crush_law import LEGACY_LAW
     from ..errors import AirgunXlError, ArchiveError
+    from ..studies.closed_loop import implausible
 
-    has_law = bool(versions(Path(request.archive) / LAWS / request.lot))
     chain = proposals(request.archive, request.lot)
-    if not has_law and not chain:
+    proposal = (chain[-1][0] if chain else 0) + 1
+    try:
+        prior, _record = load_law(request.archive, request.lot)
+    except OptionError:  # no law of that name (a law of a next that did not finish is none)
+        prior = None
+    if prior is None and not chain:
         if not request.new_lot:
             raise OptionError(f"--lot: found {request.lot!r}, which the archive "
                               f"{request.archive} does not know, expected a lot it holds or "
                               "--new-lot to start one from the report's law")
-        return LEGACY_LAW, []
+        return LEGACY_LAW, [], proposal
     if request.new_lot:
         raise OptionError(f"--new-lot: found the lot {request.lot!r} in the archive already, "
                           "expected a new lot's name (or no --new-lot to go on with it)")
-    prior, _record = load_law(request.archive, request.lot)
+    if prior is None:
+        raise ArchiveError(f"--lot: the lot {request.lot!r} has proposals but the archive "
+                           "holds no law of it, expected its law versions (see airgun-xl "
+                           "archive verify)")
+    why = implausible(prior)
+    if why:
+        raise ArchiveError(f"{prior.source}: the lot's law is {why} (a record edited or "
+                           "damaged; see airgun-xl archive verify)")
     earlier = list(chain[-1][1]["shots"]) if chain else []
+    if chain:
+        shot_keys(chain[-1][1], request.archive, request.lot, chain[-1][0])
     for s in earlier:
         for key, what in (("shot", "workbook"), ("recording", "recording")):
             try:
@@ -465,7 +514,7 @@ def _lot(request: NextRequest) -> tuple[Any, list[dict[str, Any]]]:
                 raise ArchiveError(f"{s.get(key, '?')}: the lot {request.lot}'s {what} "
                                    "differs from the one recorded (or is gone), expected it "
                                    "unchanged: the lot's law is fitted on the shots as fired")
-    return prior, earlier
+    return prior, earlier, proposal
 
 
 def _sha256(path: str | Path, what: str) -> str:
@@ -546,13 +595,15 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
              update: LawUpdate, best: PassProbability, reached: bool,
              lot_shots: list[dict[str, Any]], counted_once: bool,
              warnings: list[str], gun: str,
-             unrounded: PassProbability | None = None) -> NextOutcome:
+             unrounded: PassProbability | None = None, *, proposal: int) -> NextOutcome:
     """Store the law's new version, write the next shot's workbook, keep the verdict and the
-    proposal; a failure takes back what was done."""
+    proposal (exactly version ``proposal``, the commit point: another call on the lot that
+    stored it first refuses this one); a failure takes back what was done."""
     from ..archive import Archive
     from ..archive import sha256 as file_sha256  # the workbook just written: ours
     from ..archive.laws import LAWS, store_law
     from ..archive.lots import store_proposal
+    from ..archive.records import VersionTaken
     from ..archive.verdicts import StoredVerdict, store_verdict
     from ..crush_law import CrushLaw
     from ..transaction import signals_held
@@ -562,10 +613,12 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
         with signals_held():
             ref = store_law(request.archive, request.lot, update.law, lot_shots,
                             [{"shot": s["shot"]} for s in lot_shots], request.argv,
-                            [n.record() for n in update.nodes] if update.is_whole else None)
+                            [n.record() for n in update.nodes] if update.is_whole else None,
+                            proposal=proposal)
             version = int(ref.rpartition("@")[2])
             done.append(StoredVerdict(Path(request.archive) / LAWS / request.lot /
                                       f"v{version:04d}.json", Archive(request.archive)))
+        stage("next-law-stored")
         law = CrushLaw(update.law.coefficients, update.law.v_range, "fitted", source=ref)
         _write(request, output, shot, spec, verdict, update, best, law, ref, warnings, gun,
                unrounded)
@@ -573,6 +626,7 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
         with signals_held():
             done.append(store_verdict(request.archive, shot, verdict, request.recording,
                                       output, request.argv))
+        stage("next-verdict-stored")
         lo, hi = best.interval
         worst = best.most_failing()
         record = {"lot": request.lot, "shot": str(request.shot),
@@ -604,8 +658,15 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
                   "shots": lot_shots, "warnings": warnings,
                   "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
                   "command": list(request.argv)}
-        stored = store_proposal(request.archive, request.lot, record)
+        try:
+            stored = store_proposal(request.archive, request.lot, record, proposal)
+        except VersionTaken:
+            raise ArchiveError(f"--lot: another next stored the lot {request.lot}'s proposal "
+                               f"{request.lot}@{proposal} while this one ran, expected one next "
+                               "at a time on a lot: nothing of this call is kept, run it "
+                               "again") from None
         done.append(stored)
+        stage("next-proposal-stored")
     except BaseException:
         for thing in reversed(done):
             if isinstance(thing, Path):
@@ -613,10 +674,10 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
             else:
                 thing.take_back()
         raise
-    proposal = f"{request.lot}@{int(stored.path.stem[1:])}"
     files = (output,) + ((request.pdf,) if request.pdf is not None else ())
     return NextOutcome(verdict, update, ref, best.setting, best, request.confidence, reached,
-                       counted_once, output, proposal, files, tuple(warnings),
+                       counted_once, output, f"{request.lot}@{proposal}", files,
+                       tuple(warnings),
                        knob_value(request, best), gun, unrounded)
 
 

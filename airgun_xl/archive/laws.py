@@ -15,6 +15,7 @@ from ..crush_law import DEGREE, CrushLaw
 from ..errors import ArchiveError, OptionError
 from ..transaction import display, signals_held
 from ..untrusted_json import short
+from .lots import committed
 from .records import all_versions, read_record, versions
 from .store import Archive, safe_name
 
@@ -26,9 +27,10 @@ def _folder(root, name):
     return Path(root) / LAWS / safe_name(name)
 
 
-def store_law(root, name, law, shots, scores, command=(), intervals=None):
+def store_law(root, name, law, shots, scores, command=(), intervals=None, proposal=None):
     """Keep ``law`` in the archive at ``root`` under ``name``; return its reference
-    ``NAME@N``.
+    ``NAME@N``. With ``proposal`` (``next``'s), the law is the lot's only once the lot's
+    proposal of that version names it (:func:`airgun_xl.archive.lots.committed`).
 
     Parameters
     ----------
@@ -47,6 +49,7 @@ def store_law(root, name, law, shots, scores, command=(), intervals=None):
     record = {"name": name, "coefficients": list(law.coefficients),
               "v_range": list(law.v_range), "shots": shots, "scores": scores,
               **({"intervals": intervals} if intervals is not None else {}),
+              **({"proposal": proposal} if proposal is not None else {}),
               "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
               "command": list(command)}
     with signals_held():  # the archive made and the law stored, or neither
@@ -76,15 +79,19 @@ def load_law(root, ref):
     found = versions(folder) if folder is not None else []
     if m and m.group("version"):
         found = [v for v in found if v[0] == int(m.group("version"))]
-    if not found:
-        known = ", ".join(r["ref"] for r in list_laws(root)) or "none yet"
-        raise OptionError(f"--crush-law: found {short(ref)}, expected workbook, legacy or a "
-                          f"law in {display(root)} (stored by calibrate --archive --name; "
-                          f"there: {known})")
-    version, path = found[-1]
-    record = read_record(root, path, "law")
     name = str(ref).strip().partition("@")[0]
-    return _law(record, f"{name}@{version}", path), record
+    for version, path in reversed(found):  # the latest the archive holds (committed)
+        record = read_record(root, path, "law")
+        if committed(root, name, version, record):
+            return _law(record, f"{name}@{version}", path), record
+        if m and m.group("version"):
+            raise OptionError(f"--crush-law: found {short(ref)}, a law stored by a next that "
+                              "did not finish (no proposal of the lot names it), expected a "
+                              "law of the archive")
+    known = ", ".join(r["ref"] for r in list_laws(root)) or "none yet"
+    raise OptionError(f"--crush-law: found {short(ref)}, expected workbook, legacy or a "
+                      f"law in {display(root)} (stored by calibrate --archive --name; "
+                      f"there: {known})")
 
 
 def list_laws(root):
@@ -94,6 +101,8 @@ def list_laws(root):
         try:
             record = read_record(root, path, "law")
             _law(record, f"{folder.name}@{version}", path)  # a law fill could run
+            if not committed(root, folder.name, version, record):
+                continue  # a next that did not finish: not a law of the archive
             lo, hi = record["v_range"]
             out.append({"ref": f"{folder.name}@{version}", "v_range": [lo, hi],
                         "shots": len(record.get("shots", [])),

@@ -16,12 +16,13 @@ _VERSION = re.compile(r"^v(\d{4,})\.json$")
 
 
 def versions(folder):
-    """``[(version, path)]`` of a record folder, oldest first."""
+    """``[(version, path)]`` of a record folder, oldest first: every name of a version, a
+    FIFO, a folder or a link in its place included, so that its reader names what is there
+    (and a writer never waits on a version something else holds)."""
     folder = Path(folder)
     if not folder.is_dir():
         return []
-    found = [(int(m.group(1)), p) for p in folder.iterdir()
-             if (m := _VERSION.match(p.name)) and p.is_file()]
+    found = [(int(m.group(1)), p) for p in folder.iterdir() if (m := _VERSION.match(p.name))]
     return sorted(found)
 
 
@@ -99,12 +100,19 @@ def read_record(root, path, kind):
     return read_json(path, kind, display(path), ArchiveError)
 
 
-def store_record(folder, record, what, root=None):
+class VersionTaken(ArchiveError):
+    """The version a writer had to store was taken by another writer first."""
+
+
+def store_record(folder, record, what, root=None, version=None):
     """Write ``record`` as the next version in ``folder`` (created, inside the archive at
-    ``root``: :func:`inside`); return the version.
+    ``root``: :func:`inside`), or as exactly ``version``; return the version.
 
     Raises
     ------
+    VersionTaken
+        ``version`` was given and another writer holds it (the caller read a state that
+        has changed since).
     ArchiveError
         Naming the folder and ``what`` could not be written, or lies outside the archive.
     """
@@ -123,16 +131,25 @@ def store_record(folder, record, what, root=None):
             json.dump(record, fh, indent=1)
             fh.flush()
             os.fsync(fh.fileno())
-        for _ in range(1000):  # a version another writer took first: the next one
-            found = versions(folder)
-            version = (found[-1][0] if found else 0) + 1
+        if version is not None:  # this version or none: a compare and swap
             try:
                 os.link(tmp, folder / f"v{version:04d}.json")
-                break
             except FileExistsError:
-                continue
+                raise VersionTaken(f"{display(folder / f'v{version:04d}.json')}: was "
+                                   f"stored by another writer while this one ran, expected "
+                                   f"{what} to follow the version it was made from") from None
         else:
-            raise ArchiveError(f"{display(folder)}: no free version, expected fewer writers")
+            for _ in range(1000):  # a version another writer took first: the next one
+                found = versions(folder)
+                version = (found[-1][0] if found else 0) + 1
+                try:
+                    os.link(tmp, folder / f"v{version:04d}.json")
+                    break
+                except FileExistsError:
+                    continue
+            else:
+                raise ArchiveError(f"{display(folder)}: no free version, expected fewer "
+                                   "writers")
         stage("record-stored")
     except OSError as exc:
         raise ArchiveError(f"{display(folder)}: {what} cannot be written "

@@ -448,15 +448,15 @@ class Archive:
                 and manifest["index"]["version"] == row["version"]
                 and self._complete(entry.path, manifest))
 
-    def keep(self, folder, record, what):
+    def keep(self, folder, record, what, version=None):
         """Store ``record`` as the next version in ``folder`` (one of the archive's record
-        folders: a law's, a verdict's; :func:`~airgun_xl.archive.records.store_record});
-        return the version. A failure takes back the folders this made and the archive
-        itself if this object created it and nothing else is in it."""
+        folders: a law's, a verdict's; :func:`~airgun_xl.archive.records.store_record}), or
+        as exactly ``version``; return the version. A failure takes back the folders this
+        made and the archive itself if this object created it and nothing else is in it."""
         folder = Path(folder)
         made = [f for f in (folder.parent, folder) if not f.exists()]
         try:
-            return store_record(folder, record, what, self.root)
+            return store_record(folder, record, what, self.root, version)
         except BaseException:
             for f in reversed(made):
                 with contextlib.suppress(OSError):

@@ -419,12 +419,22 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
         raise WorkbookError(f"{shown}: row {k + 3}: time {values[k + 1, 0]:g} does not "
                             f"follow {values[k, 0]:g}, expected increasing time")
     dt = float(np.median(steps))
+    if not limits.MIN_SAMPLE_STEP <= dt <= limits.MAX_SAMPLE_STEP:  # before any use of it
+        raise WorkbookError(f"{shown}: its sample step is {dt:.4g} s ({1 / dt:.4g} Hz), "
+                            f"expected a step of {limits.MIN_SAMPLE_STEP:g} to "
+                            f"{limits.MAX_SAMPLE_STEP:g} s (a recorder of 1 Hz to 1 GHz)")
     off = np.abs(steps - dt) > GAP_TOLERANCE * dt
     if off.any():
         k = int(np.argmax(off))
         raise WorkbookError(f"{shown}: row {k + 3}: a step of {steps[k]:.4g} s, expected the "
                             f"constant {dt:.4g} s of the other rows (a gap or a changed rate)")
-    return Trace(time, sign * values[:, 1] * FILE_ACCEL_UNITS[a_unit], dt, shown,
+    accel = sign * values[:, 1] * FILE_ACCEL_UNITS[a_unit]
+    peak = float(np.max(np.abs(accel)))
+    if not peak >= limits.MIN_RECORDED_PEAK_KG:
+        raise WorkbookError(f"{shown}: the recording is flat (its largest acceleration is "
+                            f"{peak:.3g} kG), expected a pulse of at least "
+                            f"{limits.MIN_RECORDED_PEAK_KG:g} kG (about 0.001 g)")
+    return Trace(time, accel, dt, shown,
                  (t_unit, a_unit),
                  notes)
 

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from ..crush_law import CRUSH_FIT_RANGE, LEGACY_LAW, chebyshev_nodes
 from .acceptance import wilson_interval
 from .first_shot import JOINT, LAW_FIELDS, LAW_SCALE, NODES
 
@@ -119,6 +120,38 @@ class LawUpdate:
                         "one): P(PASS) draws the law as if it were known exactly, and is "
                         "optimistic")
         return said
+
+
+#: A lot's law against the report's, at every node of its range [-]: the bounds the
+#: calibration holds a scale to (calibrate.FIT_PARAMETERS). A law past them is no honeycomb of
+#: the report's kind: a record edited or damaged, or a recording misread.
+LOT_LAW_RATIO = (0.25, 4.0)
+
+
+def against_report(law):
+    """The lowest and highest ratio [-] of ``law``'s polynomial to the report's, at the 7
+    Chebyshev nodes of its range within the report's (-20 to 250 m/s); NaN when the ranges
+    do not meet or a value is not finite."""
+    lo = max(law.v_range[0], CRUSH_FIT_RANGE[0])
+    hi = min(law.v_range[1], CRUSH_FIT_RANGE[1])
+    if not lo < hi:
+        return math.nan, math.nan
+    nodes = chebyshev_nodes(lo, hi, 7)
+    with np.errstate(all="ignore"):
+        ratio = law.poly(nodes) / LEGACY_LAW.poly(nodes)
+    if not np.all(np.isfinite(ratio)):
+        return math.nan, math.nan
+    return float(ratio.min()), float(ratio.max())
+
+
+def implausible(law):
+    """Why ``law`` cannot be a lot's law (its ratio to the report's past
+    :data:`LOT_LAW_RATIO` somewhere, named), or '' when it can."""
+    low, high = against_report(law)
+    if low >= LOT_LAW_RATIO[0] and high <= LOT_LAW_RATIO[1]:
+        return ""
+    return (f"{low:.3g} to {high:.3g} times the report's law over its range, expected "
+            f"{LOT_LAW_RATIO[0]:g} to {LOT_LAW_RATIO[1]:g} times")
 
 
 def update_law(params, traces, prior, cfc=None, integrator="legacy", velocities=False,

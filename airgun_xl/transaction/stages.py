@@ -12,7 +12,9 @@ The stages (:data:`STAGES`): ``archive-made`` (a new archive's folder and marker
 ``record-stored`` (a law's or a verdict's record linked into place), ``entry-staged`` (an
 archive entry's files written to its scratch folder), ``entry-renamed`` (the entry renamed
 into place, its row not yet committed), ``publishing`` (a command's outputs staged as temps,
-before the commit), ``published`` (the commit point passed).
+before the commit), ``published`` (the commit point passed); and ``next``'s own, after each
+of its records: ``next-law-stored``, ``next-verdict-stored``, ``next-proposal-stored`` (its
+commit point passed).
 """
 import os
 import time
@@ -22,7 +24,7 @@ from pathlib import Path
 STAGES_ENV = "AIRGUN_XL_STAGES"
 
 STAGES = ("archive-made", "record-stored", "entry-staged", "entry-renamed", "publishing",
-          "published")
+          "published", "next-law-stored", "next-verdict-stored", "next-proposal-stored")
 
 #: How often a held stage looks for its hold file to go [s].
 POLL = 0.002

@@ -21,6 +21,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from ..units import PEAK_UNITS
 from .pages import finite as pages_finite
 from .pages import real
 
@@ -49,8 +50,12 @@ class Guard:
             await self.app(scope, receive, send)
             return
 
+        started = False
+
         async def send_with_headers(message: Any) -> None:
+            nonlocal started
             if message["type"] == "http.response.start":
+                started = True
                 headers = [(k, v) for k, v in message.get("headers", [])
                            if k.decode("latin-1").lower() not in HEADERS]
                 headers += [(k.encode(), v.encode()) for k, v in HEADERS.items()]
@@ -64,7 +69,18 @@ class Guard:
                                          headers={"allow": "GET, HEAD"})
             await response(scope, receive, send_with_headers)
             return
-        await self.app(scope, receive, send_with_headers)
+        try:
+            await self.app(scope, receive, send_with_headers)
+        except Exception as exc:  # noqa: BLE001 - an archive damaged while the view runs
+            if started:
+                raise
+            from starlette.responses import PlainTextResponse
+
+            # answered here, with the headers: Starlette's own 500 is sent outside this guard
+            response = PlainTextResponse(f"the archive could not be read "
+                                         f"({type(exc).__name__}): see airgun-xl archive "
+                                         "verify\n", 500)
+            await response(scope, receive, send_with_headers)
 
 
 def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = True) -> Any:
@@ -298,7 +314,8 @@ def _peak_band(predicted: dict[str, Any] | None,
         sources.append(("the prediction's specification", predicted.get("criteria") or []))
     for source, criteria in sources:
         for c in criteria:
-            scale = {"kG": 1.0, "g": 1e-3}.get(str(c.get("unit")))
+            scale = PEAK_UNITS.get(str(c.get("unit"))) if c.get("unit") in ("kG", "g") \
+                else None  # the one table of units: 1 g is 1/999.32 kG, not 1/1000
             if c.get("name") != "peak" or scale is None:
                 continue
             low, high = (pages_finite(c.get(k), scale) for k in ("low", "high"))
@@ -454,6 +471,19 @@ def _warn(text: str) -> None:
     print(f"airgun-xl: warning: {text}", file=sys.stderr, flush=True)
 
 
+def is_loopback(host: str) -> bool:
+    """Whether ``host`` is a loopback address or name (127.0.0.0/8, ::1, localhost): a view
+    there is reached from this machine only."""
+    import ipaddress
+
+    if host in LOOPBACK:
+        return True
+    try:
+        return ipaddress.ip_address(host.strip("[]")).is_loopback
+    except ValueError:  # a name: only localhost is sure to be loopback
+        return False
+
+
 def serve(archive: str | Path, host: str = "127.0.0.1", port: int = 8765,
           say: Any = print, warn: Any = _warn) -> None:
     """Run the view of ``archive`` until Ctrl-C (SIGINT) or SIGTERM; ``say`` is told the
@@ -475,11 +505,11 @@ def serve(archive: str | Path, host: str = "127.0.0.1", port: int = 8765,
         raise OptionError(MISSING) from None
     if not 0 <= port <= 65535:
         raise OptionError(f"--port: found {port}, expected 0 to 65535")
-    if host not in LOOPBACK:
+    app = build_app(archive, () if host in LOOPBACK else (host,))
+    sock = listen(host, port)  # a refusal comes alone: no warning before it
+    if not is_loopback(host):
         warn(f"--host {host}: the view answers on that address, and it has no login: anyone "
              "who reaches it reads the archive")
-    app = build_app(archive, () if host in LOOPBACK else (host,))
-    sock = listen(host, port)
     bound = sock.getsockname()
     shown = f"[{bound[0]}]" if ":" in bound[0] else bound[0]
     config = uvicorn.Config(app, log_level="critical", access_log=False, server_header=False,

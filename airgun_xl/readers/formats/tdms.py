@@ -83,7 +83,14 @@ def _samples(shown: str, chosen: Any, offset: int, count: int) -> np.ndarray:
 
 
 def _step(shown: str, chosen: Any) -> tuple[float, float]:
+    """The waveform's step and start [s]: properties stored as numbers (a text that reads as
+    one is the file's fault, not a step)."""
     try:
+        for name in ("wf_increment", "wf_start_offset"):
+            value = chosen.properties.get(name, 0.0)
+            if isinstance(value, (str, bytes, bool)) or not isinstance(value, (int, float,
+                                                                              np.number)):
+                raise TypeError(f"{name} stored as {type(value).__name__}, not a number")
         dt = float(chosen.properties["wf_increment"])
         start = float(chosen.properties.get("wf_start_offset", 0.0))
     except (TypeError, ValueError, OverflowError) as exc:
