@@ -14,6 +14,7 @@ import inspect
 import os
 from typing import TYPE_CHECKING, Any, TypeVar
 
+from . import blas  # noqa: F401 - first: OpenBLAS's kernel is pinned before numpy loads
 from .errors import (
     AirgunXlError,
     ArchiveError,

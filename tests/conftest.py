@@ -1,4 +1,7 @@
 """Shared helpers: the legacy cases and reading result columns back from a workbook."""
+import airgun_xl  # noqa: F401 - first: it pins OpenBLAS's kernel before numpy loads (blas.py)
+
+# isort: split
 import json
 from pathlib import Path
 

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..blas import KERNEL, PINNED
 from ..cells import CELLS
 from ..crush_law import law_name
 from ..reports.sidecar import have_parquet, render_history
@@ -95,7 +96,8 @@ def prepare_entry(archive, request, shot, workbook, filled, options, seconds):
                   "crush_law": {"name": law_name(p.crush_law),
                                 "coefficients": list(p.crush_law.coefficients),
                                 "v_range": list(p.crush_law.v_range)},
-                  "host": options.host, "stride": filled.stride}
+                  "host": options.host, "stride": filled.stride,
+                  "openblas": {"kernel": KERNEL, "pinned": PINNED}}
     files = {"output.xlsx": workbook}
     if shot.source is not None:
         files["input" + shot.source.path.suffix.lower()] = shot.source.path
