@@ -125,6 +125,7 @@ class NextOutcome:
                      "p_pass": self.best.probability,
                      "interval": [lo, hi], "draws": self.best.shots,
                      "most_likely_to_fail": worst[0] if worst else None,
+                     "expected": expected_record(self.best),
                      **({"unrounded": unrounded_record(self.unrounded, self.second)}
                         if self.unrounded is not None else {})},
             "gun": self.gun, "confidence": self.confidence, "reached": self.reached,
@@ -606,6 +607,7 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
     from ..archive.records import VersionTaken
     from ..archive.verdicts import StoredVerdict, store_verdict
     from ..crush_law import CrushLaw
+    from ..studies.closed_loop import against_report
     from ..transaction import signals_held
 
     done: list[Any] = []
@@ -640,6 +642,9 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
                       "second_value": best.second} if request.vary else {}),
                   "p_pass": best.probability,
                   "interval": [lo, hi], "draws": best.shots,
+                  "expected": expected_record(best), "measured": measured_record(verdict),
+                  "against_report": [v if math.isfinite(v) else None
+                                     for v in against_report(update.law)],
                   "most_likely_to_fail": worst[0] if worst else None,
                   **({"step": list(request.step),
                       "unrounded": unrounded_record(unrounded, knob_value(request, unrounded))}
@@ -746,6 +751,68 @@ def update_text(update: LawUpdate, errors: str = "") -> str:
             f"{tilt_text(update)} {shots}")
 
 
+#: How a proposal states each judged figure: its unit and the factor from the judge's (kG, s,
+#: m/s), and the digits shown.
+FIGURE_UNITS = {"peak": ("kG", 1.0, 3), "duration": ("ms", 1e3, 3),
+                "velocity change": ("m/s", 1.0, 2)}
+
+
+def expected_record(best: PassProbability) -> dict[str, list[float | None]]:
+    """The judged figures expected at the proposal, for its record and ``--json``:
+    ``{criterion: [5th, 50th, 95th percentile]}`` in the judge's units (kG, s, m/s; a NaN
+    null)."""
+    return {name: [v if math.isfinite(v) else None for v in values]
+            for name, values in best.figures.items()}
+
+
+def measured_record(verdict: Verdict) -> dict[str, dict[str, Any]]:
+    """The fired shot's judged figures beside what was expected of it: ``{criterion:
+    {"value", "unit"}}`` (a value that could not be measured: null)."""
+    return {c.name: {"value": c.value if math.isfinite(c.value) else None, "unit": c.unit}
+            for c in verdict.criteria if c.name in FIGURE_UNITS}
+
+
+def expected_text(expected: Any) -> str:
+    """``peak 9.102 kG (8.805 to 9.447), duration ...``: a record's expected figures, each
+    with its 90 % range ('' when the record holds none)."""
+    parts = []
+    for name, (unit, factor, digits) in FIGURE_UNITS.items():
+        values = expected.get(name) if isinstance(expected, dict) else None
+        if not (isinstance(values, list) and len(values) == 3
+                and all(isinstance(v, (int, float)) for v in values)):
+            continue
+        lo, mid, hi = (float(v) * factor for v in values)
+        parts.append(f"{name} {mid:.{digits}f} {unit} ({lo:.{digits}f} to {hi:.{digits}f})")
+    return ", ".join(parts)
+
+
+def measured_text(measured: Any) -> str:
+    """``peak 9.214 kG, duration 4.602 ms``: a record's measured figures, each in the unit its
+    verdict gave ('' when none)."""
+    parts = []
+    for name in FIGURE_UNITS:
+        found = measured.get(name) if isinstance(measured, dict) else None
+        if not isinstance(found, dict):
+            continue
+        value = found.get("value")
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            parts.append(f"{name} {float(value):.5g} {str(found.get('unit', ''))[:8]}")
+    return ", ".join(parts)
+
+
+def against_report_text(update: LawUpdate) -> str:
+    """The lot's law against the report's, all its updates together (each update's scale is
+    against the version before)."""
+    from ..studies.closed_loop import against_report
+
+    low, high = against_report(update.law)
+    if not (math.isfinite(low) and math.isfinite(high)):
+        return "the lot's law against the report's: not comparable (no common speed)"
+    if abs(high - low) <= 5e-4 * abs(high):
+        return f"the lot's law is x{0.5 * (low + high):.4f} the report's"
+    return f"the lot's law is x{low:.4f} to x{high:.4f} the report's over its range"
+
+
 def lines(request: NextRequest, outcome: NextOutcome) -> list[str]:
     """What ``next`` prints: the fired shot's verdict, the law's update, the next setting
     with its P(PASS), the files and the archive's records."""
@@ -759,11 +826,14 @@ def lines(request: NextRequest, outcome: NextOutcome) -> list[str]:
         said.append("  this shot was recorded in the lot before: counted once")
     said += [f"lot {request.lot}: the law {outcome.law}, "
              f"{update_text(u, ' (1 standard error)')}", f"  {u.note}",
+             f"  {against_report_text(u)}",
              f"next: {setting_text(request, b)}, P(PASS) = {b.probability:.4f} "
              f"[{lo:.4f}, {hi:.4f}] over {b.shots:,} draws"
              + (f"; most likely to fail: {worst[0]}" if worst else ""),
              *([f"  {rounded_text(request, outcome.unrounded)}"]
                if outcome.unrounded is not None else []),
+             *([f"  expected there (median, 90 % of the draws): "
+                f"{expected_text(expected_record(b))}"] if b.figures else []),
              f"  {outcome.gun}",
              f"  {'reaches' if outcome.reached else 'does NOT reach'} --confidence "
              f"{outcome.confidence:g}",
@@ -790,13 +860,21 @@ def chain(root: str | Path | None, lot: str) -> list[dict[str, Any]]:
         shots = record.get("shots") or []
         fired = shots[-1].get("shot_sha256") if shots else None
         before = predicted.get(fired) if isinstance(fired, str) else None
+        knobs = {"A28": record.get("setting_A28")}
+        if isinstance(record.get("second_cell"), str):
+            knobs[record["second_cell"][:8]] = record.get("second_value")
         rows.append({"proposal": f"{lot}@{version}", "shot": record.get("shot"),
                      "verdict": record.get("verdict"),
-                     "predicted_before": before, "law": record.get("law"),
-                     "next_A28": record.get("setting_A28"), "next_p_pass": record.get("p_pass"),
+                     "predicted_before": before[0] if before else None,
+                     "expected_before": before[1] if before else None,
+                     "measured": record.get("measured"), "law": record.get("law"),
+                     "against_report": record.get("against_report"),
+                     "next_A28": record.get("setting_A28"), "next_knobs": knobs,
+                     "next_p_pass": record.get("p_pass"),
+                     "next_expected": record.get("expected"),
                      "created": record.get("created", "")})
         if isinstance(record.get("next_sha256"), str):
-            predicted[record["next_sha256"]] = record.get("p_pass")
+            predicted[record["next_sha256"]] = (record.get("p_pass"), record.get("expected"))
     return rows
 
 
@@ -813,6 +891,23 @@ def chain_lines(lot: str, rows: list[dict[str, Any]]) -> list[str]:
                      f"{p(r['predicted_before']):>8}  {r['law']!s:<16} "
                      f"{nxt if not isinstance(nxt, (int, float)) else f'{nxt:.3f}':>12} "
                      f"{p(r['next_p_pass']):>8}  {r['shot']}")
+        expected, measured = expected_text(r.get("expected_before")), \
+            measured_text(r.get("measured"))
+        if expected:
+            lines.append(f"         expected of this shot: {expected}")
+        if measured:
+            lines.append(f"         measured: {measured}")
+        ratio = r.get("against_report")
+        if isinstance(ratio, list) and len(ratio) == 2 and all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) for v in ratio):
+            lines.append(f"         the lot's law: x{ratio[0]:.4f} to x{ratio[1]:.4f} the "
+                         "report's")
+        knobs = {k: v for k, v in (r.get("next_knobs") or {}).items()
+                 if isinstance(v, (int, float)) and not isinstance(v, bool)}
+        if knobs:
+            lines.append("         next: " + ", ".join(f"{k} {v:.6g}" for k, v in knobs.items())
+                         + (f"; expected {expected_text(r.get('next_expected'))}"
+                            if expected_text(r.get("next_expected")) else ""))
     return lines
 
 

@@ -268,6 +268,10 @@ class PassProbability:
     diverged: int
     invalid: int  # draws that are not a shot (a negative mass): counted as failures
     second: float = math.nan  # a :class:`Pair`'s second setting (NaN: one variable)
+    #: Each judged figure the specification limits (peak [kG], duration [s], velocity
+    #: change [m/s]) over the draws that ran: its 5th, 50th and 95th percentiles, the
+    #: middle and 90 % range of what the shot is expected to measure.
+    figures: dict[str, tuple[float, float, float]] = field(default_factory=dict)
 
     @property
     def probability(self) -> float:
@@ -395,7 +399,31 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
     failures = {name: int((~f).sum()) + int(invalid.sum()) for name, f in flags.items()}
     return PassProbability(float(first) if first is not None else math.nan,
                            int(ok.sum()), n, failures, int(batch.diverged.sum()),
-                           int(invalid.sum()), float(second))
+                           int(invalid.sum()), float(second),
+                           expected_figures(batch.extras, spec))
+
+
+#: The percentiles of a judged figure a proposal states: its middle and 90 % range.
+RANGE_PERCENTILES = (5.0, 50.0, 95.0)
+
+
+def expected_figures(values, spec):
+    """``{criterion: (5th, 50th, 95th percentile)}`` of each judged figure ``spec`` limits,
+    from a :class:`~.acceptance.BlockJudge`'s columns (a diverged draw's NaN left out; none
+    that ran: NaN)."""
+    from .acceptance import BLOCK_VALUES
+
+    spec = spec.resolved()
+    out = {}
+    for name, tolerance in (("peak", spec.peak), ("duration", spec.duration),
+                            ("velocity change", spec.velocity_change)):
+        if tolerance is None:
+            continue
+        column = np.asarray(values, dtype=float)[:, BLOCK_VALUES.index(name)]
+        column = column[np.isfinite(column)]
+        out[name] = (tuple(float(v) for v in np.percentile(column, RANGE_PERCENTILES))
+                     if column.size else (math.nan,) * 3)
+    return out
 
 
 @dataclass
