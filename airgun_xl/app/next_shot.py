@@ -860,7 +860,7 @@ def chain(root: str | Path | None, lot: str) -> list[dict[str, Any]]:
         shots = record.get("shots") or []
         fired = shots[-1].get("shot_sha256") if shots else None
         before = predicted.get(fired) if isinstance(fired, str) else None
-        knobs = {"A28": record.get("setting_A28")}
+        knobs = {address("v31"): record.get("setting_A28")}
         if isinstance(record.get("second_cell"), str):
             knobs[record["second_cell"][:8]] = record.get("second_value")
         rows.append({"proposal": f"{lot}@{version}", "shot": record.get("shot"),
