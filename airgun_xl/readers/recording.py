@@ -419,7 +419,9 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
         raise WorkbookError(f"{shown}: row {k + 3}: time {values[k + 1, 0]:g} does not "
                             f"follow {values[k, 0]:g}, expected increasing time")
     dt = float(np.median(steps))
-    if not limits.MIN_SAMPLE_STEP <= dt <= limits.MAX_SAMPLE_STEP:  # before any use of it
+    # before any use of it; a step on a bound to its float rounding is on it (1 ns as
+    # k x 1e-9 s reads 0.9999999999999999e-9 between some samples)
+    if not limits.MIN_SAMPLE_STEP * (1 - 1e-9) <= dt <= limits.MAX_SAMPLE_STEP * (1 + 1e-9):
         raise WorkbookError(f"{shown}: its sample step is {dt:.4g} s ({1 / dt:.4g} Hz), "
                             f"expected a step of {limits.MIN_SAMPLE_STEP:g} to "
                             f"{limits.MAX_SAMPLE_STEP:g} s (a recorder of 1 Hz to 1 GHz)")
