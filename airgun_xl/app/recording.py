@@ -30,12 +30,16 @@ class RecordingOutcome:
             return "unknown" if x is None or not math.isfinite(x) else format(x, fmt)
 
         count = len(self.channels)
+        names = [printable(c.name) for c in self.channels]
+        units = [printable(c.unit) or "-" for c in self.channels]
+        # the columns as wide as their longest entry: a long name never runs into the unit
+        wide, unit = max([24, *map(len, names)]), max([8, *map(len, units)])
         out = [f"{printable(display(self.path))}: {self.format}, {count} channel"
                f"{'' if count == 1 else 's'}",
-               f"{'#':>3}  {'name':<24} {'unit':<8} {'rate [Hz]':>12} {'samples':>12} "
-               f"{'start [s]':>12}"]
+               f"{'#':>3}  {'name':<{wide}} {'unit':<{unit}} {'rate [Hz]':>12} "
+               f"{'samples':>12} {'start [s]':>12}"]
         for k, c in enumerate(self.channels, start=1):
-            out.append(f"{k:>3}  {printable(c.name):<24} {printable(c.unit) or '-':<8} "
+            out.append(f"{k:>3}  {names[k - 1]:<{wide}} {units[k - 1]:<{unit}} "
                        f"{number(c.rate, ',.6g'):>12} {c.samples:>12,} "
                        f"{number(c.start, '.6g'):>12}")
         return out
@@ -67,4 +71,11 @@ def run(path: str | Path) -> RecordingOutcome:
     else:
         fmt = formats.detect(path)
         kind = fmt.NAME if fmt is not None else "CSV"
-    return RecordingOutcome(Path(text), kind, tuple(list_channels(path)))
+    channels = tuple(list_channels(path))
+    if not channels:  # a UFF of no time response listed "0 channels" and exited 0
+        from ..errors import WorkbookError
+        from ..transaction import display
+
+        raise WorkbookError(f"{display(Path(text))}: holds no channel of a recording (a time "
+                            f"response), expected a {kind} file of at least one")
+    return RecordingOutcome(Path(text), kind, channels)

@@ -213,7 +213,7 @@ def options_spec(fields: SpecFields) -> Specification | None:
         parsed["srs_lower_db"], parsed["srs_upper_db"] = parse_db_pair(fields.srs_tol)
     srs = None
     if fields.srs is not None:
-        freqs, levels = read_spectrum(fields.srs, fields.accel_unit)
+        freqs, levels = read_spectrum(fields.srs, fields.accel_unit, "--srs")
         srs = SrsRequirement(tuple(map(float, freqs)), tuple(map(float, levels)))
     if not parsed and srs is None:
         return None

@@ -87,12 +87,20 @@ def _stated(header):
     return (found.group(1) if found else "").strip()
 
 
-def _unit(header, table, option, which):
+def _unit(header, table, option, which, named=None):
+    """The unit key ``header`` states (in ``table``); one line naming ``option`` otherwise.
+    ``named``: the channel of a binary file, whose unit is its own field, not a header."""
     text = _stated(header)
-    key = text.replace("'s", "").replace("²", "^2").replace(" ", "")
+    key = _key(text)
     near = [k for k in table if k.lower() == key.lower()]
+    if named is not None and key not in table and not near:
+        found = "none" if not text else repr(text)
+        raise OptionError(f"{option}: {named} states the unit {found}, which is no "
+                          f"{which} unit I know; expected one of {', '.join(table)}, or "
+                          f"{option} (or --channel for another channel)")
     if key not in table and near:  # units are case sensitive: [Kg] is kilograms, [MS] not ms
-        raise OptionError(f"{option}: the {which} header {header!r} names {text!r}, a case "
+        where = named if named is not None else f"the {which} header {header!r}"
+        raise OptionError(f"{option}: {where} names {text!r}, a case "
                           f"away from {near[0]!r}; units are case sensitive (Kg is a mass, MS "
                           f"megasiemens), expected exactly one of {', '.join(table)}, or "
                           f"{option}")
@@ -252,8 +260,44 @@ def input_file(spec):
     return found["file"] if found and not Path(str(spec)).exists() else str(spec)
 
 
-def _source_table(path, channel=None):
-    """Any measured source as a :class:`~.formats.Table`."""
+def _key(text):
+    """A unit as the tables key it (``g's`` -> ``g``, ``m/s²`` -> ``m/s^2``)."""
+    return text.replace("'s", "").replace("²", "^2").replace(" ", "")
+
+
+def _first_acceleration(path, fmt, data):
+    """The name of the first channel of a file of several whose unit is an acceleration, and
+    the note that says it was chosen; None for a file of one channel, or whose first channel
+    is one (the default it always was).
+
+    Raises
+    ------
+    OptionError
+        When several channels state no acceleration unit: naming each with its unit, and
+        ``--channel``.
+    """
+    infos = fmt.channels(path, data)
+    if len(infos) < 2:
+        return None
+    for k, info in enumerate(infos):
+        if _key(info.unit) in FILE_ACCEL_UNITS:
+            if k == 0:
+                return None
+            return info.name, (f"{display(Path(path))}: channel {info.name!r} is judged, the "
+                               f"first of its {len(infos)} channels whose unit is an "
+                               f"acceleration ({info.unit}); --channel names another")
+    listed = "; ".join(f"{k}. {i.name!r} [{i.unit or 'no unit'}]"
+                       for k, i in enumerate(infos[:8], start=1))
+    more = f"; and {len(infos) - 8} more" if len(infos) > 8 else ""
+    raise OptionError(f"--channel: {display(Path(path))} holds {len(infos)} channels and none "
+                      f"states an acceleration unit ({listed}{more}), expected --channel "
+                      "naming the one to judge (and --accel-unit its unit)")
+
+
+def _source_table(path, channel=None, choose_acceleration=False):
+    """Any measured source as a :class:`~.formats.Table`; with ``choose_acceleration`` and no
+    ``channel``, a file of several channels gives its first acceleration channel (said in
+    the table's notes)."""
     text = str(path)
     found = RANGE.match(text)
     if found and not Path(text).exists():
@@ -264,7 +308,13 @@ def _source_table(path, channel=None):
         return formats.Table(*_range_table(found))
     fmt = formats.detect(path)
     if fmt is not None:
-        return fmt.read(path, formats.source(fmt, path), channel)
+        data = formats.source(fmt, path)
+        chosen = _first_acceleration(path, fmt, data) \
+            if channel is None and choose_acceleration else None
+        if chosen is None:
+            return fmt.read(path, data, channel)
+        table = fmt.read(path, data, chosen[0])
+        return table._replace(notes=(*table.notes, chosen[1]))
     if channel is not None:
         raise OptionError("--channel: found with a CSV file, expected it only with a file of "
                           "several channels (TDMS, MATLAB .mat, MDF, IDE, UFF, MME)")
@@ -353,15 +403,16 @@ EXPECTED_SPECTRUM = ("expected a CSV of natural frequency and required SRS level
                      "columns, a header row such as 'frequency [Hz],srs [g]')")
 
 
-def read_spectrum(path, accel_unit=None):
+def read_spectrum(path, accel_unit=None, option="--target-srs"):
     """A required shock response spectrum: (frequencies [Hz], levels [kG]), from a CSV whose
     header gives the units (``frequency [Hz]``, ``srs [g]``); frequencies increasing and
-    positive, levels positive. Raises WorkbookError or OptionError naming the row or unit."""
+    positive, levels positive. Raises WorkbookError or OptionError naming the row or unit
+    (``option``: the one that named the file, ``--srs`` or ``--target-srs``)."""
     if accel_unit is not None and accel_unit not in ACCEL_UNITS:
         raise OptionError(f"--accel-unit: found {accel_unit!r}, expected one of "
                           f"{', '.join(ACCEL_UNITS)}")
     shown, header, values = _table(path, EXPECTED_SPECTRUM, ("frequency", "level"))
-    f_unit = _unit(header[0], FREQUENCY_UNITS, "--target-srs", "frequency")
+    f_unit = _unit(header[0], FREQUENCY_UNITS, option, "frequency")
     a_unit = accel_unit or _unit(header[1], ACCEL_UNITS, "--accel-unit", "level")
     f = values[:, 0] * FREQUENCY_UNITS[f_unit]
     for k in range(len(f)):
@@ -400,9 +451,16 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
                                  ("--accel-unit", accel_unit, ACCEL_UNITS)):
         if given is not None and given not in table:
             raise OptionError(f"{option}: found {given!r}, expected one of {', '.join(table)}")
-    shown, header, values, said = _source_table(path, channel)
-    t_unit = time_unit or _unit(header[0], FILE_TIME_UNITS, "--time-unit", "time")
-    a_unit = accel_unit or _unit(header[1], FILE_ACCEL_UNITS, "--accel-unit", "acceleration")
+    binary = not (RANGE.match(str(path)) and not Path(str(path)).exists()) \
+        and formats.detect(path) is not None
+    shown, header, values, said = _source_table(path, channel,
+                                                choose_acceleration=accel_unit is None)
+    named = f"channel {shown.rpartition(' (')[2].rstrip(')')!r} of {display(Path(path))}" \
+        if binary else None
+    t_unit = time_unit or _unit(header[0], FILE_TIME_UNITS, "--time-unit", "time",
+                                None if named is None else f"the time of {named}")
+    a_unit = accel_unit or _unit(header[1], FILE_ACCEL_UNITS, "--accel-unit", "acceleration",
+                                 named)
     notes = [_override(shown, option, given, stated, table)
              for option, given, stated, table in (
                  ("--time-unit", time_unit, header[0], FILE_TIME_UNITS),

@@ -501,10 +501,13 @@ def srs_criterion(t: np.ndarray, kg: np.ndarray, spec: Specification) -> tuple[C
                           f"requirement rows up to {0.1 / dt:,.0f} Hz, or a faster record")
     low, length = min(r.frequencies), float(t[-1] - t[0])
     if low * length < 1:  # below one cycle over the record: not resolved, and costly
-        raise OptionError(f"{named}: found a row at {low:g} Hz, below the {1 / length:,.3g} "
+        # as many digits as tell the two apart (9.98 ms resolves 100.2 Hz, not "100")
+        digits = next((d for d in range(3, 17) if f"{low:.{d}g}" != f"{1 / length:.{d}g}"),
+                      17)
+        least = f"{1 / length:,.{digits}g}"
+        raise OptionError(f"{named}: found a row at {low:.{digits}g} Hz, below the {least} "
                           f"Hz the record's {length * 1e3:,.4g} ms can resolve (one cycle "
-                          f"over it); expected rows from {1 / length:,.3g} Hz, or a longer "
-                          "record")
+                          f"over it); expected rows from {least} Hz, or a longer record")
     from .. import limits
     from .shock import decimated_for
 

@@ -142,4 +142,6 @@ def read(path: str | Path, data: bytes | LargeFile, channel: str | None) -> Tabl
     # not lend its brackets to the unit parser
     header = ["time [s]", f"acceleration [{unit}]" if unit else "acceleration"]
     time = start + dt * (first + np.arange(len(accel)))
-    return Table(shown, header, np.column_stack([time, accel]), notes)
+    # named with its channel, as every other format's (the verdict's lines name it)
+    return Table(f"{shown} ({chosen.group_name}/{chosen.name})", header,
+                 np.column_stack([time, accel]), notes)
