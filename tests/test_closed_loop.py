@@ -480,3 +480,57 @@ def test_a_gun_that_fires_off_its_setting_is_said_and_warned_of():
         "shots: the setting proposed is the velocity to fire, which this gun reaches set that "
         "much the other way; the draws assume no such offset"]
     assert GunScatter(0.015, (0.010, 0.030), 8, -0.009, 0.005).warnings == []
+
+
+# -- issue 60: the loop says what it expects ---------------------------------------------
+
+@pytest.mark.slow
+def test_a_proposal_keeps_and_prints_what_it_expects_and_the_lot_against_the_report(
+        lot, capsys):
+    import json
+
+    from airgun_xl.app.next_shot import NextRequest, lines
+    from airgun_xl.archive.lots import proposals
+    from airgun_xl.studies.closed_loop import against_report
+
+    work, first, second = lot
+    records = [r for _, r in proposals(work / "arch", "LOT-A")][:2]  # the fixture's two
+    for record, outcome in zip(records, (first, second), strict=True):
+        expected = record["expected"]
+        assert set(expected) == {"peak", "duration"}
+        assert expected == {k: list(v) for k, v in outcome.best.figures.items()}
+        lo, mid, hi = expected["peak"]
+        assert lo <= mid <= hi and 7.0 < mid < 10.0  # kG, about the 8.5 asked
+        assert record["against_report"] == pytest.approx(list(against_report(
+            outcome.update.law)), rel=1e-12)
+        assert json.loads(outcome.to_json())["next"]["expected"] == expected
+    # the second record keeps what its fired shot measured: its verdict's figures
+    measured = records[1]["measured"]
+    for c in second.verdict.criteria:
+        assert measured[c.name]["value"] == pytest.approx(c.value, rel=1e-12)
+    # the law after two shots of a lot 10 % stronger: about 1.10 the report's, cumulative
+    low, high = records[1]["against_report"]
+    assert 1.03 < low <= high < 1.17
+    said = "\n".join(lines(NextRequest(work / "shot2.xlsx", work / "rec2.csv", work / "arch",
+                                       "LOT-A"), second))
+    assert "expected there (median, 90 % of the draws): peak " in said
+    assert "the lot's law is x" in said and "the report's" in said
+
+
+@pytest.mark.slow
+def test_history_lot_shows_the_knobs_what_was_expected_and_what_was_measured(lot,
+                                                                            capsys):
+    from airgun_xl.cli import main
+
+    work, first, second = lot
+    capsys.readouterr()
+    assert main(["history", "--archive", str(work / "arch"), "--lot", "LOT-A"]) == 0
+    out = capsys.readouterr().out
+    peak = first.best.figures["peak"]
+    assert (f"expected of this shot: peak {peak[1]:.3f} kG ({peak[0]:.3f} to {peak[2]:.3f})"
+            in out), out
+    measured = next(c for c in second.verdict.criteria if c.name == "peak")
+    assert f"measured: peak {measured.value:.5g} {measured.unit}" in out
+    assert f"next: A28 {second.setting:.6g}" in out
+    assert out.count("the lot's law: x") >= 2  # the fixture's two, and any a test added
+    assert not math.isnan(np.mean(peak))
