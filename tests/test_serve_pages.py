@@ -76,6 +76,7 @@ def lab(tmp_path_factory):
     # hostile records: a law and a verdict whose texts are a script, a law folder that links
     # out of the archive
     law = json.loads((root / ".laws" / "LOT-A" / "v0001.json").read_text())
+    law.pop("proposal")  # a law of its own, not one next made for LOT-A's proposal 1
     (root / ".laws" / "EVIL").mkdir()
     (root / ".laws" / "EVIL" / "v0001.json").write_text(json.dumps(
         {**law, "shots": [{"workbook": HOSTILE}], "created": HOSTILE}))
