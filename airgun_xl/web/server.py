@@ -505,8 +505,12 @@ def serve(archive: str | Path, host: str = "127.0.0.1", port: int = 8765,
         raise OptionError(MISSING) from None
     if not 0 <= port <= 65535:
         raise OptionError(f"--port: found {port}, expected 0 to 65535")
-    app = build_app(archive, () if host in LOOPBACK else (host,))
-    sock = listen(host, port)  # a refusal comes alone: no warning before it
+    sock = listen(host, port)  # first: a refusal comes alone, before the archive is opened
+    try:
+        app = build_app(archive, () if host in LOOPBACK else (host,))
+    except BaseException:
+        sock.close()
+        raise
     if not is_loopback(host):
         warn(f"--host {host}: the view answers on that address, and it has no login: anyone "
              "who reaches it reads the archive")

@@ -203,7 +203,7 @@ def test_59_2_a_virtual_dataset_mapping_another_file_crashes_nothing(tmp_path):
 #: A specification shot A's lot 10 % stronger fails at first (tests/test_closed_loop.py's).
 NEXT_SPEC = ["--peak", "8.5kG:5%", "--duration", "4.5ms:15%"]
 #: Monte Carlo draws a setting: these tests look at the records, not at the probability.
-NEXT_SHOTS = "200"
+NEXT_SHOTS = "100"
 
 
 def _fire(workbook, recording, seed):
