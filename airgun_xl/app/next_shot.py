@@ -475,7 +475,7 @@ def _lot(request: NextRequest) -> tuple[Any, list[dict[str, Any]], int]:
     from ..archive.laws import load_law
     from ..archive.lots import proposals, shot_keys
     from ..crush_law import LEGACY_LAW
-    from ..errors import AirgunXlError, ArchiveError
+    from ..errors import AirgunXlError
     from ..studies.closed_loop import implausible
 
     chain = proposals(request.archive, request.lot)

@@ -295,9 +295,10 @@ def _first_acceleration(path, fmt, data):
 
 
 def _source_table(path, channel=None, choose_acceleration=False):
-    """Any measured source as a :class:`~.formats.Table`; with ``choose_acceleration`` and no
-    ``channel``, a file of several channels gives its first acceleration channel (said in
-    the table's notes)."""
+    """Any measured source as a :class:`~.formats.Table`, and whether a binary format read it;
+    with ``choose_acceleration`` and no ``channel``, a file of several channels whose first is
+    no acceleration gives its first that is (said in the table's notes; the channels are
+    listed only then, so the usual file is parsed once)."""
     text = str(path)
     found = RANGE.match(text)
     if found and not Path(text).exists():
@@ -305,20 +306,22 @@ def _source_table(path, channel=None, choose_acceleration=False):
             raise OptionError("--channel: found with a workbook range, expected it only "
                               "with a file of several channels (TDMS, MATLAB .mat, MDF, IDE, UFF, "
                               "MME)")
-        return formats.Table(*_range_table(found))
+        return formats.Table(*_range_table(found)), False
     fmt = formats.detect(path)
     if fmt is not None:
         data = formats.source(fmt, path)
-        chosen = _first_acceleration(path, fmt, data) \
-            if channel is None and choose_acceleration else None
-        if chosen is None:
-            return fmt.read(path, data, channel)
-        table = fmt.read(path, data, chosen[0])
-        return table._replace(notes=(*table.notes, chosen[1]))
+        table = fmt.read(path, data, channel)
+        if channel is None and choose_acceleration \
+                and _key(_stated(table.header[1])) not in FILE_ACCEL_UNITS:
+            chosen = _first_acceleration(path, fmt, data)
+            if chosen is not None:
+                table = fmt.read(path, data, chosen[0])
+                table = table._replace(notes=(*table.notes, chosen[1]))
+        return table, True
     if channel is not None:
         raise OptionError("--channel: found with a CSV file, expected it only with a file of "
                           "several channels (TDMS, MATLAB .mat, MDF, IDE, UFF, MME)")
-    return formats.Table(*_table(path, EXPECTED, ("time", "acceleration")))
+    return formats.Table(*_table(path, EXPECTED, ("time", "acceleration"))), False
 
 
 def list_channels(path):
@@ -451,10 +454,8 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
                                  ("--accel-unit", accel_unit, ACCEL_UNITS)):
         if given is not None and given not in table:
             raise OptionError(f"{option}: found {given!r}, expected one of {', '.join(table)}")
-    binary = not (RANGE.match(str(path)) and not Path(str(path)).exists()) \
-        and formats.detect(path) is not None
-    shown, header, values, said = _source_table(path, channel,
-                                                choose_acceleration=accel_unit is None)
+    (shown, header, values, said), binary = _source_table(
+        path, channel, choose_acceleration=accel_unit is None)
     named = f"channel {shown.rpartition(' (')[2].rstrip(')')!r} of {display(Path(path))}" \
         if binary else None
     t_unit = time_unit or _unit(header[0], FILE_TIME_UNITS, "--time-unit", "time",
