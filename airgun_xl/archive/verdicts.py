@@ -79,8 +79,8 @@ def judged_trace(verdict, spans=TRACE_SPANS):
     return trace
 
 
-def verdict_record(verdict, shot, recording, report, command=()):
-    """The JSON record of a verdict."""
+def verdict_record(verdict, shot, recording, report, command=(), lot=None):
+    """The JSON record of a verdict (``lot``: the lot its shot belongs to, ``next``'s)."""
     data = Path(str(recording).partition(":")[0])
     try:
         digest = hashlib.sha256(data.read_bytes()).hexdigest() if data.is_file() else None
@@ -100,18 +100,21 @@ def verdict_record(verdict, shot, recording, report, command=()):
             "recording_sha256": digest, "report": str(report),
             "trace": judged_trace(verdict),
             "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
-            "command": list(command)}
+            "command": list(command), **({"lot": str(lot)} if lot is not None else {})}
 
 
-def store_verdict(root, shot, verdict, recording, report, command=()):
-    """Keep the verdict in the archive at ``root`` (made if new); return a
+def store_verdict(root, shot, verdict, recording, report, command=(), lot=None):
+    """Keep the verdict in the archive at ``root`` (made if new; with ``lot``, in a folder of
+    the lot's, ``LOT.SHOT``); return a
     :class:`StoredVerdict`, which :meth:`StoredVerdict.take_back` undoes. Call it with signals
     held (:func:`~airgun_xl.transaction.signals_held`) and assign its result inside that
     section: a signal then arrives once the record and the archive are whole, and the
     caller takes them back."""
-    record = verdict_record(verdict, shot, recording, report, command)
+    record = verdict_record(verdict, shot, recording, report, command, lot)
     archive = Archive(root, create=True)
-    folder = Path(root) / VERDICTS / safe_name(shot_name(shot))
+    # a lot's shots are the lot's: the same file name in two lots is two shots
+    name = shot_name(shot) if lot is None else f"{lot}.{shot_name(shot)}"
+    folder = Path(root) / VERDICTS / safe_name(name)
     version = archive.keep(folder, record, "the verdict")  # a failure takes the archive back
     return StoredVerdict(folder / f"v{version:04d}.json", archive)
 
@@ -135,8 +138,9 @@ class StoredVerdict:
 
 def list_verdicts(root):
     """Every stored verdict: ``[{"shot", "version", "verdict", "created", "recording",
-    "shot_sha256", "folder"}]`` (``shot_sha256``: the judged workbook's, None in a record
-    from before it was kept; ``folder``: the record's folder, its shot's archive name)."""
+    "shot_sha256", "folder", "lot"}]`` (``shot_sha256``: the judged workbook's, None in a
+    record from before it was kept; ``folder``: the record's folder, its shot's archive
+    name, ``LOT.SHOT`` for a lot's; ``lot``: None for a verdict of no lot's)."""
     out: list[dict] = []
     for folder, version, path in all_versions(Path(root) / VERDICTS):
         try:
@@ -146,9 +150,10 @@ def list_verdicts(root):
                         "verdict": record["verdict"], "created": record.get("created", ""),
                         "recording": record.get("recording", ""),
                         "shot_sha256": digest if isinstance(digest, str) else None,
-                        "folder": folder.name})
+                        "folder": folder.name,
+                        "lot": record["lot"] if isinstance(record.get("lot"), str) else None})
         except ArchiveError as exc:  # listed and named, not fatal (as a law)
             out.append({"shot": folder.name, "version": version, "verdict": "?",
                         "created": f"unreadable: {exc}", "recording": display(path),
-                        "shot_sha256": None, "folder": folder.name})
+                        "shot_sha256": None, "folder": folder.name, "lot": None})
     return out

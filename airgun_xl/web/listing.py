@@ -238,7 +238,7 @@ class Listing:
                  if e is not None]
         verdicts: dict[str, list[dict[str, Any]]] = {}
         for v in list_verdicts(self.archive.root):
-            verdicts.setdefault(str(v["folder"]), []).append(v)
+            verdicts.setdefault(_verdict_key(v), []).append(v)
         return Snapshot(index_rows, {e.id: e for e in found}, [], [], [], verdicts, _now())
 
     def _read(self, background: bool = False) -> Snapshot:
@@ -251,7 +251,7 @@ class Listing:
         self.progress = (0, len(index_rows))
         verdicts: dict[str, list[dict[str, Any]]] = {}
         for v in list_verdicts(self.archive.root):
-            verdicts.setdefault(str(v["folder"]), []).append(v)
+            verdicts.setdefault(_verdict_key(v), []).append(v)
         snapshot = Snapshot(index_rows, {}, [], bad, [], verdicts, _now())
         entries, rows, kept = snapshot.entries, snapshot.rows, {}
         for k, r in enumerate(index_rows):
@@ -332,3 +332,13 @@ def _number(value: Any) -> float | None:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return None
     return float(value) if math.isfinite(value) else None
+
+
+def _verdict_key(verdict: dict[str, Any]) -> str:
+    """The shot's archive name a verdict is listed under: its folder, or for a lot's verdict
+    (kept in ``LOT.SHOT``) its shot's own name (its workbook's SHA-256 then tells the lot's
+    shot from another lot's of the same name)."""
+    from ..archive.store import safe_name
+
+    return str(verdict["folder"]) if verdict.get("lot") is None else safe_name(
+        str(verdict["shot"]))
