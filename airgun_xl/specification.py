@@ -78,7 +78,7 @@ FLOORS = {
 DURATION_DEFS = ("base", "width@10%")
 
 #: The defaults by :data:`KEYS` name, applied once after the merge
-#: (:meth:`Specification.resolved`); the record judged's is the tool's noise-bounded one
+#: (:meth:`Specification.resolved`); the record judged's is the tool's low-pass one
 #: (:class:`JudgedRecord`). The corridor's and the decay's defaults apply only with a shape
 #: that draws them (:data:`SHAPE_DEFAULTS`).
 DEFAULTS: dict[str, Any] = {
@@ -103,9 +103,9 @@ RECORD_KINDS = ("default", "unfiltered", "cfc")
 class JudgedRecord:
     """The record a verdict judges (issue 42), one of three kinds:
 
-    - ``default``, the tool's noise-bounded record, what no source named: the record as it is
-      while its noise at rest is within 0.5 % of its peak, else through a 4-pole Bessel
-      low-pass at K/D both ways (:mod:`airgun_xl.studies.acceptance`);
+    - ``default``, the tool's low-pass record, what no source named: through a 4-pole Bessel
+      low-pass at K/D both ways, whatever the record's noise (a prediction and a recording
+      alike; :mod:`airgun_xl.studies.acceptance`);
     - ``unfiltered``, the record as it is (``--cfc none``, ``unfiltered`` on the sheet);
     - ``cfc``, through SAE J211 channel frequency class ``cfc`` both ways (``--cfc 600``,
       ``cfc600``).
@@ -133,7 +133,7 @@ class JudgedRecord:
         return f"cfc{self.cfc}" if self.kind == "cfc" else self.kind
 
 
-#: The tool's noise-bounded record, and the record as it is.
+#: The tool's low-pass record, and the record as it is.
 DEFAULT_RECORD = JudgedRecord("default")
 UNFILTERED = JudgedRecord("unfiltered")
 DEFAULTS["record"] = DEFAULT_RECORD
@@ -208,7 +208,7 @@ class Specification:
         The terminal-peak sawtooth's decay allowance, a fraction of D (default 0.1): the
         band admits any decay from none to it.
     record : JudgedRecord or None
-        The record judged: the tool's noise-bounded default, unfiltered, or through SAE J211
+        The record judged: the tool's low-pass default, unfiltered, or through SAE J211
         CFC N (:class:`JudgedRecord`); None until a source gives it (:meth:`resolved` then
         gives the default).
     placement : str or None

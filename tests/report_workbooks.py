@@ -69,8 +69,8 @@ def make_all(folder):
                             "1000", "--profile", "mil-std-810h-half-sine", "--peak", "9.5kG",
                             "--duration", "5ms", "--velocity-change", "240m/s", "-o",
                             str(out["accept_corridor"])],
-        "design_confidence": ["design", str(shot), "--peak", "12kG:10%", "--duration",
-                              "5ms:10%", "--velocity-change", "240m/s:10%", "--confidence",
+        "design_confidence": ["design", str(shot), "--peak", "8.6kG:10%", "--duration",
+                              "5.25ms:10%", "--velocity-change", "245m/s:10%", "--confidence",
                               "0.5", "--sd", "A28=1.5%", "--shots", "200", "-o",
                               str(out["design_confidence"])],
     }

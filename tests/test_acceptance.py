@@ -343,14 +343,15 @@ def test_fill_judges_the_prediction_by_the_sheet_and_options_override_it(tmp_pat
     shot = tmp_path / "spec.xlsx"
     wb = openpyxl.load_workbook(TEMPLATE)
     ws = wb["Specification"]
-    ws["B3"], ws["B4"], ws["B5"], ws["B6"] = 12, 10, 5, 10  # 12 kG ±10 %, 5 ms ±10 %
+    ws["B3"], ws["B4"], ws["B5"], ws["B6"] = 8.5, 10, 5, 10  # 8.5 kG ±10 %, 5 ms ±10 %
     wb.save(shot)
     assert main(["fill", str(shot), "-o", str(tmp_path / "a.xlsx")]) == 0
     line = [t for t in capsys.readouterr().out.splitlines() if "predicted" in t][0]
-    assert "the 'Specification' sheet), predicted: PASS" in line and "peak 11.994 kG" in line
+    # the record judged: the default low-pass at 6/D (D the nominal 5 ms), 8.4573 kG
+    assert "the 'Specification' sheet), predicted: PASS" in line and "peak 8.4573 kG" in line
     assert main(["fill", str(shot), "-o", str(tmp_path / "b.xlsx"), "--peak", "15kG"]) == 0
     line = [t for t in capsys.readouterr().out.splitlines() if "predicted" in t][0]
-    assert "predicted: FAIL" in line and "peak 11.994 kG -10.04 % FAIL" in line
+    assert "predicted: FAIL" in line and "peak 8.4573 kG -33.62 % FAIL" in line
     summary = openpyxl.load_workbook(tmp_path / "b.xlsx", read_only=True)["Summary"]
     texts = [str(c) for row in summary.iter_rows(values_only=True) for c in row if c]
     assert "Specification: predicted verdict" in texts and "FAIL" in texts
@@ -361,12 +362,12 @@ def test_an_archived_fill_keeps_its_predicted_verdict(tmp_path):
     import json
 
     archive = tmp_path / "lab"
-    assert main(["fill", str(TEMPLATE), "-o", str(tmp_path / "f.xlsx"), "--peak", "12kG:10%",
+    assert main(["fill", str(TEMPLATE), "-o", str(tmp_path / "f.xlsx"), "--peak", "8.5kG:10%",
                  "--archive", str(archive)]) == 0
     summary = json.loads(next(archive.rglob("summary.json")).read_text())
     verdict = summary["predicted_verdict"]
     assert verdict["verdict"] == "PASS" and verdict["criteria"][0]["name"] == "peak"
-    assert verdict["tolerances"] == ["peak: 10.8 to 13.2 kG"]
+    assert verdict["tolerances"] == ["peak: 7.65 to 9.35 kG"]
 
 
 def test_a_verdict_on_doubted_figures_is_flagged_where_it_is_shown(tmp_path, capsys):

@@ -117,7 +117,8 @@ def test_a_pass_probability_on_the_cluster_equals_the_batch_lanes(client):
     from airgun_xl.studies.sweep import parse_sd
 
     p = airgun_xl.load(TEMPLATE).params
-    spec = Specification(peak=Tolerance(12.0, 0.1, 0.1), duration=Tolerance(5e-3, 0.1, 0.1))
+    # shot A's record judged at 242 m/s: 8.36 kG, 5.22 ms (the default low-pass)
+    spec = Specification(peak=Tolerance(8.4, 0.05, 0.05), duration=Tolerance(5.2e-3, 0.1, 0.1))
     sds = [parse_sd("A28=1.5%"), parse_sd("E40=5%")]
     local = pass_probability(p, spec, sds, 300, 3, variable("A28"), 242.0)
     remote = pass_probability(p, spec, sds, 300, 3, variable("A28"), 242.0,

@@ -21,7 +21,7 @@ from airgun_xl.cli import main
 from airgun_xl.errors import OptionError
 from airgun_xl.readers.recording import Trace
 from airgun_xl.specification import combine
-from airgun_xl.studies.acceptance import judge_record, judge_rows
+from airgun_xl.studies.acceptance import judge_record
 from airgun_xl.studies.measured import prepare
 from airgun_xl.studies.recorder import Recorder
 from airgun_xl.studies.recording_quality import assess
@@ -100,42 +100,45 @@ def _tr(trace):
 # -- 2. values on their limits pass through the default record ------------------------------------
 
 def _quiet():
-    """400 g, 2 ms half-sine at 51.2 kHz with 0.1 % noise (seed 7): judged unfiltered by
-    default, its noise within the 0.5 % bound."""
+    """400 g, 2 ms half-sine at 51.2 kHz with 0.1 % noise (seed 7)."""
     return record("half-sine", 2e-3, 400 * G_KG, seed=7, rate=51_200.0, noise=0.001)
 
 
 @pytest.mark.parametrize("side", [0, 1], ids=["lower", "upper"])
 def test_a_peak_exactly_on_a_limit_passes_through_the_default_record(side):
-    """The quiet pulse scaled so that its largest sample, zeroed, is exactly the limit of
-    400 g ±10 % (360 g, then 440 g): PASS, judged unfiltered (the old rule read 1.05 % noise,
-    low-passed the record and read 398.44 g for a peak on its limit)."""
+    """The quiet pulse scaled so that the peak of its record judged (the default low-pass;
+    every step from the zeroed samples to it is linear, so a scale carries through) is
+    exactly the limit of 400 g ±10 % (360 g, then 440 g): PASS, on the limit."""
     trace = _quiet()
     limit = spec(peak="400g:10%").peak.limits[side]
     base = assess(*_tr(trace), "r").base.offset
     zeroed = trace.accel_kg - base
-    scaled = with_values(trace, base + zeroed * (limit / float(np.max(zeroed))))
+    first = by_name(judged(with_values(trace, base + zeroed), peak="400g:10%"))["peak"]
+    target = (360.0, 440.0)[side]
+    scaled = with_values(trace, base + zeroed * (target / first.value))
     v = judged(scaled, peak="400g:10%")
     c = by_name(v)["peak"]
-    assert v.passed and c.value == pytest.approx((360.0, 440.0)[side], rel=1e-12)
-    assert v.definitions[0].startswith("record judged: unfiltered, the tool's default")
+    assert v.passed and c.value == pytest.approx(target, rel=1e-12)
+    assert limit == pytest.approx(target * G_KG, rel=1e-12)
+    assert "Bessel low-pass" in v.definitions[0]
 
 
 @pytest.mark.parametrize("side", [0, 1], ids=["lower", "upper"])
 def test_a_duration_exactly_on_a_limit_passes_through_the_default_record(side):
     """The quiet pulse against a nominal duration whose limit (of ±10 %) is exactly the
-    duration it measures: PASS, judged unfiltered (through the old rule's low-pass it read
-    0.3 % longer and failed)."""
+    duration of its record judged: PASS. The default low-pass's cut-off is 6 / the nominal,
+    so the nominal is found by a fixed point (each pass changes the measured duration by
+    about a thousandth of the change of the nominal: six passes reach the last bits)."""
     trace = _quiet()
-    q = assess(*_tr(trace), "r")
-    zeroed = trace.accel_kg - q.base.offset
-    measured = float(judge_rows(trace.time, zeroed, spec(peak="400g:50%"))["duration"][0])
-    nominal = measured / (0.9, 1.1)[side]
+    nominal = 2e-3
+    for _ in range(6):
+        v = judged(trace, peak="400g:50%", duration=f"{nominal!r}s:50%")
+        nominal = by_name(v)["duration"].value / (0.9, 1.1)[side]  # in s, as given
     v = judged(trace, peak="400g:50%", duration=f"{nominal!r}s:10%")
     c = by_name(v)["duration"]
     assert v.passed, [(x.name, x.value, x.low, x.high) for x in v.criteria]
     assert c.value == pytest.approx((c.low, c.high)[side], rel=1e-12)
-    assert v.definitions[0].startswith("record judged: unfiltered, the tool's default")
+    assert "Bessel low-pass" in v.definitions[0]
 
 
 # -- 3. a start the recorder never saw ------------------------------------------------------------
@@ -341,17 +344,16 @@ def test_prepare_refuses_what_it_refused_before():
 def test_every_command_that_judges_names_the_record_judged_alike(command):
     """The commands whose --cfc is the specification's record judged say its three kinds in
     the same words: a class, none the unfiltered record, and by default the tool's
-    noise-bounded record (they said the unfiltered record was the default, which the
-    verdicts contradicted)."""
+    low-pass record, whatever the noise (issue 60; they once said the unfiltered record was
+    the default, which the verdicts contradicted)."""
     from airgun_xl.cli.commands import build_parser
 
     parser = build_parser()
     sub = next(a for a in parser._actions if a.dest == "command").choices[command]
     text = " ".join(sub.format_help().split())
     assert ("the record judged: N through SAE J211 CFC N (60, 180, 600 or 1000), none the "
-            "unfiltered record; given by no source, the tool's default (noise-bounded: "
-            "unfiltered while its noise at rest is within 0.5 % of its peak, else a 4-pole "
-            "Bessel low-pass at K/D)") in text
+            "unfiltered record; given by no source, the tool's default (a 4-pole Bessel "
+            "low-pass at K/D, whatever the record's noise)") in text
     assert "unfiltered record (the default)" not in text
 
 

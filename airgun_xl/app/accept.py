@@ -285,6 +285,8 @@ def report_data(time: np.ndarray, kg: np.ndarray, spec: Specification,
         frequencies = default_frequencies(min(100.0, hi / 16), hi)
     # on the record decimated to what the frequencies need: a 1 GHz record's would take
     # minutes and gigabytes at its own step, for the same spectrum
+    if verdict.srs_record is not None:  # the record the SRS criterion was computed on (at
+        kg = np.asarray(verdict.srs_record[1], dtype=float)  # the same rate)
     spectral, step, factor = decimated_for(kg, dt, float(np.max(frequencies)))
     levels = srs(spectral, step, frequencies, q)
     spectra: dict[str, Any] = {

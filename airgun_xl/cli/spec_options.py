@@ -9,9 +9,9 @@ from ..specification import DURATION_DEFS, PLACEMENTS, SHAPES
 
 #: The help of the record judged, where ``--cfc`` is a field of the specification.
 RECORD_HELP = ("the record judged: N through SAE J211 CFC N (60, 180, 600 or 1000), none "
-               "the unfiltered record; given by no source, the tool's default (noise-bounded: "
-               "unfiltered while its noise at rest is within 0.5 %% of its peak, else a "
-               "4-pole Bessel low-pass at K/D); the Specification sheet's 'record' field")
+               "the unfiltered record; given by no source, the tool's default (a 4-pole "
+               "Bessel low-pass at K/D, whatever the record's noise); the Specification "
+               "sheet's 'record' field")
 
 
 def add_spec_options(p, cfc=True):

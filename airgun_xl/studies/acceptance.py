@@ -10,12 +10,12 @@ record judged made) and judges it.
 Definitions (each verdict prints them, with every convention and where it came from):
 
 - **record judged**: the one the specification names (unfiltered, or SAE J211 CFC N), or by
-  default the tool's noise-bounded record: as it is when its noise at rest is within
-  :data:`NOISE_BOUND` of its peak (a prediction has none), else through a 4-pole Bessel
-  low-pass run both ways (no overshoot, no phase) at :data:`LOWPASS_PER_D` / D, D the nominal
-  duration (the measured one without), which changes an ideal pulse's peak and duration by
-  under 1 %; with its noise unknown, as it is, with a warning. A prediction and a recording
-  are judged alike, from rest; a single-sample glitch is taken out of the default record.
+  default the tool's low-pass record: a 4-pole Bessel low-pass run both ways (no overshoot, no
+  phase) at :data:`LOWPASS_PER_D` / D, D the nominal duration (the measured one without),
+  which changes an ideal pulse's peak and duration by under 1 %. The rule depends on the
+  specification and the record's rate only, never on one record's noise: a prediction and a
+  recording of the same shot are judged on the same record (issue 60). Judged from rest; a
+  single-sample glitch is taken out of the default record.
 - **peak**: the largest sample of the record judged [kG].
 - **duration** (``duration_def``): ``base``, each shape's own D: a half-sine's or a
   trapezoid's base, from the two crossings of 10 % of the peak (linearly interpolated)
@@ -33,7 +33,9 @@ Definitions (each verdict prints them, with every convention and where it came f
   ``monitor`` window, ± the band. A named shape is always judged: with no band given, the
   tool's ±20 % applies. The margin is the least distance to a limit, a fraction of the
   nominal peak.
-- **SRS**: the maximax absolute-acceleration SRS at the requirement's frequencies and Q; its
+- **SRS**: on the record as recorded by default (the default low-pass would take out what a
+  spectrum measures), on the named record otherwise: the maximax absolute-acceleration SRS
+  at the requirement's frequencies and Q; its
   margin at each is 20 log10(SRS / required) dB, inside [lower, upper]; up to the allowed
   fraction of frequencies may fall outside.
 
@@ -78,10 +80,9 @@ LOWPASS_MAX_RATE = 0.4
 #: gets only ten periods of the filter's cut-off (a 1 GHz record would take 2 million).
 MAX_PAD = 20_000
 
-#: The default record is low-passed only when its noise at rest passes this fraction of its
-#: peak (1 sigma): a clean record (a prediction, a quiet recorder) is judged as it is, its
-#: real transients kept; a noisy one is bounded. Unknown noise: as it is, with a warning.
-NOISE_BOUND = 0.005
+#: A prediction's raw peak and its judged record's peak further apart than this fraction are
+#: both shown, named (issue 60).
+RAW_APART = 1e-3
 
 #: A value on a limit is within it to this many units in the last place of the limit.
 LIMIT_ULPS = 16
@@ -180,6 +181,9 @@ class Verdict:
     onset: float | None = None  # [s], the ideal pulse's start where placed
     window: tuple[float, float] | None = None  # [s], the span monitored
     record: tuple[np.ndarray, np.ndarray] | None = None  # (t [s], kg) of the record judged
+    #: (t [s], kg) the SRS is computed on: the record judged where one is named; by default
+    #: the record as recorded (the default low-pass would take out what a spectrum measures)
+    srs_record: tuple[np.ndarray, np.ndarray] | None = None
     span: tuple[float, float] = (math.nan, math.nan)  # [s], the velocity change's window
     quality: RecordingQuality | None = None  # a recording's, as read before it was judged
 
@@ -559,10 +563,12 @@ def _window_words(window: tuple) -> str:
 
 def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
           warnings: list[str] | None = None, record: str | None = None,
-          recorded: tuple[float, float] | None = None) -> Verdict:
+          recorded: tuple[float, float] | None = None,
+          srs_record: tuple[np.ndarray, np.ndarray] | None = None) -> Verdict:
     """The verdict on one pulse ``kg`` [kG] sampled at ``t`` [s] (the record judged: already
     zeroed and filtered as the specification asks; ``record`` says how, in words; ``recorded``
-    the span [s] its samples were recorded over, :func:`judge_rows`)."""
+    the span [s] its samples were recorded over, :func:`judge_rows`); the SRS on
+    ``srs_record`` (t, kg) where given, else on the record judged."""
     spec = spec.resolved()
     values = judge_rows(t, kg, spec, refine=True, recorded=recorded)
     row = {k: v[0] for k, v in values.items()}
@@ -599,7 +605,11 @@ def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
     elif spec.shape == "none":
         definitions.append("shape: none, so the limits only: no corridor judged")
     if spec.srs is not None:
-        criteria.append(srs_criterion(np.asarray(t), np.asarray(kg), spec)[0])
+        ts, ks = srs_record if srs_record is not None else (t, kg)
+        criteria.append(srs_criterion(np.asarray(ts), np.asarray(ks), spec)[0])
+        if srs_record is not None:
+            definitions.append("SRS: on the record as recorded (the default record's "
+                               "low-pass would take out what a spectrum measures)")
     verdict = Verdict(criteria, spec, definitions, list(warnings or []),
                       float(row["onset"]) if math.isfinite(row["onset"]) else None,
                       (float(m_lo), float(m_hi)) if math.isfinite(m_lo) and math.isfinite(m_hi)
@@ -676,15 +686,12 @@ def lowpass_hz(spec: Specification, duration: float) -> float:
 
 
 def describe_record(spec: Specification, duration: float | None = None,
-                    dt: float | None = None, quiet: str | None = None) -> str:
-    """The record judged, in words, as the verdict prints it; ``quiet`` says why the default
-    record needed no low-pass."""
+                    dt: float | None = None) -> str:
+    """The record judged, in words, as the verdict prints it."""
     if spec.judged.cfc:
         return f"CFC {spec.judged.cfc} (SAE J211), both ways"
     if spec.judged.is_unfiltered:
         return "unfiltered"
-    if quiet:
-        return f"unfiltered, the tool's default for a record {quiet} (no record named)"
     per_d = LOWPASS_PER_D.get(spec.shape or "none", LOWPASS_PER_D["none"])
     if duration is None or not math.isfinite(duration) or duration <= 0:
         return (f"the tool's default: a {LOWPASS_ORDER}-pole Bessel low-pass at {per_d:g}/D, "
@@ -706,14 +713,15 @@ def _reference_duration(t: np.ndarray, kg: np.ndarray, spec: Specification) -> n
     return np.nan_to_num(judge_rows(t, kg, spec.resolved())["duration"], nan=0.0)
 
 
-def judged_record(t: np.ndarray, kg: np.ndarray, spec: Specification, noise: float = 0.0
+def judged_record(t: np.ndarray, kg: np.ndarray, spec: Specification
                   ) -> tuple[np.ndarray, np.ndarray, str]:
     """A pulse (or a block of them, a row each) as the specification judges it, from rest
     (:data:`~airgun_xl.studies.measured.REST_BEFORE` of it prepended, for a phaseless
-    filter's lead): through its CFC, unchanged (unfiltered), or by default bounded in noise:
-    as it is when ``noise`` (its rest's, 1 sigma [kG]; 0 for a prediction, NaN unknown) is
-    within :data:`NOISE_BOUND` of its peak, else through the low-pass of
-    :func:`lowpass_hz`; and the record in words."""
+    filter's lead): through its CFC, unchanged (unfiltered), or by default through the
+    low-pass of :func:`lowpass_hz` (unfiltered where that cut-off lies above
+    :data:`LOWPASS_MAX_RATE` of the rate); and the record in words. The rule is the
+    specification's and the rate's alone: a prediction and a recording go through the same
+    one, whatever their noise."""
     from .measured import REST_BEFORE
     from .shock import cfc_filter
 
@@ -721,15 +729,6 @@ def judged_record(t: np.ndarray, kg: np.ndarray, spec: Specification, noise: flo
     record = spec.judged
     if record.is_unfiltered:  # the record as it is
         return t, kg, describe_record(spec)
-    if record.is_default:
-        peak = float(np.max(kg)) if kg.size else 0.0
-        if not math.isfinite(noise):
-            return t, kg, describe_record(spec, quiet="whose noise is unknown")
-        if noise <= NOISE_BOUND * peak:
-            return t, kg, describe_record(spec, quiet=(
-                "without noise at rest (as a prediction)" if noise == 0 else
-                f"whose noise at rest, {noise:.3g} kG, is within {NOISE_BOUND:.1%} of its "
-                "peak"))
     dt = float(t[1] - t[0])
     rows = np.atleast_2d(kg)
     durations = _reference_duration(t, rows, spec) if not record.cfc else None
@@ -839,13 +838,20 @@ def judge_record(t: np.ndarray, kg: np.ndarray, spec: Specification, what: str,
                         f"{'es' * (len(spikes) != 1)} at {shown}{more}, kept in the record "
                         f"judged ({describe_record(spec)}, as the specification names it): "
                         "it may lift the peak")
-    if spec.judged.is_default and not math.isfinite(noise):
+    if not math.isfinite(noise):
         said.append(f"{what}: its noise is unknown (no record at rest before or after the "
-                    "pulse), so it is judged unfiltered: noise would lift its peak; name the "
-                    "record judged (--cfc) to filter it")
-    tj, kj, words = judged_record(t, kg, spec, noise)
-    verdict = judge(tj, kj, spec, said, record=words, recorded=recorded)
-    verdict.record = (tj, kj)
+                    "pulse): whether noise could move a criterion across its limit was not "
+                    "checked")
+    tj, kj, words = judged_record(t, kg, spec)
+    spectral = (t, kg) if spec.judged.is_default else (tj, kj)
+    verdict = judge(tj, kj, spec, said, record=words, recorded=recorded,
+                    srs_record=spectral if spec.judged.is_default else None)
+    if prediction:  # at rest before its first sample by construction: the lead is the model's
+        verdict.record = (tj, kj)
+    else:  # the filter's lead over samples never recorded is not data: never shown as such
+        kept = tj >= t[0] - 0.5 * dt
+        verdict.record = (tj[kept], kj[kept])
+    verdict.srs_record = spectral
     verdict.quality = quality
     damaged = quality.damaged if quality is not None else None
     cut = quality is not None and (quality.starts_inside or quality.ends_inside)
@@ -867,7 +873,7 @@ def noise_could_flip(verdict: Verdict, t: np.ndarray, kg: np.ndarray, spec: Spec
     dt = float(t[1] - t[0])
     peak = float(np.max(kg))
     record = spec.judged
-    if record.is_unfiltered or (record.is_default and noise <= NOISE_BOUND * peak):
+    if record.is_unfiltered:
         hz = None  # judged as it is
     else:  # J211's -3 dB point is 1.65 x its class; the low-pass's is its cut-off
         hz = record.cfc * 1.65 if record.cfc else lowpass_hz(
@@ -919,6 +925,13 @@ def predicted_verdict(result, spec: Specification) -> Verdict:
     verdict = judge_record(t, kg, spec, "the predicted pulse", noise=0.0, warnings=warnings,
                            prediction=True)
     verdict.definitions.insert(0, "judged: the predicted pulse (the test item's acceleration)")
+    raw = float(np.max(kg)) if kg.size else math.nan
+    judged = next((c.value for c in verdict.criteria if c.name == "peak"), math.nan)
+    if math.isfinite(raw) and math.isfinite(judged) and abs(raw - judged) > RAW_APART * raw:
+        verdict.definitions.insert(1, (
+            f"the model's raw pulse peaks at {raw:.4g} kG (the Summary's raw peak); the "
+            f"verdict's {judged:.4g} kG is the record judged, as a recording of this shot "
+            "would be judged: the raw peak is the model's, not a verdict"))
     return verdict
 
 
@@ -973,15 +986,11 @@ class BlockJudge:
 
     spec: Specification
     width: int = len(BLOCK_VALUES)
-    #: The noise at rest [kG, 1 sigma] of the recording the shots will be judged on: 0 judges
-    #: a prediction as it is; a fired shot's noise (the closed loop) judges the default
-    #: record as that shot's was judged (through the low-pass where the noise asks for it).
-    noise: float = 0.0
 
     def __call__(self, t: np.ndarray, kg: np.ndarray) -> np.ndarray:
         spec = self.spec.resolved()
         last = float(t[-1])  # a prediction: at rest before its first sample, known
-        t, kg, _ = judged_record(t, kg, spec, self.noise)
+        t, kg, _ = judged_record(t, kg, spec)
         values = judge_rows(t, kg, spec, recorded=(-math.inf, last))
         return np.column_stack([values.get(name, np.full(len(kg), np.nan))
                                 for name in BLOCK_VALUES])
