@@ -84,7 +84,7 @@ SCHEMAS: dict[str, dict] = {
                                           "additionalProperties": _TEXT,
                                           "description": "what the recording said of "
                                                          "itself, text by label"},
-                       "created": _TEXT, "command": _TEXTS,
+                       "created": _TEXT, "command": _TEXTS, "lot": _TEXT,
                        "trace": {"type": ["object", "null"],
                                  "description": "the record judged, thinned for a drawing",
                                  "properties": {"time_ms": {"type": "array"},
@@ -113,7 +113,7 @@ SCHEMAS: dict[str, dict] = {
             "interval": {"type": "array", "items": _NUMBER, "minItems": 2, "maxItems": 2},
             "draws": {"type": "integer"}, "most_likely_to_fail": {"type": ["string", "null"]},
             "confidence": _NUMBER, "reached": {"type": "boolean"}, "sd": _TEXTS,
-            "gun": _TEXT, "gun_name": _TEXT, "step": _TEXTS,
+            "gun": _TEXT, "model_error": _TEXT, "gun_name": _TEXT, "step": _TEXTS,
             "unrounded": {"type": "object", "required": ["A28_m_s", "p_pass"],
                           "properties": {"A28_m_s": _NUMBER,
                                          "p_pass": {"type": "number", "minimum": 0,

@@ -152,18 +152,18 @@ def with_next(lot, law, first, work, draws, n_draws, calls, vary=None, gun=None)
 
 
 def first_setting(n_draws):
-    """design --confidence on the nominal law, judged as this recorder's shots are."""
+    """design --confidence on the nominal law, judged as this recorder's shots are (one rule
+    for a prediction and a recording: the specification's record)."""
     from airgun_xl.studies.design import variable
     from airgun_xl.studies.first_shot import solve_confidence
+    from airgun_xl.studies.model_error import ModelError
     from airgun_xl.studies.sweep import parse_sds
 
     shot = airgun_xl.load(TEMPLATE)
     spec = resolve(shot, keyword_fields("bench", SPEC))
-    with tempfile.TemporaryDirectory() as tmp:  # the recorder's noise at rest, as read
-        rec = fire(TEMPLATE, LEGACY_LAW, (0.0, 0.0, 1), Path(tmp) / "r.csv")
-        noise = float(airgun_xl.accept(TEMPLATE, rec, **SPEC).verdict.quality.base.noise)
     sds = parse_sds([f"A28={GUN:.1%}", f"E40={LOT_SPREAD:.0%}", f"E43={ZETA:.0%}"])
-    found = solve_confidence(shot.params, spec, variable("A28"), sds, n_draws, 1, noise=noise)
+    found = solve_confidence(shot.params, spec, variable("A28"), sds, n_draws, 1,
+                             model_error=ModelError.prior())
     return found.best.setting, found.best.probability
 
 

@@ -122,7 +122,7 @@ def test_the_predicted_p_pass_agrees_with_single_fills_from_the_same_posterior(l
     p = airgun_xl.load(work / "shot1.xlsx").params.replace(crush_law=first.update.law)
     setting = first.setting * 1.02
     scatter = [*parse_sds(GUN), law_scatter(first.update)]
-    batch = pass_probability(p, spec, scatter, 2000, 7, variable("A28"), setting, noise=noise)
+    batch = pass_probability(p, spec, scatter, 2000, 7, variable("A28"), setting)
     assert 0.05 < batch.probability < 0.95
     rng = np.random.default_rng(11)
     law_sd = scatter[-1][2]
@@ -166,7 +166,7 @@ def test_a_second_knob_passes_a_lot_the_velocity_alone_cannot(tmp_path):
     """A lot 25 % stronger than the report's, a duration to 10 %: on shot A's mitigator the
     velocity that gives 8.5 kG gives about 3.9 ms (under 4.05), so A28 alone proposes a shot
     with P(PASS) 0 (and it fails: 3.91 ms); with --vary E13 the mitigator's radius is set with
-    the velocity, P(PASS) reaches 0.9 and the second shot passes. The next workbook holds the
+    the velocity, P(PASS) passes a half and the second shot passes. The next workbook holds the
     radius in E13, and a fill of it runs with it."""
     spec = {"peak": "8.5kG:5%", "duration": "4.5ms:10%"}
     found = {}
@@ -186,7 +186,9 @@ def test_a_second_knob_passes_a_lot_the_velocity_alone_cannot(tmp_path):
     assert alone.best.probability < 0.05 and not alone.reached and alone.second is None
     assert not alone_verdict.passed
     both, both_verdict = found["E13"]
-    assert both.reached and both.best.probability >= 0.9 and both_verdict.passed
+    # the model's own error drawn (the prior's 5 % on the peak, against its ±5 %) caps P(PASS)
+    # near 0.68 even in the middle: the velocity alone is near 0, the pair well above a half
+    assert both.best.probability >= 0.5 and both_verdict.passed
     cell, unit, radius = both.second
     sheet = airgun_xl.load(TEMPLATE).params.rcone
     assert (cell, unit) == ("E13", "m") and radius != sheet  # a wider mitigator: longer pulse
@@ -407,6 +409,7 @@ def test_next_draws_the_estimated_scatter_from_the_eighth_shot_and_says_so(tmp_p
                         r"estimated from 8 shots' launch velocities fitted against their set "
                         r"values \(their mean [+-]\d\.\d\d% \+/- \d\.\d\d% off them\)",
                         out.gun), out.gun
+    assert out.model_error.startswith("the model's own error, the prior")  # said beside it
     assert out.update.shots == 8 and len(out.update.launch) == 8
     assert json.loads(out.to_json())["gun"] == out.gun
     again = airgun_xl.next_shot(shot, rec, archive=archive, lot="LOT-G", shots=100,

@@ -169,6 +169,7 @@ def test_next_with_a_gun_draws_the_scatter_its_lots_estimate_and_keeps_its_own(
     (s0, r0, _), (s1, r1, _) = made["LOT-S"]
     first = airgun_xl.next_shot(s0, r0, archive=archive, lot="LOT-S", new_lot=True, sd=GUN,
                                 gun="G1", shots=100, output=tmp_path / "s1.xlsx", **SPEC)
+    assert first.model_error.startswith("the model's own error")  # said beside the gun's
     assert first.gun == ("the gun's scatter A28=1.5% as given (--sd): the lots of the gun G1 "
                          "hold 6 shots beyond each lot's first, and it is estimated from their "
                          "launch velocities from 7")

@@ -18,8 +18,10 @@ from airgun_xl.studies.first_shot import (
 )
 from airgun_xl.studies.sweep import parse_sd
 
-SPEC = Specification(peak=Tolerance(12.0, 0.1, 0.1), duration=Tolerance(5e-3, 0.1, 0.1),
-                     velocity_change=Tolerance(240.0, 0.1, 0.1))
+#: Round shot A's judged figures near 250 m/s (through the default low-pass at 6/D: its raw
+#: pulse's spikes are the model's, not the record judged).
+SPEC = Specification(peak=Tolerance(9.0, 0.1, 0.1), duration=Tolerance(5.3e-3, 0.1, 0.1),
+                     velocity_change=Tolerance(250.0, 0.1, 0.1))
 SDS = ["A28=1.5%", "E40=5%"]
 V0 = variable("A28")
 
@@ -87,7 +89,7 @@ def test_margins_of_a_block_are_those_of_its_verdicts(shot):
     from airgun_xl.engine.batch import run_batch
     from airgun_xl.studies.acceptance import BlockJudge
 
-    params = [V0.apply(shot.params, v) for v in (230.0, 242.0, 255.0)]
+    params = [V0.apply(shot.params, v) for v in (240.0, 251.0, 262.0)]
     batch = run_batch(params, extra=BlockJudge(SPEC))
     least = margins(batch.extras, SPEC)
     for p, m in zip(params, least, strict=True):
@@ -96,7 +98,7 @@ def test_margins_of_a_block_are_those_of_its_verdicts(shot):
                                       .criteria) / 100, abs=1e-12)
 
 
-COMMON = ["--peak", "12kG:10%", "--duration", "5ms:10%", "--velocity-change", "240m/s:10%"]
+COMMON = ["--peak", "9kG:10%", "--duration", "5.3ms:10%", "--velocity-change", "250m/s:10%"]
 
 
 def test_design_by_the_specification_writes_the_middle(tmp_path, capsys, shot):

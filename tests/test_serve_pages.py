@@ -84,7 +84,7 @@ def lab(tmp_path_factory):
     outside.mkdir()
     (outside / "v0001.json").write_text(json.dumps({**law, "created": "OUTSIDE-THE-ARCHIVE"}))
     (root / ".laws" / "LINKED").symlink_to(outside, target_is_directory=True)
-    verdict = json.loads((root / ".verdicts" / "shot1" / "v0001.json").read_text())
+    verdict = json.loads((root / ".verdicts" / "LOT-A.shot1" / "v0001.json").read_text())
     (root / ".verdicts" / "shot3" / "v0002.json").write_text(json.dumps(
         {**verdict, "shot": "shot3", "shot_sha256": None,  # as a record before they kept it
          "criteria": [{**verdict["criteria"][0], "name": HOSTILE}],
@@ -130,8 +130,13 @@ def test_filters_by_lot_verdict_and_any_input_a_limit_within(server, lab):
     assert shots("verdict=FAIL") == ["shot1", "shot3"]
     assert shots("verdict=none") == []
     v3 = _inputs(lab, "shot3")["A28"]
-    assert shots(f"input=A28&input_min={v3!r}&input_max={v3!r}") == ["shot3"]  # on both limits
-    assert shots(f"input=A28&input_min={v3 * (1 + 1e-12)!r}") == ["shot1", "shot1.next"]
+    # each run's A28 read from its params.json (two proposals may set the same velocity)
+    a28 = {s: _inputs(lab, s)["A28"] for s in ("shot1", "shot1.next", "shot3")}
+    on = [s for s, v in a28.items() if v == v3]
+    assert "shot3" in on
+    assert shots(f"input=A28&input_min={v3!r}&input_max={v3!r}") == on  # on both limits
+    assert shots(f"input=A28&input_min={v3 * (1 + 1e-12)!r}") == [
+        s for s, v in a28.items() if v > v3]
     # an input the index does not hold (read from each params.json): E43, zeta, 0.02 in all
     assert shots("input=E43&input_min=0.02&input_max=0.02") == ["shot1", "shot1.next", "shot3"]
     assert shots("input=E43&input_max=0.019") == []
@@ -279,7 +284,7 @@ def test_the_laws_page_holds_each_version_its_runs_the_chain_and_the_outcomes(pa
 def test_a_shots_page_lists_its_verdicts_and_draws_the_peaks_limits(page, server, lab):
     page.goto(f"{server}/shot/1")
     page.wait_for_selector("#pulse[data-drawn]")
-    record = json.loads((lab / ".verdicts" / "shot1" / "v0001.json").read_text())
+    record = json.loads((lab / ".verdicts" / "LOT-A.shot1" / "v0001.json").read_text())
     assert page.text_content("h3.recorded").startswith("Recorded verdict 1: FAIL")
     table = page.eval_on_selector_all(
         "#recorded-criteria-1 tr", "rows => rows.slice(1).map(r => [...r.cells].map("

@@ -312,11 +312,14 @@ def _solve_spec(request: DesignRequest, shots_progress_for: Callable[[int], Any]
             notes_after = [f"design by the specification: {label} = {value:.6g} {var.unit}, "
                            f"the largest smallest margin ({middle.margin:+.2%} of a nominal)"]
         else:
+            from .lot_chain import model_error_of
+
+            model_error = model_error_of(request.archive)
             with shots_progress(shots_progress_for, _most_shots(request.shots)) as progress:
                 c = confidence = solve_confidence(shot.params, spec, var, sds,
                                                   request.shots, request.seed, bounds,
                                                   request.integrator, request.model, runner,
-                                                  progress)
+                                                  progress, model_error=model_error)
             value, evaluations = c.best.setting, sum(r.shots for r in c.tried)
             lo, hi = c.best.interval
             worst = c.best.most_failing()
@@ -329,6 +332,7 @@ def _solve_spec(request: DesignRequest, shots_progress_for: Callable[[int], Any]
             if worst is not None:
                 lines.append(f"  most likely to fail: {worst[0]} ({worst[1]:,} of "
                              f"{c.shots:,} shots)")
+            lines.append(f"  P(PASS) includes {model_error.words()}")
             scatter = ", ".join(request.sd)
             notes += [f"design --confidence {request.confidence:g}: P(PASS) = "
                       f"{c.best.probability:.4f} (95 % interval {lo:.4f}-{hi:.4f}) at {label} "
@@ -336,7 +340,8 @@ def _solve_spec(request: DesignRequest, shots_progress_for: Callable[[int], Any]
                       f"seed {request.seed}; most likely to fail: "
                       f"{worst[0] if worst else 'none'}",
                       f"the middle design, {label} = {c.middle.setting:.6g} {var.unit}: "
-                      f"P(PASS) = {c.middle.probability:.4f} ({m_lo:.4f}-{m_hi:.4f})"]
+                      f"P(PASS) = {c.middle.probability:.4f} ({m_lo:.4f}-{m_hi:.4f})",
+                      f"P(PASS) includes {model_error.words()}"]
             extra += c.warnings
             if hi < request.confidence or c.best.probability < request.confidence:
                 extra.append(f"design --confidence: no {var.label} in range reaches "

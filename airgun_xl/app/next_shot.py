@@ -33,6 +33,7 @@ from .. import limits
 from ..cells import address
 from ..errors import ArchiveError, OptionError
 from ..transaction.stages import stage
+from .lot_chain import FIGURE_UNITS, chain, model_error_of
 from .specifying import SpecFields, require, resolve
 
 if TYPE_CHECKING:
@@ -102,6 +103,8 @@ class NextOutcome:
     gun: str = ""  # the gun's scatter drawn, and where it came from
     #: with ``step``: the best found between the steps (``best`` is the best on them)
     unrounded: PassProbability | None = None
+    #: the model's own error drawn, and where it came from (issue 60)
+    model_error: str = ""
 
     def to_json(self) -> str:
         """``next --json``: the verdict, the law's update, the setting and its P(PASS)."""
@@ -128,7 +131,8 @@ class NextOutcome:
                      "expected": expected_record(self.best),
                      **({"unrounded": unrounded_record(self.unrounded, self.second)}
                         if self.unrounded is not None else {})},
-            "gun": self.gun, "confidence": self.confidence, "reached": self.reached,
+            "gun": self.gun, "model_error": self.model_error,
+            "confidence": self.confidence, "reached": self.reached,
             "proposal": self.proposal, "files": self.files, "warnings": self.warnings})
 
 
@@ -248,17 +252,25 @@ def run(request: NextRequest) -> NextOutcome:
                                   others, freedom)
     gun_warnings = [*read_warnings, *gun_warnings]
     p_next = shot.params.replace(crush_law=update.law)
+    model_error = model_error_of(request.archive)
+    drawn = model_error.words()
     best, unrounded, conf_warnings = _choose(request, spec, p_next,
-                                             [*sds, law_scatter(update)], _noise(verdict))
+                                             [*sds, law_scatter(update)], model_error)
     reached = best.probability >= request.confidence and best.interval[1] >= request.confidence
     warnings = list(dict.fromkeys([*map(str, shot.warnings), *verdict.warnings,
                                    *update.warnings, *gun_warnings, *conf_warnings]))
     if not reached:
+        worst = best.most_failing()
+        knob = "" if request.vary is not None else (
+            f"; A28 alone moves the peak and the duration together: a second knob set with it "
+            f"(--vary {' or '.join(SECOND_KNOBS)}, the mitigator's) can move "
+            f"the {worst[0] if worst else 'duration'} apart from the peak")
         warnings.append(f"next: no A28{f' and {request.vary}' if request.vary else ''} in range"
                         f" reaches P(PASS) = {request.confidence:g}; the best found is "
-                        f"{best.probability:.4f} at {setting_text(request, best)}")
+                        f"{best.probability:.4f} at {setting_text(request, best)}{knob}")
     return _publish(request, output, shot, spec, verdict, update, best, reached, lot_shots,
-                    counted_once, warnings, gun, unrounded, proposal=proposal)
+                    counted_once, warnings, gun, unrounded, proposal=proposal,
+                    model_error=drawn)
 
 
 def _described(request: NextRequest, update: LawUpdate,
@@ -564,21 +576,13 @@ def _read_lot(lot_shots: list[dict[str, Any]]) -> tuple[list[Any], list[Any]]:
     return params, traces
 
 
-def _noise(verdict: Verdict) -> float:
-    """The fired recording's noise at rest [kG, 1 sigma]: the next shot's recording is
-    expected as noisy, and its predictions are judged as it will be (through the default
-    record's low-pass where that noise asks for it, as this shot's was)."""
-    quality = verdict.quality
-    noise = float(quality.base.noise) if quality is not None else 0.0
-    return noise if math.isfinite(noise) and noise > 0 else 0.0
-
-
-def _choose(request: NextRequest, spec: Any, p: Any, sds: list[Any], noise: float
+def _choose(request: NextRequest, spec: Any, p: Any, sds: list[Any], model_error: Any
             ) -> tuple[PassProbability, PassProbability | None, list[str]]:
-    """The A28 most likely to pass, drawing the gun, zeta and the law, each prediction judged
-    as a recording of the fired shot's noise would be (on the batch lanes, or a Dask
-    cluster: the same draws, the same shots, the same P(PASS)); with ``step``, the best the
-    knobs can be set to, and the best found between their steps."""
+    """The A28 most likely to pass, drawing the gun, zeta, the law and the model's own error,
+    each prediction judged on the specification's record, as the fired shot's recording was
+    (on the batch lanes, or a Dask cluster: the same draws, the same shots, the same
+    P(PASS)); with ``step``, the best the knobs can be set to, and the best found between
+    their steps."""
     from ..studies.design import variable
     from ..studies.first_shot import solve_confidence
     from .running import cluster_runner
@@ -586,9 +590,9 @@ def _choose(request: NextRequest, spec: Any, p: Any, sds: list[Any], noise: floa
     second = second_knob(request.vary) if request.vary is not None else None
     with cluster_runner(request.scheduler, request.workers, request.chunk) as runner:
         found = solve_confidence(p, spec, variable(address("v31")), sds, request.shots,
-                                 request.seed, integrator=request.integrator, noise=noise,
+                                 request.seed, integrator=request.integrator,
                                  runner=runner, second=second, keep_middle=False,
-                                 steps=steps_of(request))
+                                 steps=steps_of(request), model_error=model_error)
     return found.best, found.unrounded, list(found.warnings)
 
 
@@ -596,7 +600,8 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
              update: LawUpdate, best: PassProbability, reached: bool,
              lot_shots: list[dict[str, Any]], counted_once: bool,
              warnings: list[str], gun: str,
-             unrounded: PassProbability | None = None, *, proposal: int) -> NextOutcome:
+             unrounded: PassProbability | None = None, *, proposal: int,
+             model_error: str = "") -> NextOutcome:
     """Store the law's new version, write the next shot's workbook, keep the verdict and the
     proposal (exactly version ``proposal``, the commit point: another call on the lot that
     stored it first refuses this one); a failure takes back what was done."""
@@ -623,11 +628,11 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
         stage("next-law-stored")
         law = CrushLaw(update.law.coefficients, update.law.v_range, "fitted", source=ref)
         _write(request, output, shot, spec, verdict, update, best, law, ref, warnings, gun,
-               unrounded)
+               unrounded, model_error)
         done += [output] + ([request.pdf] if request.pdf is not None else [])
         with signals_held():
             done.append(store_verdict(request.archive, shot, verdict, request.recording,
-                                      output, request.argv))
+                                      output, request.argv, lot=request.lot))
         stage("next-verdict-stored")
         lo, hi = best.interval
         worst = best.most_failing()
@@ -650,7 +655,8 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
                       "unrounded": unrounded_record(unrounded, knob_value(request, unrounded))}
                      if unrounded is not None else {}),
                   "confidence": request.confidence, "reached": reached,
-                  "sd": list(request.sd), "gun": gun, "seed": request.seed,
+                  "sd": list(request.sd), "gun": gun, "model_error": model_error,
+                  "seed": request.seed,
                   **({"gun_name": request.gun,
                       "launch": [{"shot_sha256": s["shot_sha256"],
                                   "recording_sha256": s["recording_sha256"],
@@ -683,7 +689,7 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
     return NextOutcome(verdict, update, ref, best.setting, best, request.confidence, reached,
                        counted_once, output, f"{request.lot}@{proposal}", files,
                        tuple(warnings),
-                       knob_value(request, best), gun, unrounded)
+                       knob_value(request, best), gun, unrounded, model_error)
 
 
 def knob_value(request: NextRequest, best: PassProbability) -> tuple[str, str, float] | None:
@@ -696,7 +702,8 @@ def knob_value(request: NextRequest, best: PassProbability) -> tuple[str, str, f
 
 def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: Verdict,
            update: LawUpdate, best: PassProbability, law: Any, ref: str,
-           warnings: list[str], gun: str, unrounded: PassProbability | None = None) -> None:
+           warnings: list[str], gun: str, unrounded: PassProbability | None = None,
+           model_error: str = "") -> None:
     """The next shot's workbook: the chosen A28..A30, the lot's law (its Crush law sheet),
     and on its Summary the prediction of P(PASS) and where it came from."""
     from ..outputs import from_sheet
@@ -720,7 +727,7 @@ def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: V
              f"{best.probability:.4f} (95 % interval {lo:.4f}-{hi:.4f}, {best.shots:,} draws "
              f"of the gun ({', '.join(request.sd)}) and the law), seed {request.seed}",
              *([rounded_text(request, unrounded)] if unrounded is not None else []),
-             gun,
+             gun, *([f"P(PASS) includes {model_error}"] if model_error else []),
              f"most likely to fail: {worst[0] if worst else 'none'}",
              f"the lot's law {ref}: {update_text(update)}; {update.note}",
              f"from {request.shot} ({verdict.word}), recording {request.recording}")
@@ -749,12 +756,6 @@ def update_text(update: LawUpdate, errors: str = "") -> str:
         return f"the law fitted whole at its {len(update.nodes)} nodes {shots}"
     return (f"the prior scaled by {update.scale:.4f} +/- {update.error:.4f}{errors}"
             f"{tilt_text(update)} {shots}")
-
-
-#: How a proposal states each judged figure: its unit and the factor from the judge's (kG, s,
-#: m/s), and the digits shown.
-FIGURE_UNITS = {"peak": ("kG", 1.0, 3), "duration": ("ms", 1e3, 3),
-                "velocity change": ("m/s", 1.0, 2)}
 
 
 def expected_record(best: PassProbability) -> dict[str, list[float | None]]:
@@ -835,47 +836,12 @@ def lines(request: NextRequest, outcome: NextOutcome) -> list[str]:
              *([f"  expected there (median, 90 % of the draws): "
                 f"{expected_text(expected_record(b))}"] if b.figures else []),
              f"  {outcome.gun}",
+             *([f"  P(PASS) includes {outcome.model_error}"] if outcome.model_error else []),
              f"  {'reaches' if outcome.reached else 'does NOT reach'} --confidence "
              f"{outcome.confidence:g}",
              f"wrote {outcome.output}; kept the verdict, the law {outcome.law} and the "
              f"proposal {outcome.proposal} in {request.archive}"]
     return said
-
-
-def chain(root: str | Path | None, lot: str) -> list[dict[str, Any]]:
-    """``history --lot``: a row a proposal (the shot fired, its verdict, the P(PASS) predicted
-    for it before it was fired when it was fired from a proposal's workbook, the law version
-    made, the next setting and its P(PASS))."""
-    from ..archive import Archive, archive_dir
-    from ..archive.lots import proposals
-
-    found = Archive(archive_dir(root))
-    rows: list[dict[str, Any]] = []
-    predicted: dict[str, Any] = {}
-    chained = proposals(found.root, lot)
-    if not chained:
-        raise OptionError(f"--lot: found {lot!r}, which has no chain in {found.root}, "
-                          "expected a lot airgun-xl next has kept there")
-    for version, record in chained:
-        shots = record.get("shots") or []
-        fired = shots[-1].get("shot_sha256") if shots else None
-        before = predicted.get(fired) if isinstance(fired, str) else None
-        knobs = {address("v31"): record.get("setting_A28")}
-        if isinstance(record.get("second_cell"), str):
-            knobs[record["second_cell"][:8]] = record.get("second_value")
-        rows.append({"proposal": f"{lot}@{version}", "shot": record.get("shot"),
-                     "verdict": record.get("verdict"),
-                     "predicted_before": before[0] if before else None,
-                     "expected_before": before[1] if before else None,
-                     "measured": record.get("measured"), "law": record.get("law"),
-                     "against_report": record.get("against_report"),
-                     "next_A28": record.get("setting_A28"), "next_knobs": knobs,
-                     "next_p_pass": record.get("p_pass"),
-                     "next_expected": record.get("expected"),
-                     "created": record.get("created", "")})
-        if isinstance(record.get("next_sha256"), str):
-            predicted[record["next_sha256"]] = (record.get("p_pass"), record.get("expected"))
-    return rows
 
 
 def chain_lines(lot: str, rows: list[dict[str, Any]]) -> list[str]:

@@ -37,15 +37,9 @@ SHOT_BYTES = 600
 #: Points of the scan over the parameter's range.
 SCAN_POINTS = 25
 
-#: Said by :func:`solve_confidence` when the specification names no record: the predictions
-#: are judged as they are, and a noisy recording would be judged through the default
-#: low-pass (issue 45: shot A's spiky peak reads 12.0 kG unfiltered, 9.3 kG through it).
-QUIET_RECORD_WARNING = (
-    "the specification names no record: P(PASS) judges each predicted shot as it is "
-    "(unfiltered), while a recording whose noise at rest exceeds 0.5 % of its peak is judged "
-    "through the default low-pass (6/D), which lowers a spiky pulse's peak; the probability "
-    "holds for a quiet recording only. Name the record (--cfc N or --record unfiltered) to "
-    "judge both alike, or use airgun-xl next once a shot is fired")
+#: Settings of the first round that go on to the final with every shot (beside the middle
+#: design, which always does): the one :func:`centred` chooses.
+FINALISTS = 1
 
 #: What the middle design's search counts a shot that cannot be judged as (minus its
 #: smallest margin): worse than any judged shot's.
@@ -58,9 +52,6 @@ FIRST_ROUND = 0.05
 #: passing points, one scan step wider each side).
 CANDIDATES = 7
 
-#: Settings of the first round that go on to the second with every shot (beside the middle
-#: design, which always does).
-FINALISTS = 1
 
 
 def margins(values: np.ndarray, spec: Specification) -> np.ndarray:
@@ -97,14 +88,13 @@ class MiddleDesign:
                                                                      np.zeros(0)))
 
 
-def _run(p, var, xs, spec, integrator, model, runner, noise=0.0):
+def _run(p, var, xs, spec, integrator, model, runner):
     params = [apply_model(var.apply(p, x), model) for x in xs]
-    batch = (runner or run_batch)(params, integrator, extra=BlockJudge(spec, noise=noise))
+    batch = (runner or run_batch)(params, integrator, extra=BlockJudge(spec))
     return batch.extras
 
 
-def solve_middle(p, spec, var, bounds=None, integrator="legacy", model="4-mass", runner=None,
-                 noise=0.0):
+def solve_middle(p, spec, var, bounds=None, integrator="legacy", model="4-mass", runner=None):
     """The value of ``var`` with the largest smallest margin: a scan of :data:`SCAN_POINTS`,
     then a bounded search (scipy) between the best point's neighbours.
 
@@ -117,7 +107,7 @@ def solve_middle(p, spec, var, bounds=None, integrator="legacy", model="4-mass",
 
     lo, hi = bounds or var.bounds(p)
     xs = np.linspace(lo, hi, SCAN_POINTS)
-    ys = margins(_run(p, var, xs, spec, integrator, model, runner, noise), spec)
+    ys = margins(_run(p, var, xs, spec, integrator, model, runner), spec)
     if not np.isfinite(ys).any():
         raise DesignError(f"no {var.label} in {lo:.4g}-{hi:.4g} {var.unit} gives a pulse that "
                           "can be judged (every shot diverged)")
@@ -127,7 +117,7 @@ def solve_middle(p, spec, var, bounds=None, integrator="legacy", model="4-mass",
 
     def negative(x):
         count[0] += 1
-        margin = float(margins(_run(p, var, [x], spec, integrator, model, runner, noise),
+        margin = float(margins(_run(p, var, [x], spec, integrator, model, runner),
                                spec)[0])
         # a shot that cannot be judged (diverged) is the worst, but finite: the bounded
         # search's parabola steps would otherwise multiply infinities (NaN, and a warning)
@@ -169,7 +159,7 @@ class Pair:
         return self.second.apply(self.first.apply(p, x[0]), x[1])
 
 
-def _judged(p, var, xs, spec, integrator, model, runner, noise):
+def _judged(p, var, xs, spec, integrator, model, runner):
     """:class:`BlockJudge`'s values at each setting of ``var``; a setting that makes no shot
     (parameters refused: a second variable can reach them) is NaN, the worst margin."""
     params, ok = [], np.zeros(len(xs), dtype=bool)
@@ -182,7 +172,7 @@ def _judged(p, var, xs, spec, integrator, model, runner, noise):
     values = np.full((len(xs), len(BLOCK_VALUES)), np.nan)
     if params:
         values[ok] = (runner or run_batch)(params, integrator,
-                                           extra=BlockJudge(spec, noise=noise)).extras
+                                           extra=BlockJudge(spec)).extras
     return values
 
 
@@ -199,7 +189,7 @@ class PairMiddle:
 
 
 def solve_middle_pair(p, spec, pair, integrator="legacy", model="4-mass", runner=None,
-                      noise=0.0, bounds=None):
+                      bounds=None):
     """The :class:`Pair` setting with the largest smallest margin: a scan of
     :data:`SCAN_POINTS` first settings at :data:`LEVELS` second ones, each level's best
     searched again on :data:`FINE_POINTS` points, then Nelder-Mead (scipy, bounded, at most
@@ -216,7 +206,7 @@ def solve_middle_pair(p, spec, pair, integrator="legacy", model="4-mass", runner
     xs, ys = np.linspace(lo1, hi1, SCAN_POINTS), np.linspace(lo2, hi2, LEVELS)
 
     def judged(points):
-        return margins(_judged(p, pair, points, spec, integrator, model, runner, noise), spec)
+        return margins(_judged(p, pair, points, spec, integrator, model, runner), spec)
 
     coarse = judged([(x, y) for y in ys for x in xs]).reshape(LEVELS, SCAN_POINTS)
     if not np.isfinite(coarse).any():
@@ -340,9 +330,13 @@ def draws(p, sds, n, seed):
 
 
 def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator="legacy",
-                     model="4-mass", runner=None, progress=None, drawn=None, noise=0.0):
+                     model="4-mass", runner=None, progress=None, drawn=None,
+                     model_error=None):
     """The fraction of ``n`` shots that pass ``spec``, with ``var`` at ``setting`` (None: the
-    sheet's) and the ``sds`` cells scattered (:func:`airgun_xl.studies.sweep.parse_sd`).
+    sheet's) and the ``sds`` cells scattered (:func:`airgun_xl.studies.sweep.parse_sd`);
+    with ``model_error`` (a :class:`~airgun_xl.studies.model_error.ModelError`), each shot's
+    judged peak, duration and velocity change multiplied by a drawn measured / expected
+    ratio before it is judged (the corridor, a shape, is judged as predicted).
 
     A setting moves a scattered cell's mean: a drawn value is its draw's offset from the
     sheet's value, added to the setting (so the gun's scatter follows the velocity set).
@@ -391,8 +385,11 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
         except AirgunXlError:
             invalid[i] = True
     batch = (runner or run_batch)(params, integrator, progress=progress,
-                                  extra=BlockJudge(spec, noise=noise))
-    flags = flags_of(batch.extras, spec)
+                                  extra=BlockJudge(spec))
+    values = batch.extras
+    if model_error is not None:
+        values = _with_model_error(values, model_error, n, seed, invalid)
+    flags = flags_of(values, spec)
     ok = np.ones(len(params), dtype=bool)
     for f in flags.values():
         ok &= f
@@ -400,7 +397,20 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
     return PassProbability(float(first) if first is not None else math.nan,
                            int(ok.sum()), n, failures, int(batch.diverged.sum()),
                            int(invalid.sum()), float(second),
-                           expected_figures(batch.extras, spec))
+                           expected_figures(values, spec))
+
+
+def _with_model_error(values, model_error, n, seed, invalid):
+    """``values`` (:class:`BlockJudge`'s columns of the shots that ran) with each shot's
+    figures of :data:`~airgun_xl.studies.model_error.FIGURES` times its drawn ratio: draw
+    ``i`` of ``n`` belongs to draw ``i`` of the inputs, whichever settings are compared."""
+    from .model_error import FIGURES
+
+    factors = model_error.factors(n, seed)[~invalid]
+    out = np.array(values, dtype=float, copy=True)
+    for j, name in enumerate(FIGURES):
+        out[:, BLOCK_VALUES.index(name)] *= factors[:, j]
+    return out
 
 
 #: The percentiles of a judged figure a proposal states: its middle and 90 % range.
@@ -424,6 +434,40 @@ def expected_figures(values, spec):
         out[name] = (tuple(float(v) for v in np.percentile(column, RANGE_PERCENTILES))
                      if column.size else (math.nan,) * 3)
     return out
+
+
+def centrality(result, spec):
+    """How near the middle of every tolerance a setting's expected figures (the medians of
+    its draws) sit: the smallest over the criteria of the distance to the nearer limit as a
+    fraction of half the tolerance (1 in the middle, 0 on a limit, negative outside; -inf
+    when a figure is unknown)."""
+    spec = spec.resolved()
+    least = math.inf
+    for name, tolerance in (("peak", spec.peak), ("duration", spec.duration),
+                            ("velocity change", spec.velocity_change)):
+        if tolerance is None:
+            continue
+        lo, hi = tolerance.limits
+        mid = result.figures.get(name, (math.nan,) * 3)[1]
+        if not math.isfinite(mid) or not hi > lo:
+            return -math.inf
+        least = min(least, min(mid - lo, hi - mid) / (0.5 * (hi - lo)))
+    return least
+
+
+def centred(results, spec):
+    """The setting to propose among ``results`` (:class:`PassProbability`): of those whose
+    P(PASS) is within the best's error of it (at least the lower end of the best's Wilson
+    interval), the one whose expected figures sit nearest the middle of every tolerance
+    (:func:`centrality`, largest); a tie to the higher P(PASS), then the first. A plateau of
+    P(PASS) near 1 then still chooses: the middle, not a setting half the tolerance off."""
+    def p(r):  # a setting of no shot (NaN) ranks last
+        return r.probability if math.isfinite(r.probability) else -1.0
+
+    top = max(results, key=p)
+    floor = top.interval[0]
+    plateau = [r for r in results if p(r) >= floor] or [top]
+    return max(plateau, key=lambda r: (centrality(r, spec), p(r)))
 
 
 @dataclass
@@ -485,10 +529,11 @@ def settable(best, steps, ranges):
 
 
 def solve_confidence(p, spec, var, sds, n, seed=1, bounds=None, integrator="legacy",
-                     model="4-mass", runner=None, progress=None, noise=0.0, second=None,
-                     keep_middle=True, steps=None):
-    """The setting of ``var`` most likely to pass (see the module's notes); ``noise`` [kG]:
-    the rest noise of the recordings the shots will be judged on (:class:`BlockJudge`).
+                     model="4-mass", runner=None, progress=None, second=None,
+                     keep_middle=True, steps=None, model_error=None):
+    """The setting of ``var`` most likely to pass (see the module's notes), each shot judged
+    on the specification's record (:func:`~airgun_xl.studies.acceptance.judged_record`), as
+    a recording of it would be.
 
     ``second``: a second variable set with ``var`` (a :class:`Pair`, candidates from
     :func:`solve_middle_pair`); the results' ``second`` holds its setting. ``keep_middle``
@@ -498,26 +543,25 @@ def solve_confidence(p, spec, var, sds, n, seed=1, bounds=None, integrator="lega
     the settable neighbours of the best found between them (:func:`settable`), on the final
     round's draws, a tie to the nearest; the result's ``unrounded`` keeps the best found."""
     if second is None:
-        middle = solve_middle(p, spec, var, bounds, integrator, model, runner, noise)
+        middle = solve_middle(p, spec, var, bounds, integrator, model, runner)
         knobs, candidates = var, _span(middle)
     else:
         knobs = Pair(var, second)
-        middle = solve_middle_pair(p, spec, knobs, integrator, model, runner, noise, bounds)
+        middle = solve_middle_pair(p, spec, knobs, integrator, model, runner, bounds)
         candidates = sorted(set(middle.candidates) | {middle.value})
     first_n = max(200, int(round(n * FIRST_ROUND)))
     drawn_first = draws(p, sds, first_n, seed)
     first = [pass_probability(p, spec, sds, first_n, seed, knobs, x, integrator, model, runner,
-                              progress, drawn_first, noise) for x in candidates]
-    # without the middle design in the final round, a tie goes to it (the deepest margin)
-    ranked = sorted(zip(candidates, first, strict=True), key=lambda r: (
-        -r[1].probability, not keep_middle and r[0] != middle.value))
-    finalists = [x for x, _ in ranked[:FINALISTS]]
+                              progress, drawn_first, model_error) for x in candidates]
+    # among the settings within the best's error of it, the one aimed at the middle
+    chosen = centred(first, spec)
+    finalists = [candidates[first.index(chosen)]][:FINALISTS]
     if keep_middle and middle.value not in finalists:
         finalists.append(middle.value)
     drawn = draws(p, sds, n, seed + 1)  # fresh draws: the first round's luck does not carry
     final = [pass_probability(p, spec, sds, n, seed + 1, knobs, x, integrator, model, runner,
-                              progress, drawn, noise) for x in sorted(finalists)]
-    best = max(final, key=lambda r: r.probability)
+                              progress, drawn, model_error) for x in sorted(finalists)]
+    best = centred(final, spec)
     mid = (final[sorted(finalists).index(middle.value)] if middle.value in finalists
            else None)
     unrounded = None
@@ -527,15 +571,11 @@ def solve_confidence(p, spec, var, sds, n, seed=1, bounds=None, integrator="lega
         near = settable(at, steps, ranges)
         if at not in near:  # the best found is between the grids' values
             on_grid = [pass_probability(p, spec, sds, n, seed + 1, knobs, x, integrator,
-                                        model, runner, progress, drawn, noise) for x in near]
-            unrounded, best = best, max(on_grid, key=lambda r: (
-                r.probability, -abs(r.setting - best.setting),
-                -abs(r.second - best.second) if second is not None else 0.0))
+                                        model, runner, progress, drawn, model_error) for x in near]
+            unrounded, best = best, centred(on_grid, spec)
             final += on_grid
     warnings = []
     if spec.srs is not None:
         warnings.append("the SRS criterion is not in the probability: it is judged on the "
                         "designed shot's prediction only")
-    if noise == 0 and spec.resolved().judged.is_default:
-        warnings.append(QUIET_RECORD_WARNING)
     return ConfidenceDesign(best, mid, middle, first + final, n, warnings, unrounded)

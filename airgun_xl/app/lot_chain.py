@@ -1,0 +1,103 @@
+"""A lot's chain of proposals as the archive holds it (``history --lot``, the laws page), and
+what the whole archive's chains say of the model's own error (issue 60): read by ``next``
+and ``design`` alike, so that neither imports the other."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any, TypeGuard
+
+from ..cells import address
+from ..errors import ArchiveError, OptionError
+
+#: How a proposal states each judged figure: its unit and the factor from the judge's (kG, s,
+#: m/s), and the digits shown.
+FIGURE_UNITS = {"peak": ("kG", 1.0, 3), "duration": ("ms", 1e3, 3),
+                "velocity change": ("m/s", 1.0, 2)}
+
+
+def chain(root: str | Path | None, lot: str) -> list[dict[str, Any]]:
+    """``history --lot``: a row a proposal (the shot fired, its verdict, the P(PASS) predicted
+    for it before it was fired when it was fired from a proposal's workbook, the law version
+    made, the next setting and its P(PASS))."""
+    from ..archive import Archive, archive_dir
+    from ..archive.lots import proposals
+
+    found = Archive(archive_dir(root))
+    rows: list[dict[str, Any]] = []
+    predicted: dict[str, Any] = {}
+    chained = proposals(found.root, lot)
+    if not chained:
+        raise OptionError(f"--lot: found {lot!r}, which has no chain in {found.root}, "
+                          "expected a lot airgun-xl next has kept there")
+    for version, record in chained:
+        shots = record.get("shots") or []
+        fired = shots[-1].get("shot_sha256") if shots else None
+        before = predicted.get(fired) if isinstance(fired, str) else None
+        knobs = {address("v31"): record.get("setting_A28")}
+        if isinstance(record.get("second_cell"), str):
+            knobs[record["second_cell"][:8]] = record.get("second_value")
+        rows.append({"proposal": f"{lot}@{version}", "shot": record.get("shot"),
+                     "verdict": record.get("verdict"),
+                     "predicted_before": before[0] if before else None,
+                     "expected_before": before[1] if before else None,
+                     "measured": record.get("measured"), "law": record.get("law"),
+                     "against_report": record.get("against_report"),
+                     "next_A28": record.get("setting_A28"), "next_knobs": knobs,
+                     "next_p_pass": record.get("p_pass"),
+                     "next_expected": record.get("expected"),
+                     "created": record.get("created", "")})
+        if isinstance(record.get("next_sha256"), str):
+            predicted[record["next_sha256"]] = (record.get("p_pass"), record.get("expected"))
+    return rows
+
+
+def archive_pairs(root: str | Path) -> list[dict[str, tuple[float, float]]]:
+    """Every pair of expected and measured judged figures the archive at ``root`` holds
+    across its lots: a shot fired from a proposal's workbook, what that proposal expected of
+    it (the median of its draws) and what its verdict measured, ``{figure: (expected,
+    measured)}`` in the judge's units (kG, s, m/s). What the archive gives is read as
+    untrusted: a value that is no finite number is left out, a unit not known refused."""
+    from ..archive.lots import lot_names
+    from ..specification import SHOWN_UNITS
+
+    pairs = []
+    for lot in lot_names(root):
+        for row in chain(root, lot):
+            expected, measured = row.get("expected_before"), row.get("measured")
+            if not isinstance(expected, dict) or not isinstance(measured, dict):
+                continue
+            pair = {}
+            for name in FIGURE_UNITS:
+                values, found = expected.get(name), measured.get(name)
+                if not (isinstance(values, list) and len(values) == 3
+                        and isinstance(found, dict)):
+                    continue
+                mid, value, unit = values[1], found.get("value"), found.get("unit")
+                if not (_number(mid) and _number(value)):
+                    continue
+                table = SHOWN_UNITS.get(name, {"m/s": ("m/s", 1.0)})
+                if unit not in table:
+                    raise ArchiveError(f"{row['proposal']}: the measured {name}'s unit "
+                                       f"{str(unit)[:20]!r}, expected one of "
+                                       f"{', '.join(sorted(table))}")
+                pair[name] = (float(mid), float(value) / table[unit][1])
+            if pair:
+                pairs.append(pair)
+    return pairs
+
+
+def _number(value: Any) -> TypeGuard[float]:
+    """A finite number (no bool), as a record read from the archive must give it."""
+    return (isinstance(value, (int, float)) and not isinstance(value, bool)
+            and math.isfinite(value))
+
+
+def model_error_of(root: str | Path | None) -> Any:
+    """The model's error (:class:`~airgun_xl.studies.model_error.ModelError`) from the
+    archive at ``root``'s pairs (:func:`archive_pairs`), the prior without an archive."""
+    from ..studies.model_error import ModelError
+
+    if root is None or not Path(root).is_dir():
+        return ModelError.prior()
+    return ModelError.from_pairs(archive_pairs(root), f"{root}: the archive's pairs")
