@@ -52,7 +52,7 @@ EXTRA = (
     *(f"airgun-xl {command} --help" for command in COMMANDS),
     "airgun-xl fill templates/shot_a.xlsx -o lab/golden_fill.xlsx --force --reproducible",
     "airgun-xl fill templates/shot_a.xlsx -o lab/golden_only.xlsx --force --reproducible "
-    "--only summary --peak 12kG:10% --duration 5ms:10%",
+    "--only summary --peak 8.6kG:10% --duration 5.25ms:10%",
     "airgun-xl check templates/shot_a.xlsx",
     "airgun-xl convergence templates/shot_a.xlsx --levels 10us,5us,2us -o lab/golden_conv.xlsx "
     "--force",
@@ -184,6 +184,9 @@ def digest(path):
                 part = _strings(part)
             if name.startswith("xl/charts/"):  # the cache repeats the sheets' numbers
                 part = re.sub(rb"<c:numCache>.*?</c:numCache>", b"", part, flags=re.S)
+                # and an axis's decades follow its data: convergence's run-time axis moves
+                # from 1e-3 to 1e-4 s as a run is a little faster (seen once in 6 runs)
+                part = re.sub(rb'<c:(min|max) val="[^"]*"/>', rb"<c:\1/>", part)
             if name.startswith("xl/worksheets/") and any(
                     f't="s"><v>{k}</v>'.encode() in part for k in rows | columns):
                 part = _timed(part, rows & _used(part), columns)
