@@ -24,6 +24,14 @@ LEGACY_COEFFICIENTS = (1.257647, 0.008340218, -0.0001897436, 0.0000005551838, 0.
 DEGREE = 6
 
 
+def speeds_text(v_range: tuple[float, float] | list[float]) -> str:
+    """Where a law holds, said in speeds a shot has [m/s]: from 0, where the polynomial's span
+    starts below it (the report's figures' axes start at -20 m/s; no bird meets the honeycomb
+    at a negative speed), to its top."""
+    lo, hi = (float(v) for v in v_range)
+    return f"{max(lo, 0.0):.4g} to {hi:.4g} m/s"
+
+
 def chebyshev_nodes(lo, hi, n):
     """``n`` Chebyshev nodes of [``lo``, ``hi``], ascending: where a polynomial through
     them strays least from the function sampled."""

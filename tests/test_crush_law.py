@@ -6,7 +6,7 @@ import pytest
 from conftest import CASES, REFERENCE
 
 import airgun_xl
-from airgun_xl.crush_law import LEGACY_LAW, CrushLaw
+from airgun_xl.crush_law import CRUSH_FIT_RANGE, LEGACY_LAW, CrushLaw, speeds_text
 from airgun_xl.engine import _reference as ref
 from airgun_xl.engine.batch import run_batch
 from airgun_xl.engine.integrators import displacement_bound, kernel_params
@@ -32,6 +32,15 @@ def test_a_law_pads_to_degree_six_and_refuses_nonsense():
         CrushLaw((1.0,) * 8)
     with pytest.raises(ValueError, match="finite"):
         CrushLaw((1.0, float("nan")))
+
+
+def test_a_laws_range_is_said_in_speeds_a_shot_has():
+    """The report's law spans -20 to 250 m/s of its figures' axes: said 0 to 250 m/s (issue
+    60: "-20 to 250 m/s" is no speed a bird meets the honeycomb at); a fitted law's span that
+    starts above 0 is said as it is."""
+    assert CRUSH_FIT_RANGE == (-20.0, 250.0)
+    assert speeds_text(CRUSH_FIT_RANGE) == "0 to 250 m/s"
+    assert speeds_text([150.0, 243.5]) == "150 to 243.5 m/s"
 
 
 def test_the_run_uses_the_law_it_is_given():

@@ -259,6 +259,42 @@ def test_the_model_error_widens_p_pass_as_its_spread_says(shot):
         assert lo <= expected <= hi, (sd, r.probability, expected)
 
 
+def test_the_interval_takes_in_the_model_errors_own_uncertainty(shot):
+    """The prior stands for 10 pairs: its spread's one-sided 95 % upper bound is the spread x
+    sqrt(9 / chi2.ppf(0.05, 9)) (scipy). A P(PASS) drawn with it (2,000 shots, seed 11) counts
+    as cautious exactly the passes of a run drawn with that bound on the same seed, and its
+    interval runs from the cautious count's Wilson low end to the nominal one's high end."""
+    from scipy.stats import chi2
+
+    from airgun_xl.studies.acceptance import wilson_interval
+    from airgun_xl.studies.model_error import ModelError
+
+    prior = ModelError.prior()
+    np.testing.assert_allclose(prior.widened().sd,
+                               np.array(prior.sd) * math.sqrt(9 / chi2.ppf(0.05, 9)),
+                               rtol=1e-12)
+    r = pass_probability(shot.params, SPEC, [], 2000, 11, model_error=prior)
+    wide = pass_probability(shot.params, SPEC, [], 2000, 11, model_error=prior.widened())
+    assert r.cautious == wide.passes < r.passes
+    assert r.interval == (wilson_interval(wide.passes, 2000)[0],
+                          wilson_interval(r.passes, 2000)[1])
+
+
+def test_a_p_pass_above_0_99_is_printed_only_with_its_support():
+    """998 of 1,000 passing: with no model error (Wilson low end 0.9927) it is printed as it
+    is; when the cautious draws pass 960 times, as its low end "at least 0.9460", and it does
+    reaches only what its low end reaches (0.9, not 0.95), where 998 alone reaches 0.995."""
+    from airgun_xl.studies.first_shot import PassProbability, p_pass_text, reaches
+
+    alone = PassProbability(240.0, 998, 1000, {}, 0, 0)
+    doubted = PassProbability(240.0, 998, 1000, {}, 0, 0, cautious=960)
+    assert p_pass_text(alone) == "P(PASS) = 0.9980 (95 % interval 0.9927-0.9995)"
+    assert p_pass_text(doubted).startswith("P(PASS) at least 0.9460 (95 % interval "
+                                           "0.9460-0.9995; 0.9980 with the model's error")
+    assert reaches(alone, 0.995) and not reaches(doubted, 0.995)
+    assert reaches(doubted, 0.9) and not reaches(doubted, 0.95)
+
+
 # -- aimed at the middle -------------------------------------------------------------------------
 
 def test_the_centring_rule_picks_the_middle_on_a_flat_plateau():

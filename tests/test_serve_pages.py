@@ -26,7 +26,8 @@ from serve_helpers import get, screenshot, serving
 
 import airgun_xl
 from airgun_xl.app.archive import shown_figure
-from airgun_xl.app.next_shot import chain, prediction_record
+from airgun_xl.app.lot_chain import chain, expected_text, knobs_text, measured_text
+from airgun_xl.app.next_shot import prediction_record
 from airgun_xl.archive.lots import proposals
 from airgun_xl.crush_law import LEGACY_LAW
 from airgun_xl.studies.calibrate import synthetic_measurement
@@ -269,7 +270,14 @@ def test_the_laws_page_holds_each_version_its_runs_the_chain_and_the_outcomes(pa
     expected = chain(lab, "LOT-A")
     assert [r[2] for r in rows] == [e["verdict"] for e in expected] == ["FAIL", "PASS"]
     assert rows[0][3] == "n/a" and rows[1][3] == f"{expected[1]['predicted_before']:.3f}"
-    assert [r[5] for r in rows] == [f"{e['next_A28']:.3f}" for e in expected]
+    assert [r[7] for r in rows] == [f"{e['next_A28']:.3f}" for e in expected]
+    # what each proposal expected of its shot, what the shot measured, every knob set next
+    assert rows[0][4] == "n/a" and rows[1][4] == expected_text(expected[1]["expected_before"])
+    assert rows[1][4].startswith("peak ") and " kG (" in rows[1][4]
+    assert [r[5] for r in rows] == [measured_text(e["measured"]) for e in expected]
+    assert all(r[5].startswith("peak ") for r in rows)
+    assert [r[9] for r in rows] == [knobs_text(e) for e in expected]
+    assert all(r[9].startswith("A28 ") and "; expected peak " in r[9] for r in rows)
     # each P(PASS) with the warnings its proposal keeps (what it cannot vouch for)
     kept = [record.get("warnings") or [] for _v, record in proposals(lab, "LOT-A")]
     said = lot.locator("table.chain td.warnings").all_inner_texts()

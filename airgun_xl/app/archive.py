@@ -23,6 +23,7 @@ from ..archive import Archive, Entry, archive_dir
 from ..archive.index import INDEX_ENV, ROLE_NAME
 from ..archive.store import prestart_index
 from ..cells import BY_ADDRESS
+from ..crush_law import speeds_text
 from ..errors import ArchiveError, OptionError
 from ..transaction import check_output, display
 
@@ -238,7 +239,7 @@ def _history_lines(rows: list[Row], total: int | None, laws: list[dict[str, Any]
         lines.append("crush laws:")
         for law in laws:
             span = ("unreadable" if law["v_range"] is None else
-                    f"{law['v_range'][0]:.4g} to {law['v_range'][1]:.4g} m/s")
+                    f"holds at {speeds_text(law['v_range'])}")
             lines.append(f"  {law['ref']:<30} {span}, fitted on {law['shots']} shot"
                          f"{'s' * (law['shots'] != 1)}, {law['created']}")
     if verdicts:

@@ -274,7 +274,7 @@ def _solve_spec(request: DesignRequest, shots_progress_for: Callable[[int], Any]
     setting most likely to pass on the first shot."""
     from ..archive.laws import shot_with_law
     from ..studies.design import Design, variable
-    from ..studies.first_shot import solve_confidence, solve_middle
+    from ..studies.first_shot import p_pass_text, reaches, solve_confidence, solve_middle
     from ..transaction import check_output
 
     if len(request.vary) > 1:
@@ -321,32 +321,29 @@ def _solve_spec(request: DesignRequest, shots_progress_for: Callable[[int], Any]
                                                   request.integrator, request.model, runner,
                                                   progress, model_error=model_error)
             value, evaluations = c.best.setting, sum(r.shots for r in c.tried)
-            lo, hi = c.best.interval
             worst = c.best.most_failing()
-            lines.append(f"{label} = {value:.6g} {var.unit}: P(PASS) = "
-                         f"{c.best.probability:.4f} (95 % interval {lo:.4f}-{hi:.4f}, "
-                         f"{c.shots:,} shots)")
-            m_lo, m_hi = c.middle.interval
+            lines.append(f"{label} = {value:.6g} {var.unit}: {p_pass_text(c.best)}, "
+                         f"{c.shots:,} shots")
             lines.append(f"  the middle design, {label} = {c.middle.setting:.6g} {var.unit}: "
-                         f"P(PASS) = {c.middle.probability:.4f} ({m_lo:.4f}-{m_hi:.4f})")
+                         f"{p_pass_text(c.middle)}")
             if worst is not None:
                 lines.append(f"  most likely to fail: {worst[0]} ({worst[1]:,} of "
                              f"{c.shots:,} shots)")
             lines.append(f"  P(PASS) includes {model_error.words()}")
+            lines.append(f"  {model_error.bound_words()}")
             scatter = ", ".join(request.sd)
-            notes += [f"design --confidence {request.confidence:g}: P(PASS) = "
-                      f"{c.best.probability:.4f} (95 % interval {lo:.4f}-{hi:.4f}) at {label} "
-                      f"= {value:.6g} {var.unit}, over {c.shots:,} shots with {scatter}, "
-                      f"seed {request.seed}; most likely to fail: "
+            notes += [f"design --confidence {request.confidence:g}: {p_pass_text(c.best)} at "
+                      f"{label} = {value:.6g} {var.unit}, over {c.shots:,} shots with "
+                      f"{scatter}, seed {request.seed}; most likely to fail: "
                       f"{worst[0] if worst else 'none'}",
                       f"the middle design, {label} = {c.middle.setting:.6g} {var.unit}: "
-                      f"P(PASS) = {c.middle.probability:.4f} ({m_lo:.4f}-{m_hi:.4f})",
-                      f"P(PASS) includes {model_error.words()}"]
+                      f"{p_pass_text(c.middle)}",
+                      f"P(PASS) includes {model_error.words()}; {model_error.bound_words()}"]
             extra += c.warnings
-            if hi < request.confidence or c.best.probability < request.confidence:
+            if not reaches(c.best, request.confidence):
                 extra.append(f"design --confidence: no {var.label} in range reaches "
                              f"P(PASS) = {request.confidence:g}; the best found is "
-                             f"{c.best.probability:.4f} at {value:.6g} {var.unit}")
+                             f"{p_pass_text(c.best)} at {value:.6g} {var.unit}")
                 reached = False
             notes_after = []
     solved = var.apply(shot.params, value)

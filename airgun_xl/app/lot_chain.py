@@ -16,6 +16,46 @@ FIGURE_UNITS = {"peak": ("kG", 1.0, 3), "duration": ("ms", 1e3, 3),
                 "velocity change": ("m/s", 1.0, 2)}
 
 
+def expected_text(expected: Any) -> str:
+    """``peak 9.102 kG (8.805 to 9.447), duration ...``: a record's expected figures, each
+    with its 90 % range ('' when the record holds none)."""
+    parts = []
+    for name, (unit, factor, digits) in FIGURE_UNITS.items():
+        values = expected.get(name) if isinstance(expected, dict) else None
+        if not (isinstance(values, list) and len(values) == 3
+                and all(isinstance(v, (int, float)) for v in values)):
+            continue
+        lo, mid, hi = (float(v) * factor for v in values)
+        parts.append(f"{name} {mid:.{digits}f} {unit} ({lo:.{digits}f} to {hi:.{digits}f})")
+    return ", ".join(parts)
+
+
+def measured_text(measured: Any) -> str:
+    """``peak 9.214 kG, duration 4.602 ms``: a record's measured figures, each in the unit its
+    verdict gave ('' when none)."""
+    parts = []
+    for name in FIGURE_UNITS:
+        found = measured.get(name) if isinstance(measured, dict) else None
+        if not isinstance(found, dict):
+            continue
+        value = found.get("value")
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            parts.append(f"{name} {float(value):.5g} {str(found.get('unit', ''))[:8]}")
+    return ", ".join(parts)
+
+
+def knobs_text(row: dict[str, Any]) -> str:
+    """``A28 241.5, E13 0.0381; expected peak ...``: a chain row's next setting, every knob it
+    sets and what it expects there ('' when the row holds no knob)."""
+    knobs = {k: v for k, v in (row.get("next_knobs") or {}).items()
+             if isinstance(v, (int, float)) and not isinstance(v, bool)}
+    if not knobs:
+        return ""
+    expected = expected_text(row.get("next_expected"))
+    return (", ".join(f"{k} {v:.6g}" for k, v in knobs.items())
+            + (f"; expected {expected}" if expected else ""))
+
+
 def chain(root: str | Path | None, lot: str) -> list[dict[str, Any]]:
     """``history --lot``: a row a proposal (the shot fired, its verdict, the P(PASS) predicted
     for it before it was fired when it was fired from a proposal's workbook, the law version

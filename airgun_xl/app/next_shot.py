@@ -33,7 +33,14 @@ from .. import limits
 from ..cells import address
 from ..errors import ArchiveError, OptionError
 from ..transaction.stages import stage
-from .lot_chain import FIGURE_UNITS, chain, model_error_of
+from .lot_chain import (
+    FIGURE_UNITS,
+    chain,
+    expected_text,
+    knobs_text,
+    measured_text,
+    model_error_of,
+)
 from .specifying import SpecFields, require, resolve
 
 if TYPE_CHECKING:
@@ -108,6 +115,7 @@ class NextOutcome:
 
     def to_json(self) -> str:
         """``next --json``: the verdict, the law's update, the setting and its P(PASS)."""
+        from ..studies.first_shot import supported
         from .documents import dumps
 
         lo, hi = self.best.interval
@@ -126,6 +134,7 @@ class NextOutcome:
                      **({f"{self.second[0]}_{self.second[1]}": self.second[2]}
                         if self.second else {}),
                      "p_pass": self.best.probability,
+                     "p_pass_supported": supported(self.best),
                      "interval": [lo, hi], "draws": self.best.shots,
                      "most_likely_to_fail": worst[0] if worst else None,
                      "expected": expected_record(self.best),
@@ -224,6 +233,7 @@ def run(request: NextRequest) -> NextOutcome:
     from ..readers.recording import input_file
     from ..shot import Shot
     from ..studies.closed_loop import GUN_SHOTS, law_scatter, update_law
+    from ..studies.first_shot import p_pass_text, reaches
 
     output = _checked(request)
     shot = Shot.from_workbook(request.shot)
@@ -253,10 +263,10 @@ def run(request: NextRequest) -> NextOutcome:
     gun_warnings = [*read_warnings, *gun_warnings]
     p_next = shot.params.replace(crush_law=update.law)
     model_error = model_error_of(request.archive)
-    drawn = model_error.words()
+    drawn = f"{model_error.words()}; {model_error.bound_words()}"
     best, unrounded, conf_warnings = _choose(request, spec, p_next,
                                              [*sds, law_scatter(update)], model_error)
-    reached = best.probability >= request.confidence and best.interval[1] >= request.confidence
+    reached = reaches(best, request.confidence)
     warnings = list(dict.fromkeys([*map(str, shot.warnings), *verdict.warnings,
                                    *update.warnings, *gun_warnings, *conf_warnings]))
     if not reached:
@@ -267,7 +277,7 @@ def run(request: NextRequest) -> NextOutcome:
             f"the {worst[0] if worst else 'duration'} apart from the peak")
         warnings.append(f"next: no A28{f' and {request.vary}' if request.vary else ''} in range"
                         f" reaches P(PASS) = {request.confidence:g}; the best found is "
-                        f"{best.probability:.4f} at {setting_text(request, best)}{knob}")
+                        f"{p_pass_text(best)} at {setting_text(request, best)}{knob}")
     return _publish(request, output, shot, spec, verdict, update, best, reached, lot_shots,
                     counted_once, warnings, gun, unrounded, proposal=proposal,
                     model_error=drawn)
@@ -721,11 +731,11 @@ def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: V
     designed = with_cells(shot, Design(knobs, values, params, math.nan, math.nan, best.shots))
     # what the loop said travels with the figures it qualifies (the Summary's P(PASS))
     designed = dataclasses.replace(designed, warnings=list(warnings))
-    lo, hi = best.interval
+    from ..studies.first_shot import p_pass_text
     worst = best.most_failing()
-    notes = (f"next shot of lot {request.lot}: {setting_text(request, best)}, P(PASS) = "
-             f"{best.probability:.4f} (95 % interval {lo:.4f}-{hi:.4f}, {best.shots:,} draws "
-             f"of the gun ({', '.join(request.sd)}) and the law), seed {request.seed}",
+    notes = (f"next shot of lot {request.lot}: {setting_text(request, best)}, "
+             f"{p_pass_text(best)}, {best.shots:,} draws of the gun "
+             f"({', '.join(request.sd)}) and the law, seed {request.seed}",
              *([rounded_text(request, unrounded)] if unrounded is not None else []),
              gun, *([f"P(PASS) includes {model_error}"] if model_error else []),
              f"most likely to fail: {worst[0] if worst else 'none'}",
@@ -773,34 +783,6 @@ def measured_record(verdict: Verdict) -> dict[str, dict[str, Any]]:
             for c in verdict.criteria if c.name in FIGURE_UNITS}
 
 
-def expected_text(expected: Any) -> str:
-    """``peak 9.102 kG (8.805 to 9.447), duration ...``: a record's expected figures, each
-    with its 90 % range ('' when the record holds none)."""
-    parts = []
-    for name, (unit, factor, digits) in FIGURE_UNITS.items():
-        values = expected.get(name) if isinstance(expected, dict) else None
-        if not (isinstance(values, list) and len(values) == 3
-                and all(isinstance(v, (int, float)) for v in values)):
-            continue
-        lo, mid, hi = (float(v) * factor for v in values)
-        parts.append(f"{name} {mid:.{digits}f} {unit} ({lo:.{digits}f} to {hi:.{digits}f})")
-    return ", ".join(parts)
-
-
-def measured_text(measured: Any) -> str:
-    """``peak 9.214 kG, duration 4.602 ms``: a record's measured figures, each in the unit its
-    verdict gave ('' when none)."""
-    parts = []
-    for name in FIGURE_UNITS:
-        found = measured.get(name) if isinstance(measured, dict) else None
-        if not isinstance(found, dict):
-            continue
-        value = found.get("value")
-        if isinstance(value, (int, float)) and not isinstance(value, bool):
-            parts.append(f"{name} {float(value):.5g} {str(found.get('unit', ''))[:8]}")
-    return ", ".join(parts)
-
-
 def against_report_text(update: LawUpdate) -> str:
     """The lot's law against the report's, all its updates together (each update's scale is
     against the version before)."""
@@ -820,7 +802,7 @@ def lines(request: NextRequest, outcome: NextOutcome) -> list[str]:
     from .accept import verdict_lines
 
     u, b = outcome.update, outcome.best
-    lo, hi = b.interval
+    from ..studies.first_shot import p_pass_text
     worst = b.most_failing()
     said = verdict_lines(outcome.verdict, f"{request.recording} against {request.shot}")
     if outcome.counted_once:
@@ -828,8 +810,7 @@ def lines(request: NextRequest, outcome: NextOutcome) -> list[str]:
     said += [f"lot {request.lot}: the law {outcome.law}, "
              f"{update_text(u, ' (1 standard error)')}", f"  {u.note}",
              f"  {against_report_text(u)}",
-             f"next: {setting_text(request, b)}, P(PASS) = {b.probability:.4f} "
-             f"[{lo:.4f}, {hi:.4f}] over {b.shots:,} draws"
+             f"next: {setting_text(request, b)}, {p_pass_text(b)}, over {b.shots:,} draws"
              + (f"; most likely to fail: {worst[0]}" if worst else ""),
              *([f"  {rounded_text(request, outcome.unrounded)}"]
                if outcome.unrounded is not None else []),
@@ -868,12 +849,8 @@ def chain_lines(lot: str, rows: list[dict[str, Any]]) -> list[str]:
                 isinstance(v, (int, float)) and not isinstance(v, bool) for v in ratio):
             lines.append(f"         the lot's law: x{ratio[0]:.4f} to x{ratio[1]:.4f} the "
                          "report's")
-        knobs = {k: v for k, v in (r.get("next_knobs") or {}).items()
-                 if isinstance(v, (int, float)) and not isinstance(v, bool)}
-        if knobs:
-            lines.append("         next: " + ", ".join(f"{k} {v:.6g}" for k, v in knobs.items())
-                         + (f"; expected {expected_text(r.get('next_expected'))}"
-                            if expected_text(r.get("next_expected")) else ""))
+        if knobs_text(r):
+            lines.append(f"         next: {knobs_text(r)}")
     return lines
 
 

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ..crush_law import CRUSH_FIT_RANGE, LEGACY_LAW, chebyshev_nodes
+from ..crush_law import CRUSH_FIT_RANGE, LEGACY_LAW, chebyshev_nodes, speeds_text
 from .acceptance import wilson_interval
 from .first_shot import JOINT, LAW_FIELDS, LAW_SCALE, NODES
 
@@ -229,8 +229,8 @@ def _judged(note, based, fitted, n, lo, hi):
     if p_value < SHAPE_P:
         law = fitted.params[0].crush_law
         return (f"{n} shots at {lo:.4g} to {hi:.4g} m/s pin the law whole (every node but "
-                f"the lowest within +/- {WEAK_PIN:.1%} at 95 %, over {law.v_range[0]:.4g} to "
-                f"{law.v_range[1]:.4g} m/s): a scale and a tilt of the prior cannot follow "
+                f"the lowest within +/- {WEAK_PIN:.1%} at 95 %, over "
+                f"{speeds_text(law.v_range)}): a scale and a tilt of the prior cannot follow "
                 f"its shape (chi-square {chi:.3g} on {dof} degrees of freedom, p = "
                 f"{p_value:.2g}); the law fitted whole is drawn from its nodes' covariance",
                 shape)

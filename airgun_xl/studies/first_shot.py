@@ -262,6 +262,9 @@ class PassProbability:
     #: change [m/s]) over the draws that ran: its 5th, 50th and 95th percentiles, the
     #: middle and 90 % range of what the shot is expected to measure.
     figures: dict[str, tuple[float, float, float]] = field(default_factory=dict)
+    #: With a model error drawn: the shots that pass on the same draws with the error at the
+    #: upper 95 % bound of its spread (:meth:`~.model_error.ModelError.widened`).
+    cautious: int | None = None
 
     @property
     def probability(self) -> float:
@@ -269,13 +272,53 @@ class PassProbability:
 
     @property
     def interval(self) -> tuple[float, float]:
-        return wilson_interval(self.passes, self.shots)
+        """The 95 % interval of P(PASS): the Monte Carlo's Wilson interval, its low end taken
+        down to the cautious count's (the model's error as large as its evidence allows)."""
+        lo, hi = wilson_interval(self.passes, self.shots)
+        if self.cautious is not None:
+            lo = min(lo, wilson_interval(self.cautious, self.shots)[0])
+        return lo, hi
 
     def most_failing(self) -> tuple[str, int] | None:
         if not self.failures or max(self.failures.values()) == 0:
             return None
         name = max(self.failures, key=lambda k: self.failures[k])
         return name, self.failures[name]
+
+
+#: A P(PASS) above this is more than a Monte Carlo with an estimated model error can show
+#: alone: it is printed as a value only when its interval's low end (the model's error at the
+#: upper bound of its spread) is above it too, and read as reaching a confidence above it
+#: only then (issue 60: proposals printed 1.0000 passed 95.8 % of the time).
+SUPPORTED_TOP = 0.99
+
+
+def supported(result: PassProbability) -> bool:
+    """Whether ``result``'s P(PASS) may be printed as it is: at most :data:`SUPPORTED_TOP`, or
+    its interval's low end above it too."""
+    return not result.probability > SUPPORTED_TOP or result.interval[0] > SUPPORTED_TOP
+
+
+def reaches(result: PassProbability, confidence: float) -> bool:
+    """Whether ``result`` reaches a P(PASS) of ``confidence``: its probability (its interval's
+    low end where that is all :func:`supported` lets it claim) and its interval's high end
+    at least that."""
+    lo, hi = result.interval
+    claimed = result.probability if supported(result) else lo
+    return claimed >= confidence and hi >= confidence
+
+
+def p_pass_text(result: PassProbability) -> str:
+    """``P(PASS) = 0.9523 (95 % interval 0.9480-0.9563)``; a P(PASS) above
+    :data:`SUPPORTED_TOP` that its interval does not support, as its low end: ``P(PASS) at
+    least 0.9712 (95 % interval 0.9712-0.9991; 0.9975 with the model's error as estimated,
+    which does not support more than 0.99)``."""
+    lo, hi = result.interval
+    span = f"95 % interval {lo:.4f}-{hi:.4f}"
+    if supported(result):
+        return f"P(PASS) = {result.probability:.4f} ({span})"
+    return (f"P(PASS) at least {lo:.4f} ({span}; {result.probability:.4f} with the model's "
+            f"error as estimated, which does not support more than {SUPPORTED_TOP:g})")
 
 
 #: The crush law's scale as a scattered quantity (issue 45): an ``sds`` entry
@@ -387,7 +430,13 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
     batch = (runner or run_batch)(params, integrator, progress=progress,
                                   extra=BlockJudge(spec))
     values = batch.extras
+    cautious = None
     if model_error is not None:
+        wide = _with_model_error(values, model_error.widened(), n, seed, invalid)
+        wide_ok = np.ones(len(params), dtype=bool)
+        for f in flags_of(wide, spec).values():
+            wide_ok &= f
+        cautious = int(wide_ok.sum())
         values = _with_model_error(values, model_error, n, seed, invalid)
     flags = flags_of(values, spec)
     ok = np.ones(len(params), dtype=bool)
@@ -397,7 +446,7 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
     return PassProbability(float(first) if first is not None else math.nan,
                            int(ok.sum()), n, failures, int(batch.diverged.sum()),
                            int(invalid.sum()), float(second),
-                           expected_figures(values, spec))
+                           expected_figures(values, spec), cautious)
 
 
 def _with_model_error(values, model_error, n, seed, invalid):

@@ -23,6 +23,11 @@ change, pooled across lots, are the model's error out of sample.
 A drawn ratio multiplies each Monte Carlo shot's judged figure before it is judged
 (:func:`~airgun_xl.studies.first_shot.pass_probability`), on a stream of its own seeded
 from the study's seed: every setting compared sees the same ratios (common random numbers).
+
+The spread itself is an estimate: :meth:`ModelError.widened` is the error at the upper end of
+its one-sided 95 % confidence bound (chi-square on the pairs' degrees of freedom; the prior
+counts as :data:`MIN_PAIRS` pairs), and a P(PASS)'s interval runs down to what the same
+draws give under it, so that a probability near 1 is only printed with the evidence for it.
 """
 from __future__ import annotations
 
@@ -132,6 +137,23 @@ class ModelError:
         scale = math.sqrt(self.dof / (self.dof - 2)) if 2 < self.dof < math.inf else 1.0
         return tuple(math.sqrt(self.covariance[i][i]) * scale for i in range(len(FIGURES)))
 
+    @property
+    def freedom(self) -> int:
+        """Degrees of freedom of the spread's estimate: the pairs' less one, or
+        ``MIN_PAIRS - 1`` for the prior (it stands for an archive of that size)."""
+        return max(self.pairs, MIN_PAIRS) - 1
+
+    def widened(self) -> ModelError:
+        """The error with its covariance at the upper end of its one-sided 95 % confidence
+        bound, ``k / chi2.ppf(0.05, k)`` times it (``k`` :attr:`freedom`): drawn on the same
+        stream, each ratio is the nominal one's log stretched by the bound's square root."""
+        from scipy.stats import chi2
+
+        k = self.freedom
+        stretch = k / float(chi2.ppf(0.05, k))
+        cov = tuple(tuple(v * stretch for v in row) for row in self.covariance)
+        return ModelError(self.mean, cov, self.pairs, self.dof)
+
     def factors(self, n: int, seed: int) -> np.ndarray:
         """``n`` draws of measured / expected, a column per figure of :data:`FIGURES`."""
         rng = np.random.default_rng([seed, STREAM])
@@ -157,3 +179,10 @@ class ModelError:
                   f"{'s' * (self.pairs != 1)} (fewer than {MIN_PAIRS})" if self.pairs
                   else "the prior (the archive holds no pair of expected and measured shots)")
         return f"the model's own error, {source}: spread (1 sigma) {spread}, centred"
+
+    def bound_words(self) -> str:
+        """What the low end of a P(PASS)'s interval assumes of this error."""
+        wide = ", ".join(f"{f} {100 * s:.1f} %" for f, s in zip(FIGURES, self.widened().sd,
+                                                                 strict=True))
+        return (f"the interval's low end draws the model's error at the upper 95 % bound of "
+                f"its spread ({wide}; {self.freedom} degrees of freedom)")

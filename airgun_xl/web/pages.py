@@ -311,12 +311,13 @@ def compare_url(ids: list[int]) -> str:
 
 def law_curves(versions: list[tuple[str, Any]],
                intervals: dict[str, list[dict[str, Any]]] | None = None) -> dict[str, Any]:
-    """Each law version's crush factor against relative velocity over its own range, on one
-    velocity axis (a gap outside a version's range); a version with its nodes' intervals
-    (``intervals``, by its reference) also gets their low and high ends as points."""
+    """Each law version's crush factor against relative velocity over its own range from 0
+    (:func:`~airgun_xl.crush_law.speeds_text`), on one velocity axis (a gap outside a
+    version's range); a version with its nodes' intervals (``intervals``, by its reference)
+    also gets their low and high ends as points."""
     if not versions:
         return {"x": [], "y": [], "names": []}
-    lo = min(law.v_range[0] for _r, law in versions)
+    lo = max(0.0, min(law.v_range[0] for _r, law in versions))
     hi = max(law.v_range[1] for _r, law in versions)
     xs = [finite(x) for x in np.linspace(lo, hi, 200)]
     lines, names = [], []

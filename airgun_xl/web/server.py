@@ -367,7 +367,8 @@ def _from_proposals(root: Path, lots: list[str]) -> tuple[
 def _laws(root: Path, snapshot: Any, pages: Any) -> dict[str, Any]:
     """The laws page: each lot's law versions (their ranges, curves, the shots each was fitted
     on and the entries that ran it), each lot's chain, and P(PASS) against outcomes."""
-    from ..app.next_shot import chain, prediction_record
+    from ..app.lot_chain import chain, expected_text, knobs_text, measured_text
+    from ..app.next_shot import prediction_record
     from ..archive.laws import list_laws, load_law
     from ..errors import AirgunXlError
 
@@ -396,7 +397,10 @@ def _laws(root: Path, snapshot: Any, pages: Any) -> dict[str, Any]:
                                      "chain_problem": None})
     for name, lot in lots.items():
         try:
-            lot["chain"] = [{**r, "warnings": warned.get(str(r["proposal"]), [])}
+            lot["chain"] = [{**r, "warnings": warned.get(str(r["proposal"]), []),
+                             "expected_text": expected_text(r.get("expected_before")),
+                             "measured_text": measured_text(r.get("measured")),
+                             "next_text": knobs_text(r)}
                             for r in chain(root, name)]
         except AirgunXlError as exc:
             lot["chain_problem"] = str(exc) if "has no chain" not in str(exc) else None
