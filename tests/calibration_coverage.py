@@ -6,6 +6,13 @@ coverage test's worker processes (spawned) can import it."""
 import numpy as np
 
 SPEEDS = (243.53532, 200.0, 150.0)
+
+#: What is calibrated (what, cfc, noise): the law unfiltered under three noises and through
+#: CFC 600 under the most correlated, E40 under the most correlated (4 x 7 law nodes and 1
+#: E40: 29 intervals); and over how many noise seeds.
+STUDIES = (("law", None, "white"), ("law", None, "ar0.6"), ("law", None, "ar0.8"),
+           ("law", 600, "ar0.8"), ("E40", None, "ar0.8"))
+SEEDS = 100
 RATES = (20_000.0, 50_000.0, 30_000.0)
 
 
@@ -73,20 +80,18 @@ def one_seed(job):
 
 
 def main():
-    """Print each study's coverage at each node, and its weak flags' rate, over 200 seeds
+    """Print each study's coverage at each node, and its weak flags' rate, over the seeds
     (what tests/test_calibration_intervals.py asserts; docs/studies.md quotes it)."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
     from airgun_xl.studies.calibrate import Z95
 
-    studies = (("law", None, "white"), ("law", None, "ar0.6"), ("law", None, "ar0.8"),
-               ("law", 600, "ar0.8"), ("E40", None, "white"), ("E40", None, "ar0.8"))
-    jobs = [(w, c, 1000 * s, n) for w, c, n in studies for s in range(200)]
+    jobs = [(w, c, 1000 * s, n) for w, c, n in STUDIES for s in range(SEEDS)]
     with ProcessPoolExecutor(2, multiprocessing.get_context("spawn")) as pool:
         results = list(pool.map(one_seed, jobs, chunksize=8))
-    for k, study in enumerate(studies):
-        rows = results[200 * k:200 * (k + 1)]
+    for k, study in enumerate(STUDIES):
+        rows = results[SEEDS * k:SEEDS * (k + 1)]
         est, truth, err = (np.array([r[i] for r in rows]) for i in range(3))
         hits = (np.abs(est - truth) <= Z95 * err).sum(axis=0)
         weak = np.array([r[4] for r in rows]).mean(axis=0) if rows[0][4] is not None else None

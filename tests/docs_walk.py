@@ -23,7 +23,8 @@ DOCUMENTS = ("README.md", "docs/cell-map.md", "docs/output.md", "docs/trust.md",
 NOT_RUN = [
     ("README.md", "python3 -m venv .venv && . .venv/bin/activate && pip install . && "
                   "airgun-xl fill templates/shot_a.xlsx"),
-    ("README.md", '. .venv/bin/activate && pip install -e ".[test]" && python -m pytest'),
+    ("README.md", '. .venv/bin/activate && pip install -e ".[test]" && python -m pytest '
+                  '-n auto --dist loadfile'),
     ("README.md", '# needs: a lab\'s PostgreSQL server, and the extra: pip install '
                   '"airgun-xl[server]"'),
     ("docs/legacy.md", "# needs: root (apt-get) and the lab's macro runner, which is outside "

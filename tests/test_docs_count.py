@@ -43,7 +43,7 @@ def test_ci_runs_readmes_two_opening_commands_verbatim_and_last():
     first, second = (block.strip() for block in blocks[:2])
     assert "\n" not in first and "\n" not in second
     assert first.endswith("airgun-xl fill templates/shot_a.xlsx")
-    assert second.endswith("python -m pytest")
+    assert second.endswith("python -m pytest -n auto --dist loadfile")
     assert README.index(first) < README.index("## What it is")
     ci = [line for line in (ROOT / ".ci" / "run").read_text().splitlines()
           if line.strip() and not line.startswith("#")]
