@@ -153,7 +153,9 @@ SLOW_TESTS = {
     "test_outputs_block_in_the_workbook", "test_tracked_sheet_holds_the_kernel_values",
     # issue 60's Monte Carlo and design runs (10-20 s each)
     "test_fill_and_design_confidence_agree_on_the_proposal",
+    "test_design_and_next_given_the_same_law_gun_and_specification_propose_the_same_setting",
     "test_the_model_error_widens_p_pass_as_its_spread_says",
+    "test_the_interval_takes_in_the_model_errors_own_uncertainty",
     "test_fill_says_pass_exactly_when_the_monte_carlo_says_at_least_half",
 }
 

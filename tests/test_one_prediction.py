@@ -171,6 +171,53 @@ def test_fill_and_design_confidence_agree_on_the_proposal(tmp_path, capsys):
     assert "predicted: PASS" in text or "Predicted verdict: PASS" in text, text
 
 
+def test_design_and_next_given_the_same_law_gun_and_specification_propose_the_same_setting(
+        tmp_path):
+    """Shot A fired on a lot of the report's own law (the recorder model at 51.2 kHz with no
+    noise and no ringing: the lot's scale is found 1 to its standard error), then design
+    --confidence on the same workbook, gun (A28 1.5 %), specification, shots and seed: the
+    two propose A28 within 0.5 m/s (a gun's step; next draws the law's scale too, which the
+    shot pins to a few parts in 10,000), and their P(PASS) within each other's interval."""
+    import contextlib
+    import io
+    import json
+
+    from conftest import write_trace_csv
+
+    from airgun_xl.crush_law import LEGACY_LAW
+    from airgun_xl.studies.calibrate import synthetic_measurement
+
+    spec_args = ["--peak", "8.6kG:10%", "--duration", "5.25ms:10%",
+                 "--velocity-change", "245m/s:10%"]
+    common = ["--sd", "A28=1.5%", "--shots", "1000", "--seed", "7", *spec_args, "--json"]
+    shot = tmp_path / "shot1.xlsx"
+    shot.write_bytes(TEMPLATE.read_bytes())
+    p = airgun_xl.load(shot).params.replace(crush_law=LEGACY_LAW)
+    write_trace_csv(tmp_path / "rec1.csv", synthetic_measurement(p, dt=1 / 51_200, noise=0.0,
+                                                                 ringing=0.0))
+    def run(argv):
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            code = main(argv)
+        assert code in (0, 3), out.getvalue()
+        return json.loads(out.getvalue())
+
+    nxt = run(["next", str(shot), str(tmp_path / "rec1.csv"), "--archive",
+               str(tmp_path / "arch"), "--lot", "L", "--new-lot", "--confidence", "0.5",
+               *common])
+    assert nxt["law"]["scale"] == pytest.approx(1.0, abs=3 * nxt["law"]["scale_standard_error"]
+                                                + 1e-4)
+    design = run(["design", str(shot), "--confidence", "0.5", "-o",
+                  str(tmp_path / "designed.xlsx"), *common])
+    proposed = nxt["next"]["A28_m_s"]
+    best = design["confidence"]["best"]
+    assert abs(proposed - best["setting"]) <= 0.5, (proposed, best["setting"])
+    lo, hi = nxt["next"]["interval"]
+    d_lo, d_hi = best["interval"]
+    assert lo <= best["probability"] <= hi
+    assert d_lo <= nxt["next"]["p_pass"] <= d_hi
+
+
 # -- the model's own error ------------------------------------------------------------------------
 
 def pairs_with(sd, n, seed, bias=0.0):
