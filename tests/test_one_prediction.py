@@ -364,6 +364,17 @@ def test_the_centring_rule_picks_the_middle_on_a_flat_plateau():
     assert centred(lower, SPEC).setting == 230.0
 
 
+def test_a_warning_a_lots_proposals_repeat_is_said_once_with_its_count():
+    """Three proposals: "slow" carried by all three (once twice over), "tilt" by the second
+    alone: "slow" said at the first with its count, the later rows say how many they carry
+    that were said above."""
+    from airgun_xl.app.lot_chain import said_once
+
+    assert said_once([["slow"], ["slow", "tilt", "slow"], ["slow"]]) == [
+        (["slow (on 3 of the lot's 3 proposals)"], 0), (["tilt"], 1), ([], 1)]
+    assert said_once([]) == [] and said_once([[], []]) == [([], 0), ([], 0)]
+
+
 # -- records keyed by lot -------------------------------------------------------------------------
 
 def test_two_lots_with_the_same_file_names_stay_apart(tmp_path, shot, predicted):

@@ -4,6 +4,7 @@ and ``design`` alike, so that neither imports the other."""
 from __future__ import annotations
 
 import math
+from collections import Counter
 from pathlib import Path
 from typing import Any, TypeGuard
 
@@ -54,6 +55,24 @@ def knobs_text(row: dict[str, Any]) -> str:
     expected = expected_text(row.get("next_expected"))
     return (", ".join(f"{k} {v:.6g}" for k, v in knobs.items())
             + (f"; expected {expected}" if expected else ""))
+
+
+def said_once(warnings: list[list[str]]) -> list[tuple[list[str], int]]:
+    """A chain's warnings, proposal by proposal, each said once: at the first proposal that
+    carries it, with how many of the chain's proposals carry it when more than one ("... (on 4
+    of the lot's 6 proposals)"); ``[(said first here, how many said above are carried
+    again)]``, a row a proposal."""
+    carried = [list(dict.fromkeys(ws)) for ws in warnings]
+    counts = Counter(w for ws in carried for w in ws)
+    seen: set[str] = set()
+    out = []
+    for ws in carried:
+        new = [w for w in ws if w not in seen]
+        seen.update(new)
+        out.append(([w if counts[w] == 1 else
+                     f"{w} (on {counts[w]} of the lot's {len(carried)} proposals)" for w in new],
+                    len(ws) - len(new)))
+    return out
 
 
 def chain(root: str | Path | None, lot: str) -> list[dict[str, Any]]:

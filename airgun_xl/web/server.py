@@ -367,7 +367,7 @@ def _from_proposals(root: Path, lots: list[str]) -> tuple[
 def _laws(root: Path, snapshot: Any, pages: Any) -> dict[str, Any]:
     """The laws page: each lot's law versions (their ranges, curves, the shots each was fitted
     on and the entries that ran it), each lot's chain, and P(PASS) against outcomes."""
-    from ..app.lot_chain import chain, expected_text, knobs_text, measured_text
+    from ..app.lot_chain import chain, expected_text, knobs_text, measured_text, said_once
     from ..app.next_shot import prediction_record
     from ..archive.laws import list_laws, load_law
     from ..errors import AirgunXlError
@@ -397,11 +397,14 @@ def _laws(root: Path, snapshot: Any, pages: Any) -> dict[str, Any]:
                                      "chain_problem": None})
     for name, lot in lots.items():
         try:
-            lot["chain"] = [{**r, "warnings": warned.get(str(r["proposal"]), []),
+            rows = chain(root, name)
+            carried = [warned.get(str(r["proposal"]), []) for r in rows]
+            lot["chain"] = [{**r, "warnings": new, "repeats": repeats, "warned": bool(ws),
                              "expected_text": expected_text(r.get("expected_before")),
                              "measured_text": measured_text(r.get("measured")),
                              "next_text": knobs_text(r)}
-                            for r in chain(root, name)]
+                            for r, ws, (new, repeats) in zip(rows, carried,
+                                                             said_once(carried), strict=True)]
         except AirgunXlError as exc:
             lot["chain_problem"] = str(exc) if "has no chain" not in str(exc) else None
         intervals = {v["ref"]: v.get("intervals") or [] for v in lot["versions"]}
