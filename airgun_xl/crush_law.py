@@ -56,12 +56,17 @@ class CrushLaw:
         Where a fitted law came from, for the record: ``"the Crush law sheet"``, or an
         archive's law library entry such as ``"LOT-2026-07@1"`` (not compared: the same
         coefficients are the same law).
+    named : str
+        The archive's law version a workbook's Crush law sheet says it holds (``next``
+        writes it), unchecked: it becomes ``source`` only once the archive's version of that
+        name has the same values (:func:`airgun_xl.archive.laws.shot_with_law`).
     """
 
     coefficients: tuple[float, ...] = LEGACY_COEFFICIENTS
     v_range: tuple[float, float] = CRUSH_FIT_RANGE
     name: str = "legacy"
     source: str = field(default="", compare=False)
+    named: str = field(default="", compare=False)
 
     def __post_init__(self):
         c = tuple(float(x) for x in self.coefficients)

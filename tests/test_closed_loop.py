@@ -537,3 +537,54 @@ def test_history_lot_shows_the_knobs_what_was_expected_and_what_was_measured(lot
     assert f"next: A28 {second.setting:.6g}" in out
     assert out.count("the lot's law: x") >= 2  # the fixture's two, and any a test added
     assert not math.isnan(np.mean(peak))
+
+
+def test_a_fill_of_the_next_workbook_is_the_lots_in_the_archive_that_holds_its_law(
+        lot, tmp_path, capsys):
+    """next writes the law version its workbook runs in 'Crush law'!D1 (LOT-A@1). fill of that
+    workbook into the lot's archive runs it named (provenance "fitted (LOT-A@1)", so the view
+    lists the fill under LOT-A); into an archive that does not hold it, or with the sheet's
+    values edited, the law runs unnamed with a warning saying why; a D1 that is no law
+    version is refused in one line naming the cell, nothing written."""
+    import shutil
+
+    from airgun_xl.archive import Archive
+    from airgun_xl.web.listing import _LIBRARY_LAW
+
+    work, first, _second = lot
+    ws = openpyxl.load_workbook(first.output, read_only=True)["Crush law"]
+    assert (ws["C1"].value, ws["D1"].value) == ("From", first.law)
+    arch = work / "arch"
+
+    def provenance_law(archive, name):
+        return Archive(archive).get(name).load("provenance.json")["crush_law"]["name"]
+
+    copy = tmp_path / "proposal.xlsx"
+    shutil.copy(first.output, copy)
+    capsys.readouterr()
+    assert main(["fill", str(copy), "--archive", str(arch), "-o", str(tmp_path / "a.xlsx")]) == 0
+    said = capsys.readouterr()
+    assert f"the archive's crush law {first.law}" in said.out and "warning" not in said.err
+    named = provenance_law(arch, "proposal")
+    assert named == f"fitted ({first.law})"
+    assert _LIBRARY_LAW.match(named).group(2) == "LOT-A"  # the view's lot column
+    other = tmp_path / "other"
+    assert main(["fill", str(copy), "--archive", str(other), "-o", str(tmp_path / "b.xlsx")]) == 0
+    said = capsys.readouterr()
+    assert f"names the law {first.law}, which the archive does not hold" in said.err
+    assert provenance_law(other, "proposal") == "fitted"
+    edited = openpyxl.load_workbook(copy)
+    edited["Crush law"]["B4"].value = edited["Crush law"]["B4"].value * 1.01
+    edited.save(copy)
+    assert main(["fill", str(copy), "--archive", str(arch), "-o", str(tmp_path / "c.xlsx"),
+                 "--name", "edited"]) == 0
+    said = capsys.readouterr()
+    assert "whose values in the archive differ from the sheet's" in said.err
+    assert provenance_law(arch, "edited") == "fitted"
+    edited["Crush law"]["D1"].value = "=HYPERLINK(\"x\")"
+    edited.save(copy)
+    before = sorted(p.name for p in tmp_path.iterdir())
+    assert main(["fill", str(copy), "--archive", str(arch), "-o", str(tmp_path / "d.xlsx")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "'Crush law'!D1" in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == before

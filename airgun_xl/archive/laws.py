@@ -150,5 +150,32 @@ def shot_with_law(path, crush_law="workbook", archive=None):
     root = check_law_source(crush_law, archive)
     shot = Shot.from_workbook(path, read_law=crush_law == "workbook")
     if root is not None:
-        shot = shot.with_params(crush_law=load_law(root, crush_law)[0])
+        return shot.with_params(crush_law=load_law(root, crush_law)[0])
+    law = shot.params.crush_law
+    if crush_law == "workbook" and law.named:
+        return _checked_name(shot, law, archive)
     return shot
+
+
+def _checked_name(shot, law, archive):
+    """The shot with its sheet's law named for the record (its ``source``: the archive's
+    entry is then listed under that law's lot) when the archive holds that version with the
+    same values; else the law unnamed, with a warning when an archive was there to say it."""
+    from .store import archive_dir
+
+    root = archive_dir(archive, required=False)
+    unnamed = shot.with_params(crush_law=CrushLaw(law.coefficients, law.v_range, law.name))
+    if root is None:
+        return unnamed
+    try:
+        kept = load_law(root, law.named)[0]
+    except (OptionError, ArchiveError):
+        kept = None
+    if kept is not None and (kept.coefficients, kept.v_range) == (law.coefficients,
+                                                                   law.v_range):
+        return shot.with_params(crush_law=kept)
+    why = ("which the archive does not hold" if kept is None else
+           "whose values in the archive differ from the sheet's")
+    unnamed.warnings.append(f"the Crush law sheet names the law {law.named}, {why}: the "
+                            "sheet's own law is run, named as the workbook's")
+    return unnamed

@@ -1,7 +1,7 @@
 """The ``Crush law`` sheet written: a law's values exact (``fill`` reads them back through
 :mod:`airgun_xl.readers.law_sheet`, whose layout this follows), on one printed page."""
 from ..crush_law import DEGREE
-from ..readers.law_sheet import FIRST_COEFFICIENT_ROW, SHEET_NAME
+from ..readers.law_sheet import FIRST_COEFFICIENT_ROW, FROM_LABEL, SHEET_NAME
 from .columns_sheet import ColumnsWorksheet
 from .report import one_page
 
@@ -21,6 +21,9 @@ def write_law_sheet(wb, law, name=SHEET_NAME, note=NOTE, shot=None):
     coefficient = wb.add_format({"num_format": "0.000000E+00"})
     ws.write_string(0, 0, "Law")
     ws.write_string(0, 1, law.name)
+    if law.source:  # the archive's version it is: fill --archive checks it and keys the lot
+        ws.write_string(0, 2, FROM_LABEL)
+        ws.write_string(0, 3, law.source)
     ws.write_string(1, 0, "Valid from [m/s]")
     ws.write_number_column(1, 1, [law.v_range[0]], speed)  # exact: 17 digits
     ws.write_string(2, 0, "Valid to [m/s]")
