@@ -231,6 +231,9 @@ def test_design_and_next_put_their_study_on_the_pdf(fired, tmp_path):
     flat = " ".join(_text(tmp_path / "n.pdf").split())
     assert f"next shot of lot LOT-P: A28 = {proposal.setting:.6g} m/s" in flat
     assert " ".join(proposal.gun.split()) in flat
+    # what the proposal expects there, and the lot's law against the report's (issue 60)
+    assert "expected there (median, 90 % of the draws): peak " in flat
+    assert re.search(r"the lot's law is x\d\.\d{4}( to x\d\.\d{4})? the report's", flat)
 
 
 def test_design_pdf_without_a_workbook_is_refused_before_the_study(tmp_path):

@@ -732,14 +732,18 @@ def _write(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict: V
     # what the loop said travels with the figures it qualifies (the Summary's P(PASS))
     designed = dataclasses.replace(designed, warnings=list(warnings))
     from ..studies.first_shot import p_pass_text
+
     worst = best.most_failing()
     notes = (f"next shot of lot {request.lot}: {setting_text(request, best)}, "
              f"{p_pass_text(best)}, {best.shots:,} draws of the gun "
              f"({', '.join(request.sd)}) and the law, seed {request.seed}",
              *([rounded_text(request, unrounded)] if unrounded is not None else []),
+             *([f"expected there (median, 90 % of the draws): "
+                f"{expected_text(expected_record(best))}"] if best.figures else []),
              gun, *([f"P(PASS) includes {model_error}"] if model_error else []),
              f"most likely to fail: {worst[0] if worst else 'none'}",
-             f"the lot's law {ref}: {update_text(update)}; {update.note}",
+             f"the lot's law {ref}: {update_text(update)}; {against_report_text(update)}; "
+             f"{update.note}",
              f"from {request.shot} ({verdict.word}), recording {request.recording}")
     assert designed.source is not None
     options = Options(request.integrator, force=request.force, command=request.argv,
