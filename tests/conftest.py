@@ -206,8 +206,22 @@ def page(browser, server):
         yield page
 
 
+#: The longest test files, longest first (seconds a file on 2 cores, measured in a whole run):
+#: README's test command runs them on every core with one file a worker's unit
+#: (``-n auto --dist loadfile``), which hands the files out in the order collected, so these
+#: go first; a long file handed out last would leave the other cores idle at the end.
+LONGEST_FIRST = ("test_calibration_intervals", "test_golden_commands", "test_readme_workflow",
+                 "test_report_workbooks", "test_benchmarks", "test_closed_loop",
+                 "test_hostile_fifth_pass", "test_first_shot", "test_outputs", "test_fill",
+                 "test_closed_loop_whole", "test_pdf_report")
+
+
 def pytest_collection_modifyitems(config, items):
     for item in items:
         if (item.module.__name__.rsplit(".", 1)[-1] in SLOW_MODULES
                 or item.originalname in SLOW_TESTS):
             item.add_marker(pytest.mark.slow)
+    if hasattr(config, "workerinput"):  # a pytest-xdist worker: the longest files first
+        rank = {name: k for k, name in enumerate(LONGEST_FIRST)}
+        items.sort(key=lambda item: rank.get(item.module.__name__.rsplit(".", 1)[-1],
+                                             len(rank)))

@@ -79,3 +79,21 @@ def workspace(tmp_path):
     env.pop("AIRGUN_XL_ARCHIVE", None)
     (tmp_path / "home").mkdir()
     return work, env
+
+
+def walk_lines(work, env, found):
+    """Run every command line of ``found`` blocks; return how many ran."""
+    ran = 0
+    for name, block in found:
+        for line in block.splitlines():
+            if not line.strip() or line.lstrip().startswith("#"):
+                continue
+            expected = re.search(r"# exit (\d+)", line)
+            done = subprocess.run(["bash", "-c", line], cwd=work, env=env, capture_output=True,
+                                  text=True, timeout=300)
+            assert done.returncode == (int(expected.group(1)) if expected else 0), \
+                (name, line, done.stderr)
+            assert "Traceback" not in done.stderr and "error:" not in done.stderr, \
+                (name, line, done.stderr)
+            ran += 1
+    return ran

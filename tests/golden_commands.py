@@ -230,11 +230,16 @@ def _files(work):
     return out
 
 
-def walk(work, env):
-    """Run every line in ``work``: [{line, code, stdout, stderr, files}] in order."""
+def walk(work, env, before_extra=None):
+    """Run every line in ``work``: [{line, code, stdout, stderr, files}] in order;
+    ``before_extra`` is called once the documents' lines have run, before the first of
+    :data:`EXTRA`."""
     records = []
     before = _files(work)
     for name, line in lines():
+        if name == "golden" and before_extra is not None:
+            before_extra()
+            before_extra = None
         done = subprocess.run(["bash", "-c", line], cwd=work, env=env, capture_output=True,
                               text=True, timeout=600)
         after = _files(work)

@@ -193,7 +193,8 @@ def test_a_law_stored_and_run_by_name_equals_the_same_law_from_its_workbook(tmp_
     assert main(["history", "--archive", str(archive)]) == 0
     out = capsys.readouterr().out
     assert "LOT-2026-07@1" in out and "fitted on 1 shot" in out
-    law_line = next(line for line in out.splitlines() if "LOT-2026-07@1" in line)
+    law_line = next(line for line in out.splitlines()
+                    if line.strip().startswith("LOT-2026-07@1"))
     assert " holds at " in law_line and " -" not in law_line  # no negative speed said
     assert main(["fill", str(TEMPLATE), "--crush-law", "LOT-9", "--archive", str(archive),
                  "-o", str(tmp_path / "x.xlsx")]) == 2

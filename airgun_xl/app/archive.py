@@ -23,7 +23,6 @@ from ..archive import Archive, Entry, archive_dir
 from ..archive.index import INDEX_ENV, ROLE_NAME
 from ..archive.store import prestart_index
 from ..cells import BY_ADDRESS
-from ..crush_law import speeds_text
 from ..errors import ArchiveError, OptionError
 from ..transaction import check_output, display
 
@@ -236,6 +235,8 @@ def _history_lines(rows: list[Row], total: int | None, laws: list[dict[str, Any]
     lines.append(f"{len(rows)} entr{'y' if len(rows) == 1 else 'ies'}"
                  + (f" of {total} (--where)" if total is not None else ""))
     if laws:
+        from ..crush_law import speeds_text  # numpy: not on the parser's path
+
         lines.append("crush laws:")
         for law in laws:
             span = ("unreadable" if law["v_range"] is None else
