@@ -3,6 +3,8 @@ recorder model's three shots of the trust tests (tests/test_recorder.py: 243.5, 
 150 m/s at 20, 50 and 30 kHz, 3 % noise, a 50 g offset, the axis reversed), calibrated, and
 what the printed intervals claim against the truth. A module of its own, so that the
 coverage test's worker processes (spawned) can import it."""
+import functools
+
 import numpy as np
 
 SPEEDS = (243.53532, 200.0, 150.0)
@@ -17,9 +19,10 @@ SEEDS = 100
 RATES = (20_000.0, 50_000.0, 30_000.0)
 
 
+@functools.lru_cache(maxsize=1)
 def setup():
     """Shot A at 1 us, and the trust tests' other law (the macro's times 1.15 - 0.0006 V,
-    refitted at degree 6, so a fitted law can equal it)."""
+    refitted at degree 6, so a fitted law can equal it); once a process (both are frozen)."""
     from conftest import TEMPLATE
     from numpy.polynomial import Polynomial
 

@@ -8,6 +8,7 @@ cross-correlation (``"xcorr"``, scipy.signal). The scores are the headline figur
 trace (peak, its time, the pulse duration by the Summary's 10 % rule, the velocity change)
 with their errors, and Pearson's correlation of the aligned traces over their overlap.
 """
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -107,11 +108,23 @@ def anti_aliased(time, values, hz):
     Butterworth low-pass of :data:`ANTI_ALIAS_ORDER` at ``hz`` (None: unchanged), from rest."""
     if hz is None:
         return np.asarray(values, dtype=float)
-    from scipy.signal import butter, sosfilt
+    from scipy.signal import sosfilt
 
     dt = float(time[1] - time[0])
-    sos = butter(ANTI_ALIAS_ORDER, hz, fs=1 / dt, output="sos")
+    sos = _anti_alias_sos(float(hz), 1 / dt).copy()  # sosfilt wants it writable
     return sosfilt(sos, np.asarray(values, dtype=float))
+
+
+@functools.lru_cache(maxsize=64)
+def _anti_alias_sos(hz, fs):
+    """The anti-alias model's sections at ``hz`` for the rate ``fs`` [Hz], designed once: a
+    calibration filters every trial run at the same two figures (half its time went into
+    designing the same filter again)."""
+    from scipy.signal import butter
+
+    sos = butter(ANTI_ALIAS_ORDER, hz, fs=fs, output="sos")
+    sos.setflags(write=False)
+    return sos
 
 
 def check_anti_alias(hz, dt_model, dt_record):
