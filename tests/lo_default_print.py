@@ -2,7 +2,7 @@
 
 Run by Debian's ``python3`` (the one python3-uno is built for), not the project's venv:
 
-    python3 tests/lo_default_print.py PROFILE_DIR WORKBOOK...
+    python3 tests/lo_default_print.py PROFILE_DIR [--pdf DIR] WORKBOOK... [--pdf-of WORKBOOK...]
 
 It starts its own headless soffice on a private pipe and user profile, opens each workbook as
 a user would (its saved view: the active sheet and the selected sheets), and prints one JSON
@@ -15,6 +15,10 @@ object per workbook on standard output:
   the selected sheets, as the print dialog asks it: ``IsOnlySelectedSheets``);
 - ``every_sheet``: the page count of a print of every sheet (the PDF export's);
 - ``alone``: each sheet's page count when it alone is printed (its tab clicked, then print).
+
+- ``pdf``: with ``--pdf DIR``, the PDF export of each workbook named after ``--pdf-of`` (all
+  when none is), as ``soffice --convert-to pdf`` writes it (Calc's PDF filter, its defaults):
+  ``DIR/STEM.pdf``, exported while the workbook is open for the counts (one start, one load).
 
 The page counts are LibreOffice's own (``XRenderable.getRendererCount``), the sheets those
 its renderer names (``getRenderer``'s ``SourceRange``).
@@ -66,7 +70,7 @@ def _sheet_of_pages(doc, options):
     return names
 
 
-def main(profile, paths):
+def main(profile, paths, pdf_dir=None, pdf_of=None):
     proc, ctx = _connect(profile)
     smgr = ctx.ServiceManager
     desktop = smgr.createInstanceWithContext("com.sun.star.frame.Desktop", ctx)
@@ -89,9 +93,16 @@ def main(profile, paths):
                 for i in range(doc.Sheets.getCount()):
                     sheet = doc.Sheets.getByIndex(i)
                     alone[sheet.getName()] = doc.getRendererCount(sheet, ())
+                pdf = None
+                if pdf_dir is not None and (not pdf_of or path in pdf_of):
+                    stem = os.path.splitext(os.path.basename(path))[0]
+                    pdf = os.path.join(os.path.abspath(pdf_dir), stem + ".pdf")
+                    doc.storeToURL(uno.systemPathToFileUrl(pdf),
+                                   (_pv("FilterName", "calc_pdf_Export"),))
                 print(json.dumps({"path": path, "active": view.getActiveSheet().getName(),
                                   "all_sheets_default": all_sheets, "default": default,
-                                  "every_sheet": every, "alone": alone}), flush=True)
+                                  "every_sheet": every, "alone": alone, "pdf": pdf}),
+                      flush=True)
             finally:
                 doc.close(True)
     finally:
@@ -102,5 +113,18 @@ def main(profile, paths):
         proc.wait(60)
 
 
+def _arguments(argv):
+    """(profile, workbooks, pdf folder or None, workbooks to export or None) of the command
+    line above (argparse would do; Debian's python3 runs this, with nothing installed)."""
+    profile, rest = argv[0], list(argv[1:])
+    pdf_dir = pdf_of = None
+    if rest[:1] == ["--pdf"]:
+        pdf_dir, rest = rest[1], rest[2:]
+    if "--pdf-of" in rest:
+        k = rest.index("--pdf-of")
+        rest, pdf_of = rest[:k], set(rest[k + 1:])
+    return profile, rest, pdf_dir, pdf_of
+
+
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2:])
+    main(*_arguments(sys.argv[1:]))
