@@ -329,14 +329,14 @@ def test_a_proposal_naming_a_fifo_is_refused_without_blocking(lot, tmp_path, cap
     assert files_under(archive) == before and not (tmp_path / "n.xlsx").exists()
 
 
-def _gun_lot(folder, shots, seed=2):
+def _gun_lot(folder, shots, seed=2, offset=0.0):
     """``shots`` shots of a lot 10 % stronger, set from 220 m/s up by 2 m/s, each fired with
-    the gun's error drawn at 1.5 % (and zeta's at 10 %): the workbooks, recordings and the
-    gun's errors."""
+    the gun's error drawn at 1.5 % about ``offset`` (and zeta's at 10 %): the workbooks,
+    recordings and the gun's errors."""
     rng = np.random.default_rng(seed)
     made = []
     for k in range(shots):
-        error = rng.normal(0, 0.015)
+        error = offset + rng.normal(0, 0.015)
         v = 220.0 + 2 * k
         book = openpyxl.load_workbook(TEMPLATE)
         book["Sheet1"]["A28"] = v
@@ -383,12 +383,16 @@ def test_next_draws_the_estimated_scatter_from_the_eighth_shot_and_says_so(tmp_p
     store_proposal, each file by its SHA-256: seven loops of next would cost half a minute
     of CI for what the first one shows); the eighth needs no --sd A28, draws the estimate
     and says where it came from; a --sd A28=5% given then lies outside the estimate's
-    interval: a warning, on the next workbook too."""
+    interval: a warning, on the next workbook too. The gun fires 3 % slow on average: the
+    eighth shot's next finds the offset (within 2.5 of its standard errors, a 1-in-80 miss),
+    warns of it, draws the scatter with the offset's error (in quadrature) and states the gun
+    setting that fires the velocity proposed: that velocity over (1 + the offset)."""
     import hashlib
 
     from airgun_xl.archive.lots import proposals, store_proposal
+    from airgun_xl.studies.closed_loop import gun_scatter
 
-    made = _gun_lot(tmp_path, 8)
+    made = _gun_lot(tmp_path, 8, offset=-0.03)
     archive = tmp_path / "arch"
     shot, rec, _ = made[0]
     first = airgun_xl.next_shot(shot, rec, archive=archive, lot="LOT-G", new_lot=True,
@@ -405,16 +409,25 @@ def test_next_draws_the_estimated_scatter_from_the_eighth_shot_and_says_so(tmp_p
     shot, rec, _ = made[7]
     out = airgun_xl.next_shot(shot, rec, archive=archive, lot="LOT-G", shots=100,
                               output=tmp_path / "n7.xlsx", **SPEC)
+    found = gun_scatter(out.update)
+    assert abs(found.bias + 0.03) < 2.5 * found.bias_error and found.bias_error < 0.01
+    drawn = math.hypot(found.sd, found.bias_error)
+    fire = out.setting
     assert re.fullmatch(r"the gun's scatter \d\.\d\d% \(95 % interval \d\.\d\d%-\d\.\d\d%\), "
                         r"estimated from 8 shots' launch velocities fitted against their set "
-                        r"values \(their mean [+-]\d\.\d\d% \+/- \d\.\d\d% off them\)",
-                        out.gun), out.gun
+                        r"values \(their mean [+-]\d\.\d\d% \+/- \d\.\d\d% off them\); "
+                        + re.escape(f"drawn {drawn:.2%} (the scatter with the error of the mean "
+                                    "offset the setting is corrected by); to fire "
+                                    f"{fire:.2f} m/s, set the gun to "
+                                    f"{fire / (1 + found.bias):.2f} m/s (its mean offset "
+                                    f"{found.bias:+.2%} taken out)"), out.gun), out.gun
+    assert any(w.startswith(f"the gun fires {found.bias:+.2%}") for w in out.warnings)
     assert out.model_error.startswith("the model's own error, the prior")  # said beside it
     assert out.update.shots == 8 and len(out.update.launch) == 8
     assert json.loads(out.to_json())["gun"] == out.gun
     again = airgun_xl.next_shot(shot, rec, archive=archive, lot="LOT-G", shots=100,
                                 sd=["A28=5%"], output=tmp_path / "n8.xlsx", **SPEC)
-    assert again.counted_once and again.gun.endswith("; the A28=5% given is not used")
+    assert again.counted_once and "; the A28=5% given is not used; to fire " in again.gun
     said = [w for w in again.warnings if w.startswith("--sd A28=5%: the gun's scatter given")]
     assert len(said) == 1
     book = openpyxl.load_workbook(again.output, read_only=True)
@@ -472,16 +485,16 @@ def test_chunk_without_a_cluster_is_refused_before_any_work(tmp_path, capsys):
 
 def test_a_gun_that_fires_off_its_setting_is_said_and_warned_of():
     """The mean offset of the lot's launch velocities from their set values is printed with
-    the scatter; past two standard errors it is a warning (the draws assume none), within
-    them it is not."""
+    the scatter; past two standard errors it is a warning (next takes it out of the setting
+    it states for the gun), within them it is not."""
     from airgun_xl.studies.closed_loop import GunScatter
 
     off = GunScatter(0.015, (0.010, 0.030), 8, 0.031, 0.005)
     assert off.words().endswith("(their mean +3.10% +/- 0.50% off them)")
     assert off.warnings == [
         "the gun fires +3.10% (+/- 0.50%) off its set velocity on average over the lot's 8 "
-        "shots: the setting proposed is the velocity to fire, which this gun reaches set that "
-        "much the other way; the draws assume no such offset"]
+        "shots: the setting proposed is the velocity to fire; set the gun to the value next "
+        "states beside it (the offset taken out, its error drawn)"]
     assert GunScatter(0.015, (0.010, 0.030), 8, -0.009, 0.005).warnings == []
 
 

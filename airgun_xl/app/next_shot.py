@@ -258,8 +258,8 @@ def run(request: NextRequest) -> NextOutcome:
     update = update_law(params, traces, prior, spec.judged.cfc, request.integrator,
                         velocities=estimated or request.gun is not None)
     _described(request, update, lot_shots)
-    sds, gun, gun_warnings = _gun(request, update, sds, len(lot_shots), shot.params.v31,
-                                  others, freedom)
+    sds, gun, gun_warnings, offset = _gun(request, update, sds, len(lot_shots),
+                                          shot.params.v31, others, freedom)
     gun_warnings = [*read_warnings, *gun_warnings]
     p_next = shot.params.replace(crush_law=update.law)
     model_error = model_error_of(request.archive)
@@ -267,6 +267,8 @@ def run(request: NextRequest) -> NextOutcome:
     best, unrounded, conf_warnings = _choose(request, spec, p_next,
                                              [*sds, law_scatter(update)], model_error)
     reached = reaches(best, request.confidence)
+    if offset is not None:
+        gun += "; " + gun_setting_text(best.setting, offset)
     warnings = list(dict.fromkeys([*map(str, shot.warnings), *verdict.warnings,
                                    *update.warnings, *gun_warnings, *conf_warnings]))
     if not reached:
@@ -402,14 +404,29 @@ def _scatter(request: NextRequest, estimated: bool) -> list[Any]:
     return list(sds)
 
 
+def gun_setting_text(setting: float, offset: float) -> str:
+    """What to set the gun to so that it fires ``setting`` [m/s], its launch velocities
+    ``offset`` [-] off the values set on average (the estimate's error is drawn)."""
+    return (f"to fire {setting:.2f} m/s, set the gun to {setting / (1 + offset):.2f} m/s "
+            f"(its mean offset {offset:+.2%} taken out)")
+
+
 def _gun(request: NextRequest, update: LawUpdate, sds: list[Any], shots: int,
          velocity: float, others: list[tuple[str, tuple[tuple[float, float, float], ...]]],
-         freedom: int) -> tuple[list[Any], str, list[str]]:
+         freedom: int) -> tuple[list[Any], str, list[str], float | None]:
     """The gun's scatter drawn: estimated from the lot's launch velocities once it has
     :data:`~airgun_xl.studies.closed_loop.GUN_SHOTS` shots (with ``--gun``, from the launch
     velocities of every lot of that gun, ``others`` and this one, once they hold one degree
-    of freedom less), else the one given; with the words saying which, and a warning when
-    the given one lies outside the estimate's 95 % interval."""
+    of freedom less), else the one given; with the words saying which, a warning when the
+    given one lies outside the estimate's 95 % interval, and the gun's mean offset (None
+    while the scatter is the one given).
+
+    Once estimated, the launch velocities are fitted and the lot's law no longer absorbs the
+    gun's mean offset from the values set: the setting proposed is the velocity to fire
+    (the next workbook's A28, what ``fill`` predicts), the gun set to it divided by (1 +
+    the offset), and the offset's own standard error drawn with the scatter (a shot fired
+    ``(1 + e)(1 + s)`` off the velocity meant, to first order one normal of
+    hypot(scatter, error))."""
     from ..studies.closed_loop import GUN_SHOTS, gun_scatter, pooled_scatter
 
     given = next((sd for sd in sds if sd[0] == address("v31")), None)
@@ -432,11 +449,13 @@ def _gun(request: NextRequest, update: LawUpdate, sds: list[Any], shots: int,
             why = (f"the lots of the gun {request.gun} hold {max(freedom, 0)} shot"
                    f"{'s' * (freedom != 1)} beyond each lot's first, and it is estimated "
                    f"from their launch velocities from {GUN_SHOTS - 1}")
-        return sds, f"the gun's scatter {shown} as given (--sd): {why}", []
+        return sds, f"the gun's scatter {shown} as given (--sd): {why}", [], None
     rest = [sd for sd in sds if sd[0] != address("v31")]
     cell, fields, _sd, _rel = given if given is not None else (
         address("v31"), ("v31", "v32", "v33"), 0.0, True)
-    words = found.words()
+    drawn = math.hypot(found.sd, found.bias_error)
+    words = (f"{found.words()}; drawn {drawn:.2%} (the scatter with the error of the mean "
+             "offset the setting is corrected by)")
     warnings = list(found.warnings)
     if given is not None:
         value = given[2] if given[3] else given[2] / abs(velocity)  # relative to the set A28
@@ -447,7 +466,7 @@ def _gun(request: NextRequest, update: LawUpdate, sds: list[Any], shots: int,
                             f"95 % interval estimated from the {'gun' if request.gun else 'lot'}"
                             f"'s shots ({lo:.2%}-{hi:.2%}); the estimate, {found.sd:.2%}, is "
                             "drawn")
-    return [*rest, (cell, fields, found.sd, True)], words, warnings
+    return [*rest, (cell, fields, drawn, True)], words, warnings, found.bias
 
 
 def _gun_lots(request: NextRequest, lot_shots: list[dict[str, Any]]

@@ -308,8 +308,8 @@ class GunScatter:
         if abs(self.bias) > BIAS_SIGMAS * self.bias_error:
             found.append(f"the gun fires {self.bias:+.2%} (+/- {self.bias_error:.2%}) off its "
                          f"set velocity on average over {self._whose()}: the "
-                         "setting proposed is the velocity to fire, which this gun reaches "
-                         "set that much the other way; the draws assume no such offset")
+                         "setting proposed is the velocity to fire; set the gun to the value "
+                         "next states beside it (the offset taken out, its error drawn)")
         return found
 
     def words(self) -> str:
