@@ -126,7 +126,7 @@ def test_every_data_sheet_prints_by_itself(workbooks, kind):
 @pytest.fixture(scope="module")
 def lo_print(workbooks, tmp_path_factory):
     """What LibreOffice prints of every workbook (tests/lo_default_print.py), and the PDF
-    export of :data:`KINDS`' (as ``soffice --convert-to pdf`` writes it), in one start of
+    export of :data:`PDF_KINDS`' (as ``soffice --convert-to pdf`` writes it), in one start of
     LibreOffice: [records in sorted(ALL_KINDS)'s order], each with its "pdf" (or None).
     Converting the same workbooks twice, once per test, cost 80 s and 57 s."""
     if not _has_uno():
@@ -136,7 +136,7 @@ def lo_print(workbooks, tmp_path_factory):
     done = subprocess.run([UNO_PYTHON, str(Path(__file__).with_name("lo_default_print.py")),
                            str(folder / "lo"), "--pdf", str(folder),
                            *(str(workbooks[k]) for k in kinds),
-                           "--pdf-of", *(str(workbooks[k]) for k in KINDS)],
+                           "--pdf-of", *(str(workbooks[k]) for k in PDF_KINDS)],
                           capture_output=True, text=True, timeout=900, check=False)
     assert done.returncode == 0, done.stderr[-2000:]
     printed = [json.loads(line) for line in done.stdout.splitlines()]
@@ -165,7 +165,30 @@ def test_each_workbook_prints_its_report_pages_first_then_its_data(workbooks, lo
         printed = {re.split(r"\s{2,}", line.strip())[-1] for p in pages[len(sheets):]
                    for line in p.splitlines()[-1:]}  # the footer's right: the sheet's name
         assert printed == set(data), (kind, printed, set(data))
-    assert all(lo_print[k]["pdf"] is None for k in ALL_KINDS - set(KINDS))
+    assert all(lo_print[k]["pdf"] is None for k in ALL_KINDS - set(PDF_KINDS))
+
+
+#: The workbooks exported to PDF: each kind's pages checked, and a Summary with Design notes.
+PDF_KINDS = (*KINDS, "design_confidence")
+
+
+def test_every_summary_note_prints_whole(workbooks, lo_print):
+    """Issue 60: a Summary's Design notes (design --confidence's: the model's own error, the
+    probability's interval) and the predicted verdict's definitions are wrapped in their
+    column, each row as tall as its lines: every word of each prints on the page. Before, a
+    note of 300 characters in one cell ran past the page's right edge and printed cut."""
+    for kind in ("design_confidence", "fill"):
+        ws = openpyxl.load_workbook(workbooks[kind], read_only=True)["Summary"]
+        notes = [str(row[3]) for row in ws.iter_rows(values_only=True)
+                 if len(row) > 3 and row[0] in ("Design", None) and row[3]
+                 and len(str(row[3])) > 110]
+        if kind == "design_confidence":
+            assert len(notes) >= 2, notes  # the long lines this checks are there
+        text = subprocess.run(["pdftotext", lo_print[kind]["pdf"], "-"], capture_output=True,
+                              text=True, check=True).stdout
+        flat = " ".join(text.split())
+        for note in notes:
+            assert " ".join(note.split()) in flat, (kind, note)
 
 
 def test_the_grid_sweeps_charts_have_one_series_per_level(workbooks):

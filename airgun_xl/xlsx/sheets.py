@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..cells import address
+from ..crush_law import speeds_text
 from ..engine.decimate import minmax_indices
 from ..engine.summary import PULSE_FRACTION, SPECTRUM_MAX_HZ
 from ..errors import OutputError
@@ -245,7 +246,7 @@ def summary_rows(result, summary, prov):
          "", ""),
         ("Integrator", result.integrator, "", ""),
         ("Crush-factor law", "the macro's polynomial, Eq. (8)" if p.crush_law.is_legacy else
-         f"fitted, {p.crush_law.v_range[0]:.4g} to {p.crush_law.v_range[1]:.4g} m/s",
+         f"fitted, {speeds_text(p.crush_law.v_range)}",
          "", "" if p.crush_law.is_legacy else
          f"the archive's law {p.crush_law.source} (calibrate --archive --name)"
          if p.crush_law.source else "the Crush law sheet (airgun-xl calibrate)"),
@@ -303,11 +304,22 @@ def write_predicted_verdict(wb, ws, verdict, row, style, doubted=()):
         row += 1
     wrap = wb.add_format({"text_wrap": True, "valign": "top"})
     for line in verdict.definitions[1:] + [f"note: {n}" for n in verdict.spec.notes]:
-        ws.write_string(row, 3, line, wrap)
-        if len(line) > 110:  # the Definition column's width, in characters
-            ws.set_row(row, 15 * math.ceil(len(line) / 110))
+        write_definition(ws, row, line, wrap)
         row += 1
     return row
+
+
+#: Characters a line of the Summary's Definition column (D, 100 wide) holds.
+DEFINITION_CHARS = 110
+
+
+def write_definition(ws, row, line, wrap):
+    """``line`` in the Summary's Definition column at ``row``, wrapped (``wrap``: a text-wrap
+    format) and the row made tall enough for its lines: a long line printed in one cell runs
+    past the page's right edge and prints cut."""
+    ws.write_string(row, 3, line, wrap)
+    if len(line) > DEFINITION_CHARS:
+        ws.set_row(row, 15 * math.ceil(len(line) / DEFINITION_CHARS))
 
 
 def write_summary(wb, result, summary, prov, name="Summary"):
@@ -346,9 +358,10 @@ def write_summary(wb, result, summary, prov, name="Summary"):
     if prov.verdict is not None:
         row = write_predicted_verdict(wb, ws, prov.verdict, row, style,
                                       flags.get("Peak acceleration (raw)", [])) + 1
+    wrap = wb.add_format({"text_wrap": True, "valign": "top"})
     for note in prov.study_notes:
-        ws.write_string(row, 0, "Design", style.bold)
-        ws.write_string(row, 3, note)
+        ws.write_string(row, 0, "Design", style.get(bold=True, valign="top"))
+        write_definition(ws, row, note, wrap)
         row += 1
     last = write_warnings(wb, ws, row, list(prov.warnings), 3)
     one_page(ws, last, 3, shot=prov.shot, title="Summary")
@@ -441,8 +454,7 @@ def write_parameters(wb, params, shot, name="Parameters"):
     ws.write_string(row + 1, 1, "Crush-factor law")
     ws.write_string(row + 1, 2, "Eq. (8)" if law.is_legacy else "fitted")
     ws.write_string(row + 1, 4, "the macro's polynomial" if law.is_legacy else
-                    f"from the Crush law sheet, valid {law.v_range[0]:.4g} to "
-                    f"{law.v_range[1]:.4g} m/s")
+                    f"from the Crush law sheet, valid {speeds_text(law.v_range)}")
     ws.write_string(row + 2, 1, "Model; unloading force")
     ws.write_string(row + 2, 2, f"{params.model}; {params.unloading}")
     one_page(ws, row + 2, len(widths) - 1, shot=shot, title="Parameters")
