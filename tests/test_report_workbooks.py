@@ -154,6 +154,8 @@ def test_each_workbook_prints_its_report_pages_first_then_its_data(workbooks, lo
         text = subprocess.run(["pdftotext", "-layout", lo_print[kind]["pdf"], "-"],
                               capture_output=True, text=True, check=True).stdout
         pages = text.split("\f")[:-1]
+        # no figure too wide for its column (ChartData's printed "###" at the default width)
+        assert "###" not in text, (kind, [p.splitlines()[-1] for p in pages if "###" in p][:3])
         # the export prints what the counts say a print of every sheet gives
         assert len(pages) == lo_print[kind]["every_sheet"], kind
         sheets = [ws.title for ws, _ in report_sheets(path)]
@@ -186,6 +188,7 @@ def test_every_summary_note_prints_whole(workbooks, lo_print):
             assert len(notes) >= 2, notes  # the long lines this checks are there
         text = subprocess.run(["pdftotext", lo_print[kind]["pdf"], "-"], capture_output=True,
                               text=True, check=True).stdout
+        assert "###" not in text, kind  # its ChartData's figures printed whole too
         flat = " ".join(text.split())
         for note in notes:
             assert " ".join(note.split()) in flat, (kind, note)

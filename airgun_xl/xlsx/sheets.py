@@ -84,7 +84,12 @@ def write_number_columns(ws, first_row, columns, style=None):
                                   "expected fewer rows on the sheet (a larger row stride: every)")
 
 
-def write_data_sheet(ws, headers, columns, style, shot=None, width=16):
+#: A data sheet's column width [characters]: the widest figure :func:`write_number_columns`
+#: shows, a sign, a point and its digits, prints whole.
+DATA_WIDTH = 16
+
+
+def write_data_sheet(ws, headers, columns, style, shot=None, width=DATA_WIDTH):
     """A data sheet: ``headers`` in row 1, the ``{col: array}`` columns under them (see
     :func:`write_number_columns`), printed by itself (:func:`~airgun_xl.xlsx.report.data_pages`)."""
     ws.set_column(0, len(headers) - 1, width)
@@ -182,6 +187,9 @@ def write_chart_data(wb, data, refs, sheet_class, name="ChartData", budget=POINT
     longest = max((r.last_row for r in out.values() if r.sheet == ws.get_name()), default=1)
     if time_col is not None:
         longest = max(longest, 1 + len(time_ms[:limit]))
+    # as wide as the other data sheets' columns: at the default width a six-decimal time or a
+    # negative figure printed as "###" (seen on design --confidence's PDF)
+    ws.set_column(0, max(col - 1, 0), DATA_WIDTH)
     data_pages(ws, max(longest, 1), max(col - 1, 0), header_rows=2, shot=shot)
     return out
 
