@@ -89,14 +89,16 @@ def fill_cmd(shot, out, *flags):
 
 
 def timed(cmd, repeat, ok_codes=(0,)):
-    """(median, min) wall time [s] of ``cmd`` as a process, after a warm-up run; an exit code
-    outside ``ok_codes`` stops the benchmark."""
+    """(median, min) wall time [s] of ``cmd`` as a process, after a warm-up run (none in a
+    ``--quick`` run, which measures nothing); an exit code outside ``ok_codes`` stops the
+    benchmark."""
     def run():
         done = subprocess.run(cmd, capture_output=True)
         if done.returncode not in ok_codes:
             raise subprocess.CalledProcessError(done.returncode, cmd, done.stdout, done.stderr)
 
-    run()  # warm-up (OS file cache)
+    if not quick():
+        run()  # warm-up (OS file cache)
     times = []
     for _ in range(repeat):
         started = time.perf_counter()
