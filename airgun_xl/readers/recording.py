@@ -42,7 +42,8 @@ FILE_ACCEL_UNITS = {**ACCEL_UNITS, "G": ACCEL_UNITS["g"],
 #: The time units a file may state [s per unit]: the options' and ``sec``, ``msec``.
 FILE_TIME_UNITS = {**TIME_UNITS, "sec": 1.0, "msec": 1e-3}
 
-#: A step may differ from the median step by this fraction before it is a gap.
+#: A step may differ from the median step by this fraction before the time column is taken
+#: for a recorder's clock whose stamps jitter, and fitted (:mod:`.time_base`).
 GAP_TOLERANCE = 0.01
 
 #: Fewest samples a pulse may have.
@@ -484,12 +485,18 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
         raise WorkbookError(f"{shown}: its sample step is {dt:.4g} s ({1 / dt:.4g} Hz), "
                             f"expected a step of {limits.MIN_SAMPLE_STEP:g} to "
                             f"{limits.MAX_SAMPLE_STEP:g} s (a recorder of 1 Hz to 1 GHz)")
-    off = np.abs(steps - dt) > GAP_TOLERANCE * dt
-    if off.any():
-        k = int(np.argmax(off))
-        raise WorkbookError(f"{shown}: row {k + 3}: a step of {steps[k]:.4g} s, expected the "
-                            f"constant {dt:.4g} s of the other rows (a gap or a changed rate)")
-    accel = sign * values[:, 1] * FILE_ACCEL_UNITS[a_unit]
+    raw = values[:, 1]
+    if (np.abs(steps - dt) > GAP_TOLERANCE * dt).any():  # a recorder's clock: fitted
+        from .time_base import fit_clock
+
+        clock = fit_clock(shown, time, raw)
+        time, raw, dt = clock.time, raw[clock.first:clock.stop], clock.dt
+        notes += list(clock.notes)
+        if len(raw) < MIN_SAMPLES:
+            raise WorkbookError(f"{shown}: holds {len(raw)} samples on one clock around its "
+                                f"largest excursion (between the gaps in its time), expected "
+                                f"at least {MIN_SAMPLES}")
+    accel = sign * raw * FILE_ACCEL_UNITS[a_unit]
     peak = float(np.max(np.abs(accel)))
     if not peak >= limits.MIN_RECORDED_PEAK_KG:
         raise WorkbookError(f"{shown}: the recording is flat (its largest acceleration is "

@@ -104,8 +104,9 @@ def _even(name: str, time: np.ndarray, declared: float | None) -> tuple[np.ndarr
     """The samples' times without idelib's microsecond truncation: from the first, at the
     rate the file declares when every time lies within :data:`TIME_RESOLUTION` of it, else
     at the rate measured over the record (its ends) when they lie within it of that (a note
-    says the rates differ), else idelib's times as they are (a real gap is then refused by
-    the recording's step check)."""
+    says the rates differ), else idelib's times as they are: the block time codes of a real
+    recorder, which jitter, and whose clock the recording's reader fits
+    (:mod:`airgun_xl.readers.time_base`)."""
     n = len(time)
     if n < 2 or not time[-1] > time[0]:
         return time, ""
