@@ -80,9 +80,17 @@ def _seconds(unit: str) -> float | None:
     return float(TIME_UNITS[unit]) if unit in TIME_UNITS else None
 
 
+def _no_time_response(shown: str) -> WorkbookError:
+    return WorkbookError(f"{shown}: has no dataset 58 time response (function type 1), "
+                         f"{EXPECTED}")
+
+
 def channels(path: str | Path, data: bytes) -> list[ChannelInfo]:
-    """The file's time responses."""
+    """The file's time responses; a file of none is refused (listed, it read "0 channels",
+    exit 0)."""
     shown, sets = _datasets(path, data)
+    if not sets:
+        raise _no_time_response(shown)
     out = []
     for dataset in sets:
         t_unit, unit = _units(dataset)
@@ -100,8 +108,7 @@ def read(path: str | Path, data: bytes, channel: str | None) -> Table:
     """The chosen time response (the first by default)."""
     shown, sets = _datasets(path, data)
     if not sets:
-        raise WorkbookError(f"{shown}: has no dataset 58 time response (function type 1), "
-                            f"{EXPECTED}")
+        raise _no_time_response(shown)
     names = [_name(s) for s in sets]
     dataset = sets[choose(channel, names, "time response")]
     name = _name(dataset)
