@@ -304,17 +304,11 @@ def srs(shot: str | os.PathLike[str], *, q: float | str = 10.0, cfc: int | str |
     AirgunXlError
         Bad input, named; nothing is written.
     """
-    from pathlib import Path
-
-    from .app.specifying import record_filter
     from .app.srs import SrsRequest, run
-    from .specification import parse_q
 
-    record = record_filter(cfc)
-    return run(SrsRequest(Path(shot), parse_q(str(q), "--srs-q"), record,
-                          _number("--from", lo), _number("--to", hi), integrator, model,
-                          Path(output) if output is not None else None, force, crush_law,
-                          Path(archive) if archive is not None else None))
+    return run(SrsRequest.given(shot=shot, q=q, cfc=cfc, lo=lo, hi=hi, integrator=integrator,
+                                model=model, output=output, force=force,
+                                crush_law=crush_law, archive=archive))
 
 
 @_paths_checked

@@ -40,11 +40,22 @@ def test_srs_keywords_are_the_commands_and_refusals_name_them(tmp_path, capsys):
                  "--to", "5000", "-o", str(tmp_path / "c.xlsx")]) == 0
     level, frequency = outcome.largest
     assert f"largest {level:.4f} kG at {frequency:,.0f} Hz" in capsys.readouterr().out
-    for given, said in (({"q": 0}, "--srs-q: found '0'"), ({"lo": 10, "hi": 5},
-                                                           "--from/--to: found 10 and 5 Hz")):
-        with pytest.raises(OptionError, match=said):
+    # the function's refusals name its keywords, the command's its options (issue 61)
+    for given, said, option in (({"q": 0}, "q: found '0'", ["--srs-q", "0"]),
+                                ({"lo": 10, "hi": 5}, "lo/hi: found 10 and 5 Hz",
+                                 ["--from", "10", "--to", "5"]),
+                                ({"integrator": "rk4"}, "integrator: found 'rk4', expected "
+                                                        "one of legacy, newmark", None)):
+        with pytest.raises(OptionError) as caught:
             airgun_xl.srs(TEMPLATE, output=tmp_path / "x.xlsx", **given)
-    assert not (tmp_path / "x.xlsx").exists()
+        text = str(caught.value)
+        assert text.startswith(said), text
+        if option is not None:  # the same words, the option named
+            assert main(["srs", str(TEMPLATE), "-o", str(tmp_path / "y.xlsx"), *option]) == 2
+            flag = "/".join(o for o in option if o.startswith("--"))
+            rest = text.partition(": ")[2]
+            assert capsys.readouterr().err == f"airgun-xl: error: {flag}: {rest}\n"
+    assert not (tmp_path / "x.xlsx").exists() and not (tmp_path / "y.xlsx").exists()
 
 
 def test_compare_measured_scores_the_recording_against_the_prediction(tmp_path, capsys):

@@ -12,25 +12,40 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import OptionError
+from . import declared
 
 
-@dataclass(frozen=True)
-class SrsRequest:
+@dataclass(frozen=True, kw_only=True)
+class SrsRequest(declared.Checked):
     """The shot, the spectrum's band [Hz] and quality factor [-], the filter the pulse goes
     through first (a J211 class, None for none). ``output`` None writes no workbook (the CLI
-    gives its default, ``SHOT.srs.xlsx``)."""
+    gives its default, ``SHOT.srs.xlsx``). Declared once (:mod:`.declared`): the command's
+    options, in this order, and the API's keywords."""
 
-    shot: Path
-    q: float = 10.0
-    cfc: int | None = None
-    lo: float = 100.0  # [Hz]
-    hi: float = 10_000.0  # [Hz]
-    integrator: str = "legacy"
-    model: str = "4-mass"
-    output: Path | None = None
-    force: bool = False
-    crush_law: str = "workbook"
-    archive: Path | None = None  # where a library law is read from
+    shot: Path = declared.shot()
+    output: Path | None = declared.output("the SRS workbook", "SHOT.srs.xlsx")
+    force: bool = declared.force()
+    q: float = declared.option(10.0, "--srs-q", metavar="Q", read=declared.a_quality_factor,
+                               help="quality factor (default 10: 5 %% damping)",
+                               aliases=(("--q", "SRS quality factor"),))
+    cfc: int | None = declared.option(None, "--cfc", metavar="N|none", kind="cfc",
+                                      read=declared.a_cfc,
+                                      help="filter the pulse first: SAE J211 class 60, 180, "
+                                           "600 or 1000, or none (the default)")
+    lo: float = declared.option(100.0, "--from", metavar="HZ", read=declared.a_number,
+                                help="lowest natural frequency (default 100)")  # [Hz]
+    hi: float = declared.option(10_000.0, "--to", metavar="HZ", read=declared.a_number,
+                                help="highest natural frequency (default 10000)")  # [Hz]
+    integrator: str = declared.integrator()
+    model: str = declared.model()
+    crush_law: str = declared.crush_law()
+    archive: Path | None = declared.archive()  # where a library law is read from
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not (0 < self.lo < self.hi < float("inf")):
+            raise OptionError(f"lo/hi: found {self.lo:g} and {self.hi:g} Hz, expected "
+                              "0 < FROM < TO")
 
 
 @dataclass(frozen=True)
@@ -71,15 +86,11 @@ def run(request: SrsRequest) -> SrsOutcome:
     """
     from ..archive.laws import shot_with_law
     from ..models import apply_model
-    from ..specification import parse_q
     from ..studies.check import after_run, before_run
     from ..studies.shock import cfc_filter, default_frequencies, srs
     from ..transaction import check_output
 
-    q = parse_q(str(request.q), "--srs-q")  # the one grammar, whoever gave it
-    if not (0 < request.lo < request.hi < float("inf")):
-        raise OptionError(f"--from/--to: found {request.lo:g} and {request.hi:g} Hz, expected "
-                          "0 < FROM < TO")
+    q = request.q  # read by the one grammar when the request was made
     shot = shot_with_law(request.shot, request.crush_law, request.archive)
     if request.output is not None:  # before the run, not after
         check_output(request.output, request.force, inputs=[request.shot])

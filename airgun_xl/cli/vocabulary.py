@@ -38,7 +38,7 @@ class Idea:
 VOCABULARY = {
     "archive folder": Idea("--archive", ("archive", "dir"), aliases=("DIR",),
                            subjects=("archive",)),
-    "SRS quality factor": Idea("--srs-q", ("srs_q",), aliases=("--q",)),
+    "SRS quality factor": Idea("--srs-q", ("srs_q", "q"), aliases=("--q",)),
     "recording's filter": Idea("--cfc", ("cfc",), aliases=("--record",)),
     "recording": Idea("RECORDING", ("recording", "measured")),
     "recording's sign": Idea("--sign", ("sign",)),

@@ -1,0 +1,250 @@
+"""A command declared once (issue 61): a frozen, keyword-only request whose fields carry
+their option.
+
+Each field of a request is a value (a number in its unit, a choice, a path), declared with
+:func:`option` or :func:`positional`: its default, how the command line spells it (flags,
+metavar, help, old spellings) and its grammar, one function ``read(value, who)`` that takes
+what a caller gave (a value, or the text a command line gave) and gives the value, or raises
+the project's :class:`~airgun_xl.errors.OptionError` naming ``who``. From that one
+declaration:
+
+- the request checks itself (:class:`Checked`): each field read in ``__post_init__``, a
+  refusal naming the field as the Python API spells it (``q: found '0', ...``);
+- the CLI builds the command's options, in the fields' order
+  (:func:`airgun_xl.cli.declared.add_declared`), each read with the same grammar, a refusal
+  naming its flag (``--srs-q: found '0', ...``), and the request from the parsed options
+  (:func:`airgun_xl.cli.declared.request_of`);
+- the Python API function's keywords are the request's fields
+  (``tests/test_declared.py`` checks each converted function's signature against them).
+
+The options several commands share are declared once here (:func:`shot`, :func:`output`,
+:func:`force`, :func:`integrator`, :func:`model`, :func:`crush_law`, :func:`archive`).
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, TypeVar
+
+from ..choices import INTEGRATORS, MODELS
+from ..errors import OptionError
+
+#: A field's grammar: (what the caller gave, who gave it) -> the value.
+Read = Callable[[Any, str], Any]
+
+T = TypeVar("T", bound="Checked")
+
+
+@dataclass(frozen=True)
+class Option:
+    """How a field is spelt on the command line.
+
+    Attributes
+    ----------
+    flags : tuple of str
+        Its spellings (``("-o", "--output")``); a positional's is its name alone.
+    help : str
+        Its help line; ``%`` as argparse reads it (``%%`` for a percent sign).
+    metavar : str or None
+        The value's placeholder in the help.
+    kind : str
+        ``"value"`` (given once, its value read by the grammar), ``"switch"`` (present or
+        not), ``"choice"`` (one of ``choices``), ``"cfc"`` (a J211 class or ``none``, told
+        apart from a specification's) or ``"positional"``.
+    choices : tuple of str
+        For a ``"choice"``.
+    aliases : tuple of tuple of str
+        Old spellings kept one release, each ``(flag, idea)`` (the idea as
+        :data:`airgun_xl.cli.vocabulary.VOCABULARY` names it).
+    cli_default : object
+        What the command line stores when the option is not given, when it is not the
+        field's default (``--output``'s None stands for the command's own default name).
+    """
+
+    flags: tuple[str, ...]
+    help: str
+    metavar: str | None = None
+    kind: str = "value"
+    choices: tuple[str, ...] = ()
+    aliases: tuple[tuple[str, str], ...] = ()
+
+
+def _keep(value: Any, who: str) -> Any:
+    return value
+
+
+def option(default: Any, *flags: str, help: str, read: Read = _keep,
+           metavar: str | None = None, kind: str = "value", choices: tuple[str, ...] = (),
+           aliases: tuple[tuple[str, str], ...] = ()) -> Any:
+    """A request's field with a default, spelt ``flags`` on the command line."""
+    return dataclasses.field(default=default, metadata={
+        "option": Option(tuple(flags), help, metavar, kind, choices, aliases), "read": read})
+
+
+def positional(name: str, *, help: str, read: Read = _keep, metavar: str | None = None
+               ) -> Any:
+    """A request's field without a default: the command's positional argument ``name``."""
+    return dataclasses.field(metadata={
+        "option": Option((name,), help, metavar, "positional"), "read": read})
+
+
+def option_of(field: dataclasses.Field[Any]) -> Option:
+    """The command-line spelling a field was declared with."""
+    found = field.metadata.get("option")
+    assert isinstance(found, Option), f"{field.name} was not declared with option()"
+    return found
+
+
+class Checked:
+    """A request that checks itself: each declared field read by its grammar, a refusal
+    naming the field (the Python API's keyword). Its subclasses are frozen, keyword-only
+    dataclasses."""
+
+    @classmethod
+    def given(cls: type[T], **values: Any) -> T:
+        """The request of what a caller gave, each field as the caller gave it (text, a
+        number, a path), read by its grammar: the Python API's one line."""
+        return cls(**values)
+
+    def __post_init__(self) -> None:
+        for field in dataclasses.fields(self):  # type: ignore[arg-type]
+            read = field.metadata.get("read")
+            if read is not None:
+                object.__setattr__(self, field.name, read(getattr(self, field.name),
+                                                          field.name))
+
+
+# -- grammars --------------------------------------------------------------------------
+
+
+def a_path(value: Any, who: str) -> Path:
+    """A path: a ``str`` or ``os.PathLike``, not empty."""
+    if isinstance(value, Path):
+        return value
+    if isinstance(value, str) and value.strip():
+        return Path(value)
+    try:
+        import os
+
+        return Path(os.fspath(value))
+    except TypeError:
+        raise OptionError(f"{who}: found {value!r}, expected a path") from None
+
+
+def a_path_or_none(value: Any, who: str) -> Path | None:
+    return None if value is None else a_path(value, who)
+
+
+def a_number(value: Any, who: str) -> float:
+    """A number, given as one or as text (``"0.95"``); a bool is no number."""
+    if isinstance(value, bool):
+        raise OptionError(f"{who}: found {value!r}, expected a number")
+    try:
+        return float(value if isinstance(value, (int, float)) else str(value))
+    except ValueError:
+        raise OptionError(f"{who}: found {value!r}, expected a number") from None
+
+
+def a_switch(value: Any, who: str) -> bool:
+    """True or False (a switch)."""
+    if not isinstance(value, bool):
+        raise OptionError(f"{who}: found {value!r}, expected True or False")
+    return value
+
+
+def one_of(choices: tuple[str, ...]) -> Read:
+    """One of ``choices``, as text."""
+    def read(value: Any, who: str) -> str:
+        if not isinstance(value, str) or value not in choices:
+            raise OptionError(f"{who}: found {value!r}, expected one of "
+                              f"{', '.join(sorted(choices))}")
+        return value
+    return read
+
+
+def a_law(value: Any, who: str) -> str:
+    """A crush law's name: ``workbook``, ``legacy`` or ``NAME[@N]`` (checked against the
+    archive where it is read)."""
+    if not isinstance(value, str) or not value.strip():
+        raise OptionError(f"{who}: found {value!r}, expected workbook, legacy or a law's "
+                          "NAME or NAME@N")
+    return value
+
+
+def a_cfc(value: Any, who: str) -> int | None:
+    """A SAE J211 class (60, 180, 600, 1000; ``"600"``), or None / ``"none"`` for none."""
+    if value is None:
+        return None
+    from .specifying import cfc_class
+
+    if isinstance(value, bool) or (isinstance(value, float) and not math.isfinite(value)):
+        raise OptionError(f"{who}: found {value!r}, expected a SAE J211 class (60, 180, 600 "
+                          "or 1000) or none")
+    try:
+        return cfc_class(str(value))
+    except ValueError as exc:
+        raise OptionError(f"{who}: {exc}") from None
+
+
+def a_quality_factor(value: Any, who: str) -> float:
+    """The SRS's quality factor (:func:`airgun_xl.specification.parse_q`'s grammar)."""
+    from ..specification import parse_q
+
+    if isinstance(value, bool):
+        raise OptionError(f"{who}: found {value!r}, expected a quality factor")
+    return parse_q(str(value), who)
+
+
+# -- the options several commands share -------------------------------------------------
+
+#: The help of every command's positional shot workbook.
+SHOT_HELP = "the shot's workbook, in the report's layout (.xlsx, .xlsm or .xls)"
+INTEGRATOR_HELP = ("legacy: ArtSim's scheme (the default); newmark: average-acceleration "
+                   "Newmark, unconditionally stable for the OBR chain")
+MODEL_HELP = "4-mass: ArtSim (the default); rigid: the previous rigid-body model"
+CRUSH_LAW_HELP = ("workbook: the law the workbook's Crush law sheet names (a calibrated "
+                  "workbook's fitted law), else the macro's (default); legacy: the macro's "
+                  "polynomial, Eq. (8), whatever the workbook says; NAME or NAME@N: a law of "
+                  "the --archive's library (calibrate --archive --name)")
+ARCHIVE_HELP = ("the archive whose library --crush-law NAME is read from (default: "
+                "$AIRGUN_XL_ARCHIVE when set)")
+
+
+def shot() -> Any:
+    """The shot's workbook (``SHOT.xlsx``)."""
+    return positional("shot", help=SHOT_HELP, metavar="SHOT.xlsx", read=a_path)
+
+
+def output(what: str, default: str, metavar: str = "OUT.xlsx") -> Any:
+    """``-o``/``--output``: ``what`` the file holds; None writes none (the command line
+    gives the command's ``default`` name)."""
+    return option(None, "-o", "--output", help=f"{what} (default: {default})",
+                  metavar=metavar, read=a_path_or_none)
+
+
+def force(metavar: str = "OUT.xlsx") -> Any:
+    """``--force``: overwrite the output."""
+    return option(False, "--force", help=f"overwrite {metavar} if it exists", kind="switch",
+                  read=a_switch)
+
+
+def integrator() -> Any:
+    return option("legacy", "--integrator", help=INTEGRATOR_HELP, kind="choice",
+                  choices=tuple(sorted(INTEGRATORS)), read=one_of(tuple(INTEGRATORS)))
+
+
+def model() -> Any:
+    return option("4-mass", "--model", help=MODEL_HELP, kind="choice",
+                  choices=tuple(MODELS), read=one_of(tuple(MODELS)))
+
+
+def crush_law() -> Any:
+    return option("workbook", "--crush-law", help=CRUSH_LAW_HELP, metavar="LAW", read=a_law)
+
+
+def archive() -> Any:
+    """``--archive DIR``, where a library law is read from (None: $AIRGUN_XL_ARCHIVE)."""
+    return option(None, "--archive", help=ARCHIVE_HELP, metavar="DIR", read=a_path_or_none)

@@ -1,0 +1,67 @@
+"""A command's options built from its request's declaration (issue 61;
+:mod:`airgun_xl.app.declared`): one ``add_argument`` a field, in the fields' order, its value
+read by the field's own grammar naming the flag; and the request from what was parsed."""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+from typing import Any
+
+from ..app.declared import option_of
+from ..errors import OptionError
+from .recording_options import CfcOption
+from .vocabulary import Alias, One
+
+
+def _typed(read: Any, flag: str) -> Any:
+    """argparse's ``type``: the field's grammar, a refusal naming ``flag``."""
+    def parse(text: str) -> Any:
+        return read(text, flag)
+    parse.__name__ = flag.lstrip("-").replace("-", "_")  # argparse names it in its messages
+    return parse
+
+
+def add_declared(parser: argparse.ArgumentParser, request: type, skip: tuple[str, ...] = ()
+                 ) -> None:
+    """Each field of the dataclass ``request`` (but ``skip``) as ``parser``'s argument."""
+    for field in dataclasses.fields(request):
+        if field.name in skip:
+            continue
+        spelt = option_of(field)
+        read = field.metadata["read"]
+        flag = spelt.flags[-1]
+        if spelt.kind == "positional":
+            parser.add_argument(field.name, metavar=spelt.metavar, help=spelt.help)
+        elif spelt.kind == "switch":
+            parser.add_argument(*spelt.flags, action="store_true", help=spelt.help)
+        elif spelt.kind == "choice":
+            parser.add_argument(*spelt.flags, choices=spelt.choices, default=field.default,
+                                help=spelt.help)
+        elif spelt.kind == "cfc":
+            parser.add_argument(*spelt.flags, type=_typed(read, flag), default=field.default,
+                                metavar=spelt.metavar, action=CfcOption, help=spelt.help)
+        else:
+            parser.add_argument(*spelt.flags, type=_typed(read, flag), default=field.default,
+                                metavar=spelt.metavar, action=One, help=spelt.help,
+                                dest=field.name)
+        for alias, idea in spelt.aliases:
+            parser.add_argument(alias, type=_typed(read, alias), dest=field.name,
+                                metavar=spelt.metavar, action=Alias, idea=idea)
+
+
+def request_of(request: type, args: argparse.Namespace, **given: Any) -> Any:
+    """The ``request`` of the parsed ``args`` (each field from its own dest; ``given``
+    overrides, such as an output's default name); a refusal of the request's own checks
+    names the field's flag, as every command-line refusal does."""
+    fields = dataclasses.fields(request)
+    values = {f.name: given[f.name] if f.name in given else getattr(args, f.name)
+              for f in fields}
+    try:
+        return request(**values)
+    except OptionError as exc:  # "q: ..." or, of two fields together, "lo/hi: ..."
+        prefix, colon, rest = str(exc).partition(": ")
+        flags = {f.name: option_of(f).flags[-1] for f in fields}
+        names = prefix.split("/")
+        if colon and all(name in flags for name in names):
+            raise OptionError("/".join(flags[n] for n in names) + ": " + rest) from None
+        raise
