@@ -393,11 +393,9 @@ def check(shot: str | os.PathLike[str], *, integrator: str = "legacy") -> CheckO
     AirgunXlError
         A bad workbook or cell, named.
     """
-    from pathlib import Path
-
     from .app.check import CheckRequest, run
 
-    return run(CheckRequest(Path(shot), integrator))
+    return run(CheckRequest.given(shot=shot, integrator=integrator))
 
 
 @_paths_checked

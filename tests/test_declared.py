@@ -14,13 +14,14 @@ import pytest
 from conftest import TEMPLATE
 
 import airgun_xl
+from airgun_xl.app.check import CheckRequest
 from airgun_xl.app.declared import option_of
 from airgun_xl.app.srs import SrsRequest
 from airgun_xl.cli.commands import build_parser
 from airgun_xl.errors import OptionError
 
 #: The commands declared once so far: (command, API function, request).
-DECLARED = [("srs", airgun_xl.srs, SrsRequest)]
+DECLARED = [("srs", airgun_xl.srs, SrsRequest), ("check", airgun_xl.check, CheckRequest)]
 
 
 def _subparser(command):
@@ -94,6 +95,14 @@ def test_a_request_checks_itself_naming_the_keyword(keyword, value, said):
     with pytest.raises(OptionError) as caught:
         SrsRequest.given(**given)
     assert str(caught.value).startswith(said), caught.value
+
+
+def test_check_refuses_an_integrator_that_does_not_exist():
+    """The issue's case: ``check(integrator="rk4")`` answered about a scheme that does not
+    exist; it is refused naming the keyword, the command naming its option (argparse's)."""
+    with pytest.raises(OptionError, match=r"^integrator: found 'rk4', expected one of "
+                                          r"legacy, newmark$"):
+        airgun_xl.check(TEMPLATE, integrator="rk4")
 
 
 def test_a_request_is_keyword_only_and_frozen():

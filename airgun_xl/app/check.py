@@ -9,11 +9,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from . import declared
 
-@dataclass(frozen=True)
-class CheckRequest:
-    shot: Path
-    integrator: str = "legacy"
+
+@dataclass(frozen=True, kw_only=True)
+class CheckRequest(declared.Checked):
+    """The shot and the scheme whose critical step is predicted. Declared once
+    (:mod:`.declared`): the command's options and the API's keywords."""
+
+    shot: Path = declared.shot("workbook in the report's layout")
+    integrator: str = declared.integrator()
 
 
 @dataclass(frozen=True)

@@ -213,9 +213,9 @@ ARCHIVE_HELP = ("the archive whose library --crush-law NAME is read from (defaul
                 "$AIRGUN_XL_ARCHIVE when set)")
 
 
-def shot() -> Any:
+def shot(help: str = SHOT_HELP) -> Any:
     """The shot's workbook (``SHOT.xlsx``)."""
-    return positional("shot", help=SHOT_HELP, metavar="SHOT.xlsx", read=a_path)
+    return positional("shot", help=help, metavar="SHOT.xlsx", read=a_path)
 
 
 def output(what: str, default: str, metavar: str = "OUT.xlsx") -> Any:
