@@ -153,6 +153,14 @@ def test_a_corridor_and_an_srs_requirement_are_on_the_pdf(tmp_path):
     flat = " ".join(_text(pdf).split())
     assert re.search(r"corridor \S+ % the record inside the band", flat), flat
     assert re.search(r"\bSRS \S+ dB -40 to 40 dB ", flat), flat
+    # each criterion's detail under the table, as the terminal and the workbook say it
+    # (issue 63: an SRS failure located by its frequencies, not its worst figure alone)
+    outcome = airgun_xl.accept(shot, TEMPLATE.parent / "shot_a_recording.csv", sign=-1,
+                               cfc=1000, profile="mil-std-810h-half-sine", peak="9.5kG",
+                               duration="5ms", srs=str(requirement), srs_tol="-40dB,+40dB")
+    for c in outcome.criteria:
+        if c.detail:
+            assert f"- {c.name}: " + " ".join(c.detail.split()) in flat, (c.name, c.detail)
     rows = _rows_of_colour(pdf, tmp_path, (156, 0, 6), 50)
     assert np.any(rows < 0.4) and np.any((rows > 0.4) & (rows < 0.68))  # corridor, SRS
 

@@ -180,6 +180,13 @@ def _text_pages(pages: _Pages, verdict: Any, about: list[tuple[str, str]],
     rows, colours = _criteria_rows(verdict)
     pages.table(["Criterion", "Value", "Unit", "Limits", "Margin", "Result"], rows,
                 [0.0, 0.17, 0.29, 0.37, 0.67, 0.80], colours)
+    # where each was judged and, for a failure, where it failed: the SRS's frequencies
+    # outside their band with their excess, the corridor's worst instant (as the terminal and
+    # the workbook say it; the table alone gave only the worst figure)
+    for c in verdict.criteria:
+        if c.detail:
+            pages.text(f"- {c.name}: {c.detail}", indent=0.02,
+                       colour="black" if c.passed else FAIL_COLOUR)
     pages.gap()
     pages.text(f"Warnings ({len(warnings)})" if warnings else "Warnings: none", size=11,
                bold=True, colour=FAIL_COLOUR if warnings else "black")
