@@ -225,6 +225,36 @@ def test_accept_passes_exit_0_and_fails_exit_3(tmp_path, recording, capsys):
     assert "FAIL  peak: " in capsys.readouterr().out
 
 
+def test_the_verdict_sheet_holds_each_detail_whole_and_a_signature_block(tmp_path, recording):
+    """Issue 63: an SRS failing at many frequencies names them all in its Detail cell, and
+    the row is as tall as its wrapped lines (it printed over the "Overall" row); the sheet
+    ends with the test engineer's block, a line to fill by hand for each of the name, the
+    signature and the date, as the PDF's."""
+    from airgun_xl.reports.acceptance import DETAIL_CHARS
+    from airgun_xl.xlsx.report import SIGNATURE_LINES
+
+    requirement = tmp_path / "req.csv"
+    requirement.write_text("frequency [Hz],srs [g]\n200,10\n300,30\n1000,100\n3000,300\n")
+    out = tmp_path / "srs.xlsx"
+    assert main(["accept", str(TEMPLATE), str(recording), "--sign", "-1", "--cfc", "1000",
+                 "--peak", "9.5kG:10%", "--srs", str(requirement), "--srs-tol", "-3dB,+3dB",
+                 "-o", str(out), "--quiet"]) == 3
+    ws = openpyxl.load_workbook(out)["Verdict"]
+    rows = {ws.cell(r, 1).value: r for r in range(1, ws.max_row + 1) if ws.cell(r, 1).value}
+    srs_row = rows["SRS"]
+    detail = ws.cell(srs_row, 8).value
+    assert detail.count(" Hz (+") >= 2 and len(detail) > DETAIL_CHARS, detail
+    lines = math.ceil(len(detail) / DETAIL_CHARS)
+    assert ws.row_dimensions[srs_row].height == 15 * lines
+    assert ws.cell(srs_row, 8).alignment.wrap_text
+    engineer = rows["Test engineer"]
+    assert engineer > rows["Overall"]
+    assert [ws.cell(engineer + 2 * (k + 1), 1).value for k in range(3)] == [
+        f"{label}:" for label in SIGNATURE_LINES]
+    assert all(ws.cell(engineer + 2, col).border.bottom.style == "thin" for col in (2, 3, 4))
+    assert ws.print_area and str(engineer + 6) in str(ws.print_area)  # printed with the page
+
+
 def test_accept_refuses_a_shot_without_a_specification(tmp_path, recording, capsys):
     out = tmp_path / "none.xlsx"
     assert main(["accept", str(TEMPLATE), str(recording), "--sign", "-1", "-o",

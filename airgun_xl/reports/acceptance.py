@@ -2,13 +2,15 @@
 between its tolerance lines, each on one printed page; the data sheets behind the charts."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..engine.decimate import minmax_indices
 from ..units import G_PER_KG
 from ..xlsx.charts import POINT_BUDGET, line_series, log_axis, nice_range, titled
 from ..xlsx.columns_sheet import ColumnsWorksheet
-from ..xlsx.report import Style, axis, chart_size, one_page, report_workbook
+from ..xlsx.report import SIGNATURE_LINES, Style, axis, chart_size, one_page, report_workbook
 from ..xlsx.sheets import write_about, write_data_sheet, write_warnings, write_wrapped
 
 RECORD, IDEAL, LIMIT, REQUIRED = "#c00000", "#1f4e79", "#7f7f7f", "#000000"
@@ -18,6 +20,10 @@ VERDICT_COLS, CHART_COLS = 8, 14
 
 #: Characters a wrapped line of the Verdict page holds across its printed columns.
 VERDICT_LINE_CHARS = 160
+
+
+#: Characters a line of the Detail column (H, 60 wide) holds.
+DETAIL_CHARS = 58
 
 
 def write_verdict_table(wb, ws, verdict, row, bold):
@@ -55,6 +61,8 @@ def write_verdict_table(wb, ws, verdict, row, bold):
             ws.write_string(row, 5, "none")
         ws.write_string(row, 6, "PASS" if c.passed else "FAIL", good if c.passed else bad)
         ws.write_string(row, 7, c.detail, wrap)
+        if len(c.detail) > DETAIL_CHARS:  # as tall as its lines: it printed over the rows below
+            ws.set_row(row, 15 * math.ceil(len(c.detail) / DETAIL_CHARS))
         row += 1
     ws.write_string(row, 0, "Overall")
     ws.write_string(row, 6, verdict.word, good if verdict.passed else bad)
@@ -71,6 +79,19 @@ def write_verdict_table(wb, ws, verdict, row, bold):
         ws.write_string(row + 1, 0, "Notes of the profile", bold)
         row = write_wrapped(wb, ws, row + 2, list(verdict.spec.notes), VERDICT_COLS - 1,
                             VERDICT_LINE_CHARS)
+    return row
+
+
+def write_signature(wb, ws, row, bold):
+    """The test engineer's block from ``row``: a line to fill by hand for each of
+    :data:`SIGNATURE_LINES` (a verdict a client signs; issue 63); the last row written."""
+    line = wb.add_format({"bottom": 1})
+    ws.write_string(row, 0, "Test engineer", bold)
+    for label in SIGNATURE_LINES:
+        row += 2
+        ws.write_string(row, 0, f"{label}:")
+        for col in range(1, 4):
+            ws.write_blank(row, col, None, line)
     return row
 
 
@@ -168,6 +189,7 @@ def write_acceptance(path, verdict, about, pulse, spectra, force=False, shot=Non
             row = write_recording_block(wb, ws, verdict, row + 1, bold)
         row = write_warnings(wb, ws, row + 1, verdict.warnings, VERDICT_COLS - 1,
                              line_chars=160)
+        row = write_signature(wb, ws, row + 2, bold)
         one_page(ws, row, VERDICT_COLS - 1, shot=shot, title="Verdict")
 
         # a long record (2,000,000 samples) is charted by its every bucket's min and max:

@@ -210,7 +210,9 @@ def _text_pages(pages: _Pages, verdict: Any, about: list[tuple[str, str]],
     pages.room(LINE * 10)  # the block whole on one page: its title and three lines
     pages.text("Test engineer", size=11, bold=True)
     pages.gap(1.2)
-    for label in ("Name", "Signature", "Date"):
+    from ..xlsx.report import SIGNATURE_LINES
+
+    for label in SIGNATURE_LINES:
         pages.room(LINE * 2.4)
         pages.figure.text(LEFT, pages.y, f"{label}:", fontsize=9, va="top",
                           parse_math=False)

@@ -165,6 +165,11 @@ def _header_text(text):
     return text.replace("&", "&&")
 
 
+#: The lines of a report's signature block, to fill by hand (the accept workbook's Verdict
+#: sheet and the PDF report: a verdict a client signs).
+SIGNATURE_LINES = ("Name", "Signature", "Date")
+
+
 def one_page(ws, last_row, last_col, first_row=0, first_col=0, landscape=True, shot=None,
              title=None, report=True):
     """Print ``ws``'s range (0-based, inclusive) on one A4 page: a header with ``shot`` (the
