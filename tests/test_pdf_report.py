@@ -166,6 +166,42 @@ def test_a_corridor_and_an_srs_requirement_are_on_the_pdf(tmp_path):
 
 
 @needs_poppler
+@pytest.mark.parametrize("peak,unit", [("9300g:10%", "g"), ("9.5kG:10%", "kG"),
+                                       (None, "g")])
+def test_the_charts_are_in_the_clients_unit(peak, unit, tmp_path):
+    """Issue 63: the pulse and the SRS are drawn in the unit the specification's peak was
+    given in (a client who writes g reads g); with an SRS requirement and no peak, in g, as
+    the workbook's SRS chart; the pseudo-velocity in m/s."""
+    from airgun_xl.reports.pdf_report import chart_unit
+    from airgun_xl.specification import Specification
+    from airgun_xl.units import G_PER_KG
+
+    requirement = tmp_path / "req.csv"
+    requirement.write_text("frequency [Hz],srs [g]\n200,150\n1000,1500\n4000,6000\n")
+    pdf = tmp_path / "unit.pdf"
+    shot = tmp_path / "shot.xlsx"
+    shot.write_bytes(TEMPLATE.read_bytes())
+    given = ["--peak", peak] if peak else []
+    code = main(["accept", str(shot), str(TEMPLATE.parent / "shot_a_recording.csv"),
+                 "--sign", "-1", "--cfc", "1000", *given, "--srs", str(requirement),
+                 "--srs-tol", "-40dB,+40dB", "--pdf", str(pdf), "--reproducible", "--quiet"])
+    assert code in (0, 3) and pdf.is_file()
+    flat = " ".join(_text(pdf).split())
+    assert flat.count(f"Acceleration ({unit})") == 2, flat  # the pulse's axis and the SRS's
+    other = {"g", "kG"} - {unit}
+    assert not any(f"Acceleration ({o})" in flat for o in other)
+    assert "Velocity (m/s)" in flat
+    # each source line once: "How it was judged" repeated the sources' lines
+    outcome = airgun_xl.accept(shot, TEMPLATE.parent / "shot_a_recording.csv", sign=-1,
+                               cfc=1000, srs=str(requirement), srs_tol="-40dB,+40dB",
+                               **({"peak": peak} if peak else {}))
+    for line in outcome.verdict.sources():
+        assert flat.count(" ".join(line.split())) == 1, line
+    assert chart_unit(Specification()) == ("kG", 1.0)
+    assert chart_unit(Specification(units=(("peak", "g"),))) == ("g", pytest.approx(G_PER_KG))
+
+
+@needs_poppler
 def test_a_fills_pdf_holds_the_summarys_figures_the_verdict_and_the_charts(tmp_path):
     """fill --pdf: the Summary's figures as the sheet shows them (its number format: 11.994
     kG, 0.2885 ms...), the predicted verdict's criteria, the warnings (none here), and a

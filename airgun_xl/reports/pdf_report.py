@@ -200,11 +200,13 @@ def _text_pages(pages: _Pages, verdict: Any, about: list[tuple[str, str]],
             pages.text(f"{label}: {text}", indent=0.02)
     pages.gap()
     pages.text("How it was judged", size=11, bold=True)
+    sources = verdict.sources()
     for line in verdict.definitions:
-        pages.text(f"- {line}", indent=0.02)
+        if line not in sources:  # said once, under the sources (issue 63)
+            pages.text(f"- {line}", indent=0.02)
     pages.gap()
     pages.text("The specification's sources", size=11, bold=True)
-    for line in verdict.sources():
+    for line in sources:
         pages.text(f"- {line}", indent=0.02)
     pages.gap(1.5)
     pages.room(LINE * 10)  # the block whole on one page: its title and three lines
@@ -230,6 +232,21 @@ def _two_and_five(value: float, _position: object) -> str:
     return f"{value:g}" if any(abs(mantissa - m) < 1e-6 for m in (2.0, 5.0)) else ""
 
 
+def chart_unit(spec: Any) -> tuple[str, float]:
+    """(unit, factor from kG) the charts show accelerations in: the client's (issue 63): the
+    unit the specification's peak was given in; g for an SRS requirement without a peak (its
+    rows are read as the spectra a client writes, and the workbook's SRS chart is in g); kG
+    when neither says."""
+    from ..specification import shown_unit
+    from ..units import G_PER_KG
+
+    if dict(spec.units).get("peak"):
+        return shown_unit(spec, "peak")
+    if spec.srs is not None:
+        return "g", G_PER_KG
+    return "kG", 1.0
+
+
 def _chart_page(pages: _Pages, verdict: Any, pulse: dict[str, Any],
                 spectra: dict[str, Any]) -> None:
     """The pulse with its limits, the SRS and the pseudo-velocity: one page."""
@@ -237,37 +254,42 @@ def _chart_page(pages: _Pages, verdict: Any, pulse: dict[str, Any],
 
     pages.new()
     fig = pages.figure
+    unit, factor = chart_unit(verdict.spec)
     t_ms = np.asarray(pulse["time"]) * 1e3
     ax = fig.add_axes((LEFT + 0.03, 0.62, RIGHT - LEFT - 0.03, 0.28))
-    ax.plot(t_ms, pulse["kg"], color="#1f4e79", linewidth=0.8, label="Record judged")
+    ax.plot(t_ms, np.asarray(pulse["kg"]) * factor, color="#1f4e79", linewidth=0.8,
+            label="Record judged")
     if "upper" in pulse:
-        ax.plot(t_ms, pulse["ideal"], color="#7f7f7f", linewidth=0.8, linestyle="--",
-                label="Ideal pulse")
-        ax.plot(t_ms, pulse["upper"], color=FAIL_COLOUR, linewidth=0.8, label="Corridor")
-        ax.plot(t_ms, pulse["lower"], color=FAIL_COLOUR, linewidth=0.8)
+        ax.plot(t_ms, np.asarray(pulse["ideal"]) * factor, color="#7f7f7f", linewidth=0.8,
+                linestyle="--", label="Ideal pulse")
+        ax.plot(t_ms, np.asarray(pulse["upper"]) * factor, color=FAIL_COLOUR, linewidth=0.8,
+                label="Corridor")
+        ax.plot(t_ms, np.asarray(pulse["lower"]) * factor, color=FAIL_COLOUR, linewidth=0.8)
     elif verdict.spec.peak is not None:
         lo, hi = verdict.spec.peak.limits
-        ax.axhspan(lo, hi, color="#c6efce", alpha=0.6, label="Peak's limits")
+        ax.axhspan(lo * factor, hi * factor, color="#c6efce", alpha=0.6,
+                   label="Peak's limits")
     ax.set_xlabel("Time (ms)")
-    ax.set_ylabel("Acceleration (kG)")
+    ax.set_ylabel(f"Acceleration ({unit})")
     ax.set_title("The record judged", fontsize=10)
     ax.grid(True, color="#d9d9d9", linewidth=0.5)
     ax.legend(fontsize=7, loc="upper right")
     f = np.asarray(spectra["frequencies"])
-    for k, (key, title, unit) in enumerate((("srs", f"SRS (maximax, Q = {spectra['q']:g})",
-                                             "Acceleration (kG)"),
-                                            ("pv", "Pseudo-velocity", "Velocity (m/s)"))):
+    for k, (key, title, label, scale_by) in enumerate((
+            ("srs", f"SRS (maximax, Q = {spectra['q']:g})", f"Acceleration ({unit})", factor),
+            ("pv", "Pseudo-velocity", "Velocity (m/s)", 1.0))):
         ax = fig.add_axes((LEFT + 0.03, 0.36 - k * 0.27, RIGHT - LEFT - 0.03, 0.2))
-        ax.loglog(f, spectra[key], color="#1f4e79", linewidth=0.9, label=title)
+        ax.loglog(f, np.asarray(spectra[key]) * scale_by, color="#1f4e79", linewidth=0.9,
+                  label=title)
         if key == "srs" and "required" in spectra:
-            ax.loglog(f, spectra["required"], color="black", linewidth=0.8,
-                      label="Required")
-            ax.loglog(f, spectra["lower"], color=FAIL_COLOUR, linewidth=0.6,
-                      linestyle="--", label="Tolerance")
-            ax.loglog(f, spectra["upper"], color=FAIL_COLOUR, linewidth=0.6,
-                      linestyle="--")
+            ax.loglog(f, np.asarray(spectra["required"]) * factor, color="black",
+                      linewidth=0.8, label="Required")
+            ax.loglog(f, np.asarray(spectra["lower"]) * factor, color=FAIL_COLOUR,
+                      linewidth=0.6, linestyle="--", label="Tolerance")
+            ax.loglog(f, np.asarray(spectra["upper"]) * factor, color=FAIL_COLOUR,
+                      linewidth=0.6, linestyle="--")
         ax.set_xlabel("Frequency (Hz)")
-        ax.set_ylabel(unit)
+        ax.set_ylabel(label)
         for scale, (lo, hi) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
             # plain numbers (100, 1000), not powers of ten; over less than two decades the
             # minor ticks at 2 and 5 are labelled too, or the axis would show one number
