@@ -226,6 +226,15 @@ def test_a_fills_pdf_holds_the_summarys_figures_the_verdict_and_the_charts(tmp_p
     # the record judged (the default low-pass at 6/D) peaks at 8.4573 kG; the raw 11.994 kG
     # is on the Summary as the model's
     assert re.search(r"peak 8\.4573 kG 7\.65 to 9\.35 kG \+9\.50 % PASS", flat), flat
+    # the shot's inputs, every cell the run read (issue 63: a client reads the velocity, the
+    # masses and the mitigator beside the figures), each as the Parameters sheet holds it
+    params = airgun_xl.load(TEMPLATE).params
+    from airgun_xl.xlsx.sheets import parameter_rows
+
+    for cell, label, value, unit, _meaning in parameter_rows(params):
+        shown = "blank" if value is None else f"{value:.7g}"
+        assert f"{cell} {' '.join(label.split())} {shown} {unit}" in flat, (cell, label)
+    assert "A28 " in flat and f"{params.v31:.7g} m/s" in flat
     rows = _rows_of_colour(tmp_path / "f0.pdf", tmp_path, (31, 78, 121), 40)
     for lo, hi in ((0.1, 0.35), (0.38, 0.62), (0.66, 0.92)):  # the three rows of charts
         assert np.any((rows > lo) & (rows < hi)), (lo, hi)

@@ -353,7 +353,7 @@ def _write_pdf(shot: Shot, filled: Filled, path: Path, info: Provenance, options
     from ..reports.pdf_report import summary_text, write_fill_pdf
     from ..untrusted_json import printable
     from ..xlsx.charts import CHARTS, series_data, spectrum_range
-    from ..xlsx.sheets import flagged_figures
+    from ..xlsx.sheets import flagged_figures, parameter_rows
 
     result = filled.result
     summary = filled.summary if filled.summary is not None else summarize(result)
@@ -368,11 +368,14 @@ def _write_pdf(shot: Shot, filled: Filled, path: Path, info: Provenance, options
                else (0.0, end))
               for spec in CHARTS if any(s.key in data for s in spec.series)]
     source = filled.verdict.spec.source if filled.verdict is not None else ""
+    inputs = [(cell, printable(label), "blank" if value is None else f"{value:.7g}", unit)
+              for cell, label, value, unit, _meaning in parameter_rows(result.params)]
     write_fill_pdf(path, rows, filled.verdict, [printable(w) for w in record], charts,
                    (f"Shot: {printable(name)}", f"{result.model} model, {result.integrator} "
                     "integrator", f"Specification: {printable(source or 'none given')}"),
                    options.reproducible, tuple(printable(n) for n in options.study_notes),
-                   tuple(flagged_figures(record).get("Peak acceleration (raw)", [])))
+                   tuple(flagged_figures(record).get("Peak acceleration (raw)", [])),
+                   inputs)
 
 
 # -- the command -------------------------------------------------------------------------

@@ -425,11 +425,13 @@ def write_fill_pdf(path: str | Path, rows: list[tuple[str, str, str, str]],
                    verdict: Any, warnings: list[str],
                    charts: list[tuple[Any, dict[str, Any], tuple[float, float]]],
                    heading: tuple[str, str, str], reproducible: bool = False,
-                   notes: tuple[str, ...] = (), doubted: tuple[str, ...] = ()) -> None:
+                   notes: tuple[str, ...] = (), doubted: tuple[str, ...] = (),
+                   inputs: Sequence[tuple[str, str, str, str]] = ()) -> None:
     """A fill's report at ``path``: ``rows`` the Summary's (quantity, value as shown, unit,
     definition), the predicted ``verdict`` (or None; ``doubted`` the cells whose warnings
     put it in doubt), what the study behind the shot found (``notes``: a design's, the
-    closed loop's P(PASS)), the warnings, and ``charts``
+    closed loop's P(PASS)), the warnings, the shot's ``inputs`` (cell, quantity, value as
+    shown, unit: the velocity, the masses, the mitigator; issue 63) and ``charts``
     (:class:`~airgun_xl.xlsx.charts.ChartSpec`, its series' data, its x range)."""
     import matplotlib
 
@@ -462,6 +464,11 @@ def write_fill_pdf(path: str | Path, rows: list[tuple[str, str, str, str]],
         pages.text("Summary", size=11, bold=True)
         pages.table(["Quantity", "Value", "Unit", "Definition"],
                     [list(r) for r in rows], [0.0, 0.33, 0.47, 0.54])
+        if inputs:
+            pages.gap()
+            pages.text("The shot's inputs (the cells the run read)", size=11, bold=True)
+            pages.table(["Cell", "Quantity", "Value", "Unit"], [list(r) for r in inputs],
+                        [0.0, 0.08, 0.5, 0.66])
         _fill_charts(pages, charts)
         _save(path, pages, heading, date, f"Shot report: {heading[0]}")
 

@@ -430,12 +430,26 @@ def write_wrapped(wb, ws, row, lines, last_col, line_chars=WARNING_LINE_CHARS):
     return row + len(lines)
 
 
+def parameter_rows(params):
+    """[(cell, quantity, value or None when blank, unit, meaning)] of every cell the macro
+    reads (:data:`airgun_xl.cells.CELLS`), as the run used them: the Parameters sheet's
+    rows and the fill's PDF's list of the shot's inputs."""
+    from ..cells import CELLS
+
+    rows = []
+    for cell in CELLS:
+        value = getattr(params, cell.name, None)
+        number = (float(value) if isinstance(value, (int, float)) and not isinstance(value, bool)
+                  else None)
+        rows.append((cell.address, cell.label, number, cell.unit.replace("^3", "³") or "-",
+                     cell.meaning))
+    return rows
+
+
 def write_parameters(wb, params, shot, name="Parameters"):
     """The Parameters sheet: every cell the macro reads (:data:`airgun_xl.cells.CELLS`), its
     quantity, the value the run used (exact, shown to 7 significant digits), its unit and
     meaning; printed as one landscape page. Sheet 1 keeps the input's layout as data."""
-    from ..cells import CELLS
-
     ws = wb.add_worksheet(name)
     style = Style(wb)
     widths = (7, 30, 16, 8, 70)
@@ -446,17 +460,16 @@ def write_parameters(wb, params, shot, name="Parameters"):
     for col, heading in enumerate(("Cell", "Quantity", "Value", "Unit", "Meaning")):
         ws.write_string(2, col, heading, style.header)
     row = 3
-    for cell in CELLS:
-        value = getattr(params, cell.name, None)
-        ws.write_string(row, 0, cell.address)
-        ws.write_string(row, 1, cell.label)
-        if isinstance(value, (int, float)) and not isinstance(value, bool):
-            ws.write_number(row, 2, float(value),
+    for address_, label, value, unit, meaning in parameter_rows(params):
+        ws.write_string(row, 0, address_)
+        ws.write_string(row, 1, label)
+        if value is not None:
+            ws.write_number(row, 2, value,
                             style.fmt(general_format([value], digits=7), align="right"))
         else:
             ws.write_string(row, 2, "blank", style.get(align="right"))
-        ws.write_string(row, 3, cell.unit.replace("^3", "³") or "-")
-        ws.write_string(row, 4, cell.meaning)
+        ws.write_string(row, 3, unit)
+        ws.write_string(row, 4, meaning)
         row += 1
     law = params.crush_law
     ws.write_string(row + 1, 1, "Crush-factor law")
