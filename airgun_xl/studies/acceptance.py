@@ -470,9 +470,18 @@ def judge_rows(t: np.ndarray, kg: np.ndarray, spec: Specification, refine: bool 
         inside = (t[None, :] >= m_lo[:, None]) & (t[None, :] <= m_hi[:, None])
         upper, lower = corridor_limits(spec, t[None, :] - onset[:, None])
         room = np.minimum(upper - kg, kg - lower)
-        margin = np.min(np.where(inside, room, np.inf), axis=1) / _nominals(spec)[0]
+        where = np.where(inside, room, np.inf)
+        worst = np.argmin(where, axis=1)
+        margin = where[np.arange(len(worst)), worst] / _nominals(spec)[0]
         judged = pulse_in & (m_lo >= lo_t - dt) & (m_hi <= hi_t + dt)
         out["corridor"] = np.where(judged, margin, np.nan)
+        # where the record comes nearest a limit (or passes it furthest), and which: +1 the
+        # upper, -1 the lower (a failure located, issue 63)
+        ahead = (np.broadcast_to(upper - kg, room.shape)[np.arange(len(worst)), worst]
+                 <= np.broadcast_to(kg - lower, room.shape)[np.arange(len(worst)), worst])
+        out["corridor at"] = np.where(judged, np.broadcast_to(t, room.shape)[
+            np.arange(len(worst)), worst], np.nan)
+        out["corridor side"] = np.where(ahead, 1.0, -1.0)
     return out
 
 
@@ -593,11 +602,16 @@ def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
         margin = float(row["corridor"])
         decay = (f", decay allowed 0 to {spec.decay:.0%} of D" if spec.shape == "sawtooth"
                  else "")
+        at = float(row["corridor at"])
+        side = "upper" if row["corridor side"] > 0 else "lower"
+        located = ("" if not math.isfinite(at) else
+                   f"; {'outside' if margin < 0 else 'nearest'} its {side} limit at "
+                   f"{at * 1e3:.4f} ms, by {abs(margin):.2%} of the nominal peak")
         criteria.append(Criterion("corridor", 100 * margin, "%", 0.0, None,
                                   100 * margin, "%", margin >= 0,
                                   f"±{spec.corridor:.0%} of {_shown_peak(spec)}, time "
                                   f"slack ±{spec.time_slack:.0%}, placed by "
-                                  f"{spec.placement}{decay}"))
+                                  f"{spec.placement}{decay}{located}"))
         definitions.append(f"corridor: the ideal {spec.shape} starts at "
                            f"{row['onset'] * 1e3:.4f} ms ({spec.placement}); monitored from "
                            f"{m_lo * 1e3:.4f} to {m_hi * 1e3:.4f} ms "
