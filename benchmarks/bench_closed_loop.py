@@ -51,6 +51,7 @@ from bench_fill import TEMPLATE, machine
 import airgun_xl
 from airgun_xl.app.specifying import keyword_fields, resolve
 from airgun_xl.crush_law import CRUSH_FIT_RANGE, LEGACY_LAW, crush_factor
+from airgun_xl.errors import AirgunXlError
 from airgun_xl.studies.acceptance import judge_record
 from airgun_xl.studies.calibrate import _chebyshev_nodes, law_through
 from airgun_xl.studies.closed_loop import brier, reliability
@@ -126,6 +127,10 @@ def by_hand(lot, law, first, work, draws):
     return MOST_SHOTS + 1
 
 
+#: The lots next refused (lot, shot, the refusal): counted as never passed by next.
+REFUSED: list[tuple[int, int, str]] = []
+
+
 def with_next(lot, law, first, work, draws, n_draws, calls, vary=None, gun=None):
     """Shots to the first PASS by next; each (predicted P(PASS), passed) of a proposal
     fired. With ``gun``, every lot in one archive (``work``'s parent's) and the gun's
@@ -137,11 +142,15 @@ def with_next(lot, law, first, work, draws, n_draws, calls, vary=None, gun=None)
     for k in range(MOST_SHOTS):
         rec = fire(shot, law, draws[k], work / f"next{k}.csv")
         started = time.perf_counter()
-        out = airgun_xl.next_shot(shot, rec, archive=archive, lot=f"LOT-{lot}",
-                                  new_lot=k == 0, sd=[f"A28={GUN:.1%}", f"E43={ZETA:.0%}"],
-                                  shots=n_draws, seed=lot * 10 + k,
-                                  output=work / f"next{k + 1}.xlsx", vary=vary, gun=gun,
-                                  **SPEC)
+        try:
+            out = airgun_xl.next_shot(shot, rec, archive=archive, lot=f"LOT-{lot}",
+                                      new_lot=k == 0, sd=[f"A28={GUN:.1%}", f"E43={ZETA:.0%}"],
+                                      shots=n_draws, seed=lot * 10 + k,
+                                      output=work / f"next{k + 1}.xlsx", vary=vary, gun=gun,
+                                      **SPEC)
+        except AirgunXlError as exc:  # next refuses the lot (a law the model cannot fit):
+            REFUSED.append((lot, k + 1, str(exc)))  # the lab takes it by hand from here
+            return MOST_SHOTS + 1, record
         calls.append((time.perf_counter() - started, out.gun, out.update))
         if predicted is not None:
             record.append((predicted, out.verdict.passed))
@@ -337,6 +346,10 @@ def main():
     widths = [max(len(r[i]) for r in rows) for i in range(6)]
     for r in rows:
         print("  ".join(cell.ljust(w) for cell, w in zip(r, widths, strict=True)))
+    if REFUSED:
+        lot, k, why = REFUSED[0]
+        print(f"\nnext refused {len(REFUSED)} lot(s) (counted as never passed by next); the "
+              f"first, lot {lot} at its shot {k}: {why}")
     updates = [u for _, _, u in calls]
     print(f"\nthe law's updates: {sum(not u.tilted for u in updates)} a scale, "
           f"{sum(u.tilted and not u.is_whole for u in updates)} a scale and tilt "
