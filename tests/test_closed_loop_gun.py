@@ -8,6 +8,7 @@ lot's 8 shots give.
 """
 import hashlib
 import json
+import math
 
 import numpy as np
 import openpyxl
@@ -183,7 +184,14 @@ def test_next_with_a_gun_draws_the_scatter_its_lots_estimate_and_keeps_its_own(
                                  output=tmp_path / "s2.xlsx", **SPEC)
     expected = pooled_scatter([(lot, launches[lot]) for lot in ("LOT-P", "LOT-Q", "LOT-R")]
                               + [("LOT-S", second.update.launch)], "G1")
-    assert second.gun == expected.words() and expected.lots == 4 and expected.shots == 11
+    from airgun_xl.app.next_shot import gun_setting_text
+
+    drawn = math.hypot(expected.sd, expected.bias_error)
+    assert second.gun == (  # the offset's error drawn, the gun's setting stated (issue 60)
+        f"{expected.words()}; drawn {drawn:.2%} (the scatter with the error of the mean "
+        "offset the setting is corrected by); "
+        + gun_setting_text(second.setting, expected.bias))
+    assert expected.lots == 4 and expected.shots == 11
     said = [w for w in second.warnings if "the lot LOT-Z is left out" in w]
     assert said == ["the gun's scatter: the lot LOT-Z is left out: its record holds a launch "
                     "velocity factor of 1.4, expected within 1 +/- 0.15 (the fit's bound)"]

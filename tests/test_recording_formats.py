@@ -489,11 +489,11 @@ def test_a_uffs_time_responses_are_listed_and_a_lying_point_count_is_one_line(pu
     assert main(["accept", str(TEMPLATE), str(none), "--peak", "9kG:10%"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "has no dataset 58 time response" in err, err
-    # listed, it is the same line (it listed "0 channels" with exit 0: issue 62)
+    # listed, one line too (it listed "0 channels" with exit 0: issue 62)
     assert main(["recording", str(none)]) == 2
     captured = capsys.readouterr()
     assert captured.out == "" and captured.err.count("\n") == 1, captured
-    assert "has no dataset 58 time response" in captured.err
+    assert "holds no channel of a recording (a time response)" in captured.err
     data = files["binary"].read_bytes()
     for cut in range(1, 10):
         short = tmp_path / f"cut{cut}.uff"

@@ -8,11 +8,13 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from ..errors import OptionError
 from . import declared
+
+if TYPE_CHECKING:  # numpy loads with the run, not with the command's parser (its request)
+    import numpy as np
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -72,6 +74,8 @@ class SrsOutcome:
     @property
     def largest(self) -> tuple[float, float]:
         """(level [kG], frequency [Hz]) of the spectrum's largest level."""
+        import numpy as np
+
         k = int(np.argmax(self.levels))
         return float(self.levels[k]), float(self.frequencies[k])
 
@@ -104,6 +108,8 @@ def run(request: SrsRequest) -> SrsOutcome:
         [str(w) for w in shot.warnings] + [str(f) for f in findings if f.level != "note"]
         + [str(w) for w in result.warnings[len(shot.warnings):]]
         + [str(f) for f in after_run(result)]))
+    import numpy as np
+
     pulse = result.accel_kg[np.isfinite(result.accel_kg)]
     dt = shot.params.delta
     if request.cfc is not None:

@@ -9,7 +9,7 @@ from typing import Any
 
 from ..app.declared import option_of
 from ..errors import OptionError
-from .recording_options import CfcOption
+from .recording_options import CfcOption, cfc_value
 from .vocabulary import Alias, One
 
 
@@ -37,15 +37,15 @@ def add_declared(parser: argparse.ArgumentParser, request: type, skip: tuple[str
         elif spelt.kind == "choice":
             parser.add_argument(*spelt.flags, choices=spelt.choices, default=field.default,
                                 help=spelt.help)
-        elif spelt.kind == "cfc":
-            parser.add_argument(*spelt.flags, type=_typed(read, flag), default=field.default,
+        elif spelt.kind == "cfc":  # argparse's own line, as every command's --cfc gives
+            parser.add_argument(*spelt.flags, type=cfc_value, default=field.default,
                                 metavar=spelt.metavar, action=CfcOption, help=spelt.help)
         else:
             parser.add_argument(*spelt.flags, type=_typed(read, flag), default=field.default,
                                 metavar=spelt.metavar, action=One, help=spelt.help,
                                 dest=field.name)
         for alias, idea in spelt.aliases:
-            parser.add_argument(alias, type=_typed(read, alias), dest=field.name,
+            parser.add_argument(alias, type=_typed(read, flag), dest=field.name,
                                 metavar=spelt.metavar, action=Alias, idea=idea)
 
 

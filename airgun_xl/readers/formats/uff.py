@@ -80,17 +80,9 @@ def _seconds(unit: str) -> float | None:
     return float(TIME_UNITS[unit]) if unit in TIME_UNITS else None
 
 
-def _no_time_response(shown: str) -> WorkbookError:
-    return WorkbookError(f"{shown}: has no dataset 58 time response (function type 1), "
-                         f"{EXPECTED}")
-
-
 def channels(path: str | Path, data: bytes) -> list[ChannelInfo]:
-    """The file's time responses; a file of none is refused (listed, it read "0 channels",
-    exit 0)."""
+    """The file's time responses (a file of none: the listing refuses it)."""
     shown, sets = _datasets(path, data)
-    if not sets:
-        raise _no_time_response(shown)
     out = []
     for dataset in sets:
         t_unit, unit = _units(dataset)
@@ -108,7 +100,8 @@ def read(path: str | Path, data: bytes, channel: str | None) -> Table:
     """The chosen time response (the first by default)."""
     shown, sets = _datasets(path, data)
     if not sets:
-        raise _no_time_response(shown)
+        raise WorkbookError(f"{shown}: has no dataset 58 time response (function type 1), "
+                            f"{EXPECTED}")
     names = [_name(s) for s in sets]
     dataset = sets[choose(channel, names, "time response")]
     name = _name(dataset)
