@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -127,8 +128,6 @@ def a_path(value: Any, who: str) -> Path:
     if isinstance(value, str) and value.strip():
         return Path(value)
     try:
-        import os
-
         return Path(os.fspath(value))
     except TypeError:
         raise OptionError(f"{who}: found {value!r}, expected a path") from None
