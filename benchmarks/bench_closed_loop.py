@@ -133,12 +133,14 @@ REFUSED: list[tuple[int, int, str]] = []
 
 def with_next(lot, law, first, work, draws, n_draws, calls, vary=None, gun=None):
     """Shots to the first PASS by next; each (predicted P(PASS), passed) of a proposal
-    fired. With ``gun``, every lot in one archive (``work``'s parent's) and the gun's
-    scatter pooled over them (``next --gun``); ``calls`` gets (seconds, the gun's words, the
-    law's update)."""
+    fired. Every lot in one archive (``work``'s parent's), as a lab keeps one; with ``gun``,
+    the gun's scatter pooled over them (``next --gun``); ``calls`` gets (seconds, the gun's
+    words, the law's update)."""
     shot = with_velocity(work / "next0.xlsx", first)
     predicted, record = None, []
-    archive = work / "archive" if gun is None else work.parent / "archive"
+    # one lab, one archive: the lots' pairs of expected and measured figures are the model
+    # error's record (issue 60); with a per-lot archive every lot drew the prior
+    archive = work.parent / "archive"
     for k in range(MOST_SHOTS):
         rec = fire(shot, law, draws[k], work / f"next{k}.csv")
         started = time.perf_counter()
