@@ -79,7 +79,9 @@ def _line(time: np.ndarray, first: int, stop: int) -> tuple[float, float, float]
     t = time[first:stop] - time[first]
     k_mean, t_mean = k.mean(), t.mean()
     dk = k - k_mean
-    step = float(np.dot(dk, t - t_mean) / np.dot(dk, dk))
+    # numpy's pairwise sums, not BLAS's dot, whose kernel (and rounding) depends on the CPU:
+    # the same stamps give the same clock on every machine
+    step = float(np.sum(dk * (t - t_mean)) / np.sum(dk * dk))
     offset = float(t_mean - step * k_mean)
     worst = float(np.max(np.abs(t - (offset + step * k)))) / step
     return float(time[first]) + offset, step, worst
