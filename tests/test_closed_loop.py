@@ -601,3 +601,26 @@ def test_a_fill_of_the_next_workbook_is_the_lots_in_the_archive_that_holds_its_l
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "'Crush law'!D1" in err, err
     assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_the_archives_pair_is_taken_against_the_models_own_prediction(lot):
+    """The second shot was fired from the first proposal's workbook: the archive's pair of it
+    is the first proposal's model median before its error was drawn (not the median with the
+    error drawn), the second verdict's measured peak in kG and duration in s, and the spread
+    the drawn inputs explain, log(95th / 5th) / 3.2897 (the 5th to 95th percentile of a
+    normal, scipy's), to the last bit."""
+    from scipy.stats import norm
+
+    from airgun_xl.app.lot_chain import archive_pairs
+
+    work, first, second = lot
+    pairs = archive_pairs(work / "arch")
+    assert pairs, "the archive holds the second shot's pair"
+    pair = pairs[0]
+    measured = {c.name: c.value for c in second.verdict.criteria}
+    for name, scale in (("peak", 1.0), ("duration", 1e-3)):
+        lo, mid, hi = first.best.model_figures[name]
+        assert pair[name][0] == mid and mid != first.best.figures[name][1]
+        assert pair[name][1] == pytest.approx(measured[name] * scale, rel=1e-15)
+        assert pair[name][2] == pytest.approx(math.log(hi / lo) / (2 * norm.ppf(0.95)),
+                                              rel=1e-14)

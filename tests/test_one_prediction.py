@@ -392,3 +392,59 @@ def test_two_lots_with_the_same_file_names_stay_apart(tmp_path, shot, predicted)
     assert [(r["folder"], r["version"], r["lot"]) for r in rows] == [
         ("LOT-A.shot_a", 1, "LOT-A"), ("LOT-B.shot_a", 1, "LOT-B"), ("shot_a", 1, None)]
     assert {_verdict_key(r) for r in rows} == {"shot_a"}
+
+
+def test_a_specification_without_a_velocity_change_still_learns_from_its_pairs():
+    """12 pairs of peak and duration only (the bench's specification judges no velocity
+    change): the two figures are learnt from the pairs (numpy's covariance of their logs x
+    (1 + 1/12), 11 degrees of freedom), the velocity change keeps the prior. (Before, a pair
+    had to hold all three figures to count, and such an archive drew the prior for ever.)"""
+    from airgun_xl.studies.model_error import PRIOR_SD, ModelError
+
+    pairs = [{k: v for k, v in p.items() if k != "velocity change"}
+             for p in pairs_with(0.03, 12, 5, bias=-0.01)]
+    e = ModelError.from_pairs(pairs)
+    assert e.learnt == ("peak", "duration") and e.pairs == 12 and e.dof == 11
+    logs = np.log([[p[f][1] / p[f][0] for f in ("peak", "duration")] for p in pairs])
+    cov = np.array(e.covariance)
+    np.testing.assert_allclose(cov[:2, :2], np.cov(logs, rowvar=False) * (1 + 1 / 12),
+                               rtol=1e-12)
+    assert cov[2, 2] == PRIOR_SD["velocity change"] ** 2 and cov[2, 0] == cov[2, 1] == 0.0
+    np.testing.assert_allclose(e.mean[:2], logs.mean(axis=0), rtol=1e-12)
+    assert "velocity change: the prior" in e.words()
+
+
+def test_the_spread_the_drawn_inputs_explain_is_taken_out_of_the_pairs():
+    """2,000 pairs (seed 8) whose log ratio is an input's draw (4 % spread, stated with each
+    pair as the spread its inputs explain) plus the model's own error (2 %): the error learnt
+    is the pairs' variance less the mean explained one, exactly as numpy computes it, and
+    that is 2 % to within 0.5 % (the sampling error of a 4.5 % spread's variance from 2,000
+    pairs, carried to the 2 % left, is about 0.16 %: 3 of them). Left in, the inputs would be
+    drawn twice (4.5 %). A stated spread larger than the pairs' leaves MIN_SD, not zero."""
+    from airgun_xl.studies.model_error import MIN_SD, ModelError
+
+    rng = np.random.default_rng(8)
+    z = 0.04 * rng.standard_normal((2000, 2)) + 0.02 * rng.standard_normal((2000, 2))
+    pairs = [{"peak": (9.0, 9.0 * math.exp(a), 0.04),
+              "duration": (3.5e-3, 3.5e-3 * math.exp(b), 0.04)} for a, b in z]
+    e = ModelError.from_pairs(pairs)
+    sample = np.var(z, axis=0, ddof=1)
+    np.testing.assert_allclose(np.array(e.covariance)[[0, 1], [0, 1]],
+                               (sample - 0.04 ** 2) * (1 + 1 / 2000), rtol=1e-12)
+    assert abs(math.sqrt(e.covariance[0][0]) - 0.02) < 0.005
+    assert abs(math.sqrt(e.covariance[1][1]) - 0.02) < 0.005
+    assert e.explained[:2] == pytest.approx((0.04, 0.04), rel=1e-12)
+    assert "net of the spread the drawn inputs explain there: peak 4.0 %" in e.words()
+    over = [{"peak": (9.0, 9.0 * math.exp(0.01 * a), 0.04)} for a, _ in z[:50] / 0.06]
+    assert ModelError.from_pairs(over).covariance[0][0] == pytest.approx(
+        MIN_SD ** 2 * (1 + 1 / 50), rel=1e-12)
+
+
+def test_a_pair_whose_explained_spread_is_no_spread_is_refused():
+    from airgun_xl.errors import OptionError
+    from airgun_xl.studies.model_error import ModelError
+
+    pairs = pairs_with(0.05, 4, 2)
+    pairs[1] = {**pairs[1], "peak": (9.0, 9.1, -0.2)}
+    with pytest.raises(OptionError, match=r"pair 2's peak spread explained by the inputs -0.2"):
+        ModelError.from_pairs(pairs)

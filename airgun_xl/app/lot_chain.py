@@ -100,6 +100,7 @@ def chain(root: str | Path | None, lot: str) -> list[dict[str, Any]]:
                      "verdict": record.get("verdict"),
                      "predicted_before": before[0] if before else None,
                      "expected_before": before[1] if before else None,
+                     "model_before": before[2] if before else None,
                      "measured": record.get("measured"), "law": record.get("law"),
                      "against_report": record.get("against_report"),
                      "next_A28": record.get("setting_A28"), "next_knobs": knobs,
@@ -107,16 +108,22 @@ def chain(root: str | Path | None, lot: str) -> list[dict[str, Any]]:
                      "next_expected": record.get("expected"),
                      "created": record.get("created", "")})
         if isinstance(record.get("next_sha256"), str):
-            predicted[record["next_sha256"]] = (record.get("p_pass"), record.get("expected"))
+            predicted[record["next_sha256"]] = (record.get("p_pass"), record.get("expected"),
+                                                record.get("expected_model"))
     return rows
 
 
-def archive_pairs(root: str | Path) -> list[dict[str, tuple[float, float]]]:
+def archive_pairs(root: str | Path) -> list[dict[str, tuple[float, ...]]]:
     """Every pair of expected and measured judged figures the archive at ``root`` holds
     across its lots: a shot fired from a proposal's workbook, what that proposal expected of
-    it (the median of its draws) and what its verdict measured, ``{figure: (expected,
-    measured)}`` in the judge's units (kG, s, m/s). What the archive gives is read as
-    untrusted: a value that is no finite number is left out, a unit not known refused."""
+    it and what its verdict measured, ``{figure: (expected, measured, explained)}`` in the
+    judge's units (kG, s, m/s). ``expected`` is the median of the model's own draws before its
+    error was drawn and ``explained`` the standard deviation of their log that the drawn
+    inputs give (from their 90 % range, as a normal's: (log 95th - log 5th) / 3.29), so that
+    the model's error is what the inputs do not explain; a record older than that keeps the
+    median with the error drawn and no ``explained`` (a pair of two). What the archive gives
+    is read as untrusted: a value that is no finite number is left out, a unit not known
+    refused."""
     from ..archive.lots import lot_names
     from ..specification import SHOWN_UNITS
 
@@ -124,9 +131,10 @@ def archive_pairs(root: str | Path) -> list[dict[str, tuple[float, float]]]:
     for lot in lot_names(root):
         for row in chain(root, lot):
             expected, measured = row.get("expected_before"), row.get("measured")
+            model = row.get("model_before")
             if not isinstance(expected, dict) or not isinstance(measured, dict):
                 continue
-            pair = {}
+            pair: dict[str, tuple[float, ...]] = {}
             for name in FIGURE_UNITS:
                 values, found = expected.get(name), measured.get(name)
                 if not (isinstance(values, list) and len(values) == 3
@@ -140,10 +148,29 @@ def archive_pairs(root: str | Path) -> list[dict[str, tuple[float, float]]]:
                     raise ArchiveError(f"{row['proposal']}: the measured {name}'s unit "
                                        f"{str(unit)[:20]!r}, expected one of "
                                        f"{', '.join(sorted(table))}")
-                pair[name] = (float(mid), float(value) / table[unit][1])
+                own = _model_range(model.get(name) if isinstance(model, dict) else None)
+                if own is None:
+                    pair[name] = (float(mid), float(value) / table[unit][1])
+                else:
+                    pair[name] = (own[0], float(value) / table[unit][1], own[1])
             if pair:
                 pairs.append(pair)
     return pairs
+
+
+#: A normal's 5th to 95th percentile, in standard deviations: 2 x 1.6449 (scipy.stats.norm).
+RANGE_SIGMAS = 3.2897072539029444
+
+
+def _model_range(values: Any) -> tuple[float, float] | None:
+    """(median, standard deviation of the log) of a proposal's model figures ``[5th, 50th,
+    95th]``, or None where they are not three positive, ordered finite numbers."""
+    if not (isinstance(values, list) and len(values) == 3 and all(map(_number, values))):
+        return None
+    lo, mid, hi = (float(v) for v in values)
+    if not 0 < lo <= mid <= hi:
+        return None
+    return mid, math.log(hi / lo) / RANGE_SIGMAS
 
 
 def _number(value: Any) -> TypeGuard[float]:

@@ -677,6 +677,7 @@ def _publish(request: NextRequest, output: Path, shot: Shot, spec: Any, verdict:
                   "p_pass": best.probability,
                   "interval": [lo, hi], "draws": best.shots,
                   "expected": expected_record(best), "measured": measured_record(verdict),
+                  "expected_model": expected_record(best, model=True),
                   "against_report": [v if math.isfinite(v) else None
                                      for v in against_report(update.law)],
                   "most_likely_to_fail": worst[0] if worst else None,
@@ -791,12 +792,15 @@ def update_text(update: LawUpdate, errors: str = "") -> str:
             f"{tilt_text(update)} {shots}")
 
 
-def expected_record(best: PassProbability) -> dict[str, list[float | None]]:
+def expected_record(best: PassProbability, model: bool = False
+                    ) -> dict[str, list[float | None]]:
     """The judged figures expected at the proposal, for its record and ``--json``:
     ``{criterion: [5th, 50th, 95th percentile]}`` in the judge's units (kG, s, m/s; a NaN
-    null)."""
+    null); with ``model``, the model's own before its error was drawn (what the archive's
+    pair of the shot is taken against)."""
+    figures = best.model_figures if model else best.figures
     return {name: [v if math.isfinite(v) else None for v in values]
-            for name, values in best.figures.items()}
+            for name, values in figures.items()}
 
 
 def measured_record(verdict: Verdict) -> dict[str, dict[str, Any]]:

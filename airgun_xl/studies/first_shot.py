@@ -265,6 +265,12 @@ class PassProbability:
     #: With a model error drawn: the shots that pass on the same draws with the error at the
     #: upper 95 % bound of its spread (:meth:`~.model_error.ModelError.widened`).
     cautious: int | None = None
+    #: With a model error drawn: :attr:`figures` before it was drawn, the model's own
+    #: prediction over the drawn inputs; an archive's pair of this shot is its median against
+    #: what was measured, less the spread its 90 % range says the inputs explain
+    #: (:func:`~airgun_xl.app.lot_chain.archive_pairs`). Without one: empty (:attr:`figures`
+    #: is the model's own).
+    model_figures: dict[str, tuple[float, float, float]] = field(default_factory=dict)
 
     @property
     def probability(self) -> float:
@@ -430,8 +436,9 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
     batch = (runner or run_batch)(params, integrator, progress=progress,
                                   extra=BlockJudge(spec))
     values = batch.extras
-    cautious = None
+    cautious, model_figures = None, {}
     if model_error is not None:
+        model_figures = expected_figures(values, spec)
         wide = _with_model_error(values, model_error.widened(), n, seed, invalid)
         wide_ok = np.ones(len(params), dtype=bool)
         for f in flags_of(wide, spec).values():
@@ -446,7 +453,7 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
     return PassProbability(float(first) if first is not None else math.nan,
                            int(ok.sum()), n, failures, int(batch.diverged.sum()),
                            int(invalid.sum()), float(second),
-                           expected_figures(values, spec), cautious)
+                           expected_figures(values, spec), cautious, model_figures)
 
 
 def _with_model_error(values, model_error, n, seed, invalid):

@@ -9,16 +9,26 @@ draws' judged figures), and the verdict of the shot fired from it says what was 
 Their log ratios, ``log(measured / expected)`` for the peak, the duration and the velocity
 change, pooled across lots, are the model's error out of sample.
 
-- With :data:`MIN_PAIRS` or more pairs, the error is their sample mean and covariance, and a
-  new shot's ratio is drawn from the predictive distribution of a normal model whose mean and
-  covariance are unknown: a multivariate Student t of ``n - 1`` degrees of freedom, location
-  the mean, scale the covariance times ``1 + 1/n`` (a few pairs give heavy tails, not false
-  confidence).
+Each measured figure differs from the model's median for two reasons: the inputs the study
+draws anyway (the gun's scatter, zeta's, the law's own uncertainty), and the model's error. A
+pair carries the spread the drawn inputs explain (the standard deviation of the log, from the
+90 % range of the model's own draws before its error was drawn); the model's error is the rest:
+the pairs' variance less the mean explained variance, never below :data:`MIN_SD` squared (the
+inputs drawn twice would make a probability too low; the rest not taken out, too high).
+
+- A figure with :data:`MIN_PAIRS` or more pairs is learnt: the figures so learnt take the
+  pairs' sample mean and covariance (over the pairs complete in them; the variances net of
+  what the inputs explain, the correlations the pairs' own), and a new shot's ratio is drawn
+  from the predictive distribution of a normal model whose mean and covariance are unknown: a
+  multivariate Student t of ``n - 1`` degrees of freedom, location the mean, scale the
+  covariance times ``1 + 1/n`` (a few pairs give heavy tails, not false confidence). A figure
+  the lab's specifications never judged (no pairs) keeps the prior, centred, uncorrelated.
 - With fewer, each figure's standard deviation is the larger of :data:`PRIOR_SD` and what the
-  pairs show (from two on), uncorrelated, and centred (a bias from fewer pairs than that is
-  noise). The prior is the spread an independent simulated lab measured at the proposals
-  (issue 60: 4.9 % on the peak, 2.6 % on the duration) rounded up; the velocity change, the
-  pulse's integral, follows the gun's velocity, which the gun's own scatter already draws.
+  pairs show net of the inputs (from two on), uncorrelated, and centred (a bias from fewer
+  pairs than that is noise). The prior is the spread an independent simulated lab measured at
+  the proposals (issue 60: 4.9 % on the peak, 2.6 % on the duration) rounded up; the velocity
+  change, the pulse's integral, follows the gun's velocity, which the gun's own scatter
+  already draws.
 
 A drawn ratio multiplies each Monte Carlo shot's judged figure before it is judged
 (:func:`~airgun_xl.studies.first_shot.pass_probability`), on a stream of its own seeded
@@ -45,8 +55,13 @@ FIGURES = ("peak", "duration", "velocity change")
 #: The prior's standard deviation of log(measured / expected) per figure [-].
 PRIOR_SD = {"peak": 0.05, "duration": 0.03, "velocity change": 0.01}
 
-#: Pairs from which the archive's covariance (and mean) replaces the prior.
+#: Pairs of a figure from which the archive's covariance (and mean) replaces the prior.
 MIN_PAIRS = 10
+
+#: The smallest spread of the log ratio claimed for a figure [-]: the archive's figures are
+#: measured to about this (a recording's noise and quantisation at the peak), so a spread the
+#: inputs seem to explain whole is not read as a perfect model.
+MIN_SD = 0.005
 
 #: A measured / expected ratio outside this band is no pair of one shot: the archive's record
 #: is refused (a unit lost, a workbook of another shot).
@@ -70,12 +85,20 @@ class ModelError:
         The archive's pairs it was learnt from (0: the prior).
     dof : float
         Degrees of freedom of the t it is drawn from (inf: normal).
+    explained : tuple of float
+        Per figure, the root mean square spread of the log the drawn inputs explained at
+        the pairs, taken out of their spread [-] (0: none known).
+    learnt : tuple of str
+        The figures whose error is the pairs' (with :data:`MIN_PAIRS` or more); the others'
+        the larger of the prior and the pairs'.
     """
 
     mean: tuple[float, ...]
     covariance: tuple[tuple[float, ...], ...]
     pairs: int
     dof: float = math.inf
+    explained: tuple[float, ...] = (0.0, 0.0, 0.0)
+    learnt: tuple[str, ...] = ()
 
     @classmethod
     def prior(cls) -> ModelError:
@@ -83,53 +106,96 @@ class ModelError:
         return cls._diagonal([PRIOR_SD[f] for f in FIGURES], 0)
 
     @classmethod
-    def _diagonal(cls, sds: list[float], pairs: int) -> ModelError:
+    def _diagonal(cls, sds: list[float], pairs: int,
+                  explained: tuple[float, ...] = (0.0, 0.0, 0.0)) -> ModelError:
         n = len(FIGURES)
         cov = tuple(tuple(sds[i] ** 2 if i == j else 0.0 for j in range(n)) for i in range(n))
-        return cls((0.0,) * n, cov, pairs)
+        return cls((0.0,) * n, cov, pairs, explained=explained)
 
     @classmethod
-    def from_pairs(cls, pairs: Iterable[Mapping[str, tuple[float, float]]],
+    def from_pairs(cls, pairs: Iterable[Mapping[str, tuple[float, ...]]],
                    where: str = "the archive") -> ModelError:
-        """From pairs ``{figure: (expected, measured)}`` (each in one unit); a pair that lacks a
-        figure leaves it out of that figure's spread (the covariance from the complete
-        pairs).
+        """From pairs ``{figure: (expected, measured[, explained])}`` (each in one unit;
+        ``explained`` the standard deviation of the log the drawn inputs give there, 0 when
+        not given); a pair that lacks a figure leaves it out of that figure's spread.
 
         Raises
         ------
         OptionError
-            A ratio that is not finite and positive, or outside :data:`RATIO_BAND`.
+            A ratio that is not finite and positive, or outside :data:`RATIO_BAND`; an
+            explained spread that is not a finite number from 0 to 1.
         """
-        rows = []
+        rows, drawn = [], []
         for k, pair in enumerate(pairs):
-            row = []
+            row, spread = [], []
             for f in FIGURES:
                 got = pair.get(f)
                 if got is None:
                     row.append(math.nan)
+                    spread.append(math.nan)
                     continue
-                expected, measured = got
+                expected, measured = got[0], got[1]
                 ratio = measured / expected if expected else math.nan
                 if not (math.isfinite(ratio) and RATIO_BAND[0] <= ratio <= RATIO_BAND[1]):
                     raise OptionError(
                         f"{where}: pair {k + 1}'s {f} measured {measured:.6g} against "
                         f"{expected:.6g} expected, expected a ratio within {RATIO_BAND[0]:g} "
                         f"to {RATIO_BAND[1]:g} (a unit lost, or the record of another shot)")
+                explained = got[2] if len(got) > 2 else 0.0
+                if not (math.isfinite(explained) and 0.0 <= explained <= 1.0):
+                    raise OptionError(
+                        f"{where}: pair {k + 1}'s {f} spread explained by the inputs "
+                        f"{explained:.6g}, expected a standard deviation of the log from 0 "
+                        "to 1 (a 90 % range out of order, or the record of another shot)")
                 row.append(math.log(ratio))
+                spread.append(explained ** 2)
             rows.append(row)
+            drawn.append(spread)
         logs = np.array(rows, dtype=float).reshape(-1, len(FIGURES))
-        complete = logs[np.all(np.isfinite(logs), axis=1)]
-        n = len(complete)
-        if n >= MIN_PAIRS:
-            cov = np.cov(complete, rowvar=False, ddof=1) * (1 + 1 / n)
-            return cls(tuple(float(v) for v in complete.mean(axis=0)),
-                       tuple(tuple(float(v) for v in r) for r in cov), n, float(n - 1))
-        sds = []
+        variances = np.array(drawn, dtype=float).reshape(-1, len(FIGURES))
+        counts = np.isfinite(logs).sum(axis=0)
+        learnt = [j for j in range(len(FIGURES)) if counts[j] >= MIN_PAIRS]
+        complete = np.all(np.isfinite(logs[:, learnt]), axis=1) if learnt else \
+            np.zeros(len(logs), dtype=bool)
+        n = int(complete.sum())
+        if learnt and n >= MIN_PAIRS:
+            return cls._learnt(logs[complete][:, learnt], variances[complete][:, learnt],
+                               learnt, n)
+        sds: list[float] = []
+        spreads: list[float] = []
         for j, f in enumerate(FIGURES):
-            column = logs[np.isfinite(logs[:, j]), j]
-            seen = float(np.std(column, ddof=1)) if len(column) >= 2 else 0.0
-            sds.append(max(PRIOR_SD[f], seen))
-        return cls._diagonal(sds, len(logs))
+            has = np.isfinite(logs[:, j])
+            column = logs[has, j]
+            inputs = float(variances[has, j].mean()) if has.any() else 0.0
+            seen = float(np.var(column, ddof=1)) if len(column) >= 2 else 0.0
+            sds.append(max(PRIOR_SD[f], math.sqrt(max(seen - inputs, 0.0))))
+            spreads.append(math.sqrt(inputs))
+        return cls._diagonal(sds, len(logs), tuple(spreads))
+
+    @classmethod
+    def _learnt(cls, logs: np.ndarray, variances: np.ndarray, learnt: list[int],
+                n: int) -> ModelError:
+        """The figures ``learnt`` (columns of ``logs``, ``n`` complete pairs) from the pairs,
+        net of the variances the inputs explain; the others the prior's."""
+        sample = np.atleast_2d(np.cov(logs, rowvar=False, ddof=1))
+        inputs = variances.mean(axis=0)
+        net = np.sqrt(np.maximum(np.diag(sample) - inputs, MIN_SD ** 2))
+        raw = np.sqrt(np.diag(sample))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            corr = sample / np.outer(raw, raw)
+        corr = np.where(np.isfinite(corr), corr, 0.0)
+        np.fill_diagonal(corr, 1.0)
+        block = corr * np.outer(net, net) * (1 + 1 / n)
+        size = len(FIGURES)
+        cov = np.diag([PRIOR_SD[f] ** 2 for f in FIGURES])
+        mean = np.zeros(size)
+        explained = np.zeros(size)
+        cov[np.ix_(learnt, learnt)] = block
+        mean[learnt] = logs.mean(axis=0)
+        explained[learnt] = np.sqrt(inputs)
+        return cls(tuple(float(v) for v in mean),
+                   tuple(tuple(float(v) for v in r) for r in cov), n, float(n - 1),
+                   tuple(float(v) for v in explained), tuple(FIGURES[j] for j in learnt))
 
     @property
     def sd(self) -> tuple[float, ...]:
@@ -152,7 +218,8 @@ class ModelError:
         k = self.freedom
         stretch = k / float(chi2.ppf(0.05, k))
         cov = tuple(tuple(v * stretch for v in row) for row in self.covariance)
-        return ModelError(self.mean, cov, self.pairs, self.dof)
+        return ModelError(self.mean, cov, self.pairs, self.dof, self.explained,
+                          self.learnt)
 
     def factors(self, n: int, seed: int) -> np.ndarray:
         """``n`` draws of measured / expected, a column per figure of :data:`FIGURES`."""
@@ -170,15 +237,21 @@ class ModelError:
         """The error in words, as a study states it."""
         spread = ", ".join(f"{f} {100 * s:.1f} %" for f, s in zip(FIGURES, self.sd,
                                                                    strict=True))
-        if self.pairs >= MIN_PAIRS and math.isfinite(self.dof):
+        taken = [(f, e) for f, e in zip(FIGURES, self.explained, strict=True) if e > 0]
+        net = (f" (net of the spread the drawn inputs explain there: "
+               f"{', '.join(f'{f} {100 * e:.1f} %' for f, e in taken)})" if taken else "")
+        if self.learnt:
             bias = ", ".join(f"{f} {100 * (math.exp(m) - 1):+.1f} %"
-                             for f, m in zip(FIGURES, self.mean, strict=True))
+                             for f, m in zip(FIGURES, self.mean, strict=True)
+                             if f in self.learnt)
+            prior = [f for f in FIGURES if f not in self.learnt]
             return (f"the model's own error from the archive's {self.pairs} pairs of expected "
-                    f"and measured shots: spread (1 sigma) {spread}; bias {bias}")
+                    f"and measured shots: spread (1 sigma) {spread}{net}; bias {bias}"
+                    + (f"; {', '.join(prior)}: the prior (no pairs enough)" if prior else ""))
         source = (f"the larger of the prior and the archive's {self.pairs} pair"
                   f"{'s' * (self.pairs != 1)} (fewer than {MIN_PAIRS})" if self.pairs
                   else "the prior (the archive holds no pair of expected and measured shots)")
-        return f"the model's own error, {source}: spread (1 sigma) {spread}, centred"
+        return f"the model's own error, {source}: spread (1 sigma) {spread}{net}, centred"
 
     def bound_words(self) -> str:
         """What the low end of a P(PASS)'s interval assumes of this error."""
