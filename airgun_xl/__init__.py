@@ -417,10 +417,10 @@ def diff(legacy: str | os.PathLike[str], new: str | os.PathLike[str], *,
     AirgunXlError
         A file that cannot be read, named.
     """
-    from .app.diff import run
+    from .app.diff import DiffRequest, run
 
-    return run(os.fspath(legacy), os.fspath(new), _number("--rtol", rtol),
-               _number("--atol", atol), None if report is None else os.fspath(report), force)
+    return run(DiffRequest.given(legacy=legacy, new=new, rtol=rtol, atol=atol, report=report,
+                                 force=force))
 
 
 @_paths_checked

@@ -16,12 +16,14 @@ from conftest import TEMPLATE
 import airgun_xl
 from airgun_xl.app.check import CheckRequest
 from airgun_xl.app.declared import option_of
+from airgun_xl.app.diff import DiffRequest
 from airgun_xl.app.srs import SrsRequest
 from airgun_xl.cli.commands import build_parser
 from airgun_xl.errors import OptionError
 
 #: The commands declared once so far: (command, API function, request).
-DECLARED = [("srs", airgun_xl.srs, SrsRequest), ("check", airgun_xl.check, CheckRequest)]
+DECLARED = [("srs", airgun_xl.srs, SrsRequest), ("check", airgun_xl.check, CheckRequest),
+            ("diff", airgun_xl.diff, DiffRequest)]
 
 
 def _subparser(command):
@@ -112,3 +114,24 @@ def test_a_request_is_keyword_only_and_frozen():
     assert (request.shot, request.q, request.cfc, request.lo) == (TEMPLATE, 20.0, None, 200.0)
     with pytest.raises(dataclasses.FrozenInstanceError):
         request.q = 5.0  # type: ignore[misc]
+
+
+@pytest.mark.parametrize("keyword,value,said", [
+    ("rtol", -1e-3, "rtol: found -0.001, expected a number >= 0"),
+    ("atol", "nan", "atol: found 'nan', expected a number >= 0"),
+    ("rtol", "tight", "rtol: found 'tight', expected a number >= 0"),
+    ("report", 3, "report: found 3, expected a path"),
+])
+def test_diffs_request_refuses_naming_the_keyword(keyword, value, said):
+    """``diff(rtol=-1e-3)`` compared with a negative tolerance (every column then differs,
+    and the report said so without a word on why); the API said "--rtol" of a keyword."""
+    with pytest.raises(OptionError) as caught:
+        DiffRequest.given(legacy=TEMPLATE, new=TEMPLATE, **{keyword: value})
+    assert str(caught.value) == said
+
+
+def test_diffs_command_line_names_the_flag(capsys):
+    from airgun_xl.cli import main
+
+    assert main(["diff", str(TEMPLATE), str(TEMPLATE), "--atol", "-2"]) == 2
+    assert capsys.readouterr().err.strip().endswith("--atol: found '-2', expected a number >= 0")

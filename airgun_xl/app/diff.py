@@ -10,14 +10,16 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from .. import limits
 from ..cells import CELLS
-from ..errors import WorkbookError
+from ..errors import OptionError, WorkbookError
 from ..readers import guard
+from . import declared
+
+if TYPE_CHECKING:  # numpy loads with a comparison, not with the command's parser
+    import numpy as np
 
 #: Default tolerance: Calc and Excel keep 15 significant digits.
 DEFAULT_RTOL = 1e-12
@@ -54,6 +56,7 @@ def _first_sheet(path: str | Path) -> Any:
     of :mod:`airgun_xl.readers.guard` is checked before python-calamine runs."""
     import io
 
+    import numpy as np
     from python_calamine import CalamineWorkbook
 
     data, kind = guard.read_input(path)
@@ -94,6 +97,8 @@ def read_results(path: str | Path) -> ResultSheet:
         When the file cannot be read, passes a cap of :mod:`airgun_xl.limits`, or is not in
         the macro's layout (no "Time" in H1 and time values below it).
     """
+    import numpy as np
+
     path = Path(path)
     grid, text, data = _first_sheet(path)
     height, width = grid.shape
@@ -211,6 +216,8 @@ def _same_param(a: object, b: object) -> bool:
 
 def _align(a: Any, b: Any) -> tuple[np.ndarray, np.ndarray]:
     """Indices into a and b of rows with equal time (the grids may differ in length)."""
+    import numpy as np
+
     if len(a.time) == len(b.time) and np.allclose(a.time, b.time, rtol=0,
                                                   atol=1e-9 * np.ptp(a.time) + 1e-300):
         idx = np.arange(len(a.time))
@@ -226,6 +233,8 @@ def _align(a: Any, b: Any) -> tuple[np.ndarray, np.ndarray]:
 def _compare(col: Any, header: str, x: np.ndarray, y: np.ndarray, times: Any,
              rtol: float, atol: float) -> ColumnDiff:
     """Column diff of aligned arrays x (legacy) and y (new)."""
+    import numpy as np
+
     scale = float(np.nanmax(np.abs(x))) if np.isfinite(x).any() else 0.0
     both = np.isfinite(x) & np.isfinite(y)
     diff = np.where(both, np.abs(x - y), 0.0)
@@ -280,6 +289,8 @@ def _compare_columns(a: ResultSheet, b: ResultSheet, ia: np.ndarray, ib: np.ndar
     """Each result column both sheets fill under one header, compared on the shared times
     (AB by row: its rows may run past the time grid); and the columns only one side fills
     (or fills under another header)."""
+    import numpy as np
+
     columns, only_legacy, only_new = [], [], []
     for col in sorted(set(a.data) | set(b.data)):
         xa: Any = a.data.get(col)
@@ -308,6 +319,8 @@ def _compare_columns(a: ResultSheet, b: ResultSheet, ia: np.ndarray, ib: np.ndar
 
 def _compare_finals(a: ResultSheet, b: ResultSheet, rtol: float, atol: float) -> Any:
     """The final masses below column I, each compared as a one-row column."""
+    import numpy as np
+
     out = []
     for k, label in enumerate(("Final M1", "Final m31")):
         x, y = np.array([a.finals[k]]), np.array([b.finals[k]])
@@ -323,6 +336,8 @@ def _compare_finals(a: ResultSheet, b: ResultSheet, rtol: float, atol: float) ->
 def _worst_column(a: ResultSheet, b: ResultSheet, ia: np.ndarray, ib: np.ndarray) -> Any:
     """(name, time, legacy, new) of the column whose largest difference is the largest
     fraction of its magnitude (AB and empty columns aside); None when there is none."""
+    import numpy as np
+
     worst = None
     for col in sorted(set(a.data) & set(b.data)):
         x, y = a.data[col], b.data[col]
@@ -341,6 +356,8 @@ def diff_histories(name_a: str, a: dict[str, np.ndarray], name_b: str,
                    atol: float = 0.0) -> DiffReport:
     """Compare two full time histories (``{column: array}`` with a ``time`` column), as
     :func:`diff_workbooks` compares sheet columns; for archived runs."""
+    import numpy as np
+
     ta, tb = np.asarray(a["time"]), np.asarray(b["time"])
     sa = ResultSheet(Path(name_a), {}, {}, {}, ta, (np.nan, np.nan))
     sb = ResultSheet(Path(name_b), {}, {}, {}, tb, (np.nan, np.nan))
@@ -407,9 +424,42 @@ class DiffOutcome:
         return bool(self.report.same)
 
 
-def run(legacy: str | Path, new: str | Path, rtol: float = DEFAULT_RTOL, atol: float = 0.0,
-        report: str | Path | None = None, force: bool = False) -> DiffOutcome:
-    """Compare a legacy workbook with a new one; with ``report``, also write the error table
+#: The help of ``diff``'s tolerances.
+RTOL_HELP = ("relative to each column's largest magnitude (default 1e-12: Calc and Excel keep "
+             "15 digits)")
+ATOL_HELP = "absolute tolerance (default 0)"
+
+
+def a_tolerance(value: Any, who: str) -> float:
+    """A tolerance: a number >= 0 [-], given as one or as text."""
+    try:
+        found = declared.a_number(value, who)
+    except OptionError:
+        found = -1.0
+    if not found >= 0:
+        raise OptionError(f"{who}: found {value!r}, expected a number >= 0")
+    return found
+
+
+@dataclass(frozen=True, kw_only=True)
+class DiffRequest(declared.Checked):
+    """The two workbooks, the tolerances [-] and where the report goes (None: none). Declared
+    once (:mod:`.declared`): the command's options and the API's keywords."""
+
+    legacy: Path = declared.positional("legacy", metavar="LEGACY", read=declared.a_path,
+                                       help="the workbook the macro filled (the reference)")
+    new: Path = declared.positional("new", metavar="NEW", read=declared.a_path,
+                                    help="the workbook airgun-xl fill wrote")
+    rtol: float = declared.option(DEFAULT_RTOL, "--rtol", help=RTOL_HELP, read=a_tolerance)
+    atol: float = declared.option(0.0, "--atol", help=ATOL_HELP, read=a_tolerance)
+    report: Path | None = declared.option(
+        None, "--report", metavar="REPORT.xlsx", read=declared.a_path_or_none,
+        help="also write a workbook: error table and the worst column's curves")
+    force: bool = declared.force("REPORT.xlsx")
+
+
+def run(request: DiffRequest) -> DiffOutcome:
+    """Compare a legacy workbook with a new one; with a report, also write the error table
     and the worst column's curves there.
 
     Raises
@@ -417,12 +467,13 @@ def run(legacy: str | Path, new: str | Path, rtol: float = DEFAULT_RTOL, atol: f
     airgun_xl.errors.AirgunXlError
         A file that cannot be read, or a report that exists (without ``force``).
     """
+    legacy, new, report = request.legacy, request.new, request.report
     if report is not None:
-        check_report(report, force, [legacy, new])
-    found = diff_workbooks(legacy, new, rtol, atol)
+        check_report(report, request.force, [legacy, new])
+    found = diff_workbooks(legacy, new, request.rtol, request.atol)
     files: tuple[Path, ...] = ()
     if report is not None:
-        write_report(found, report, force)
+        write_report(found, report, request.force)
         files = (Path(report),)
     return DiffOutcome(found, files)
 

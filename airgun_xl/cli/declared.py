@@ -21,11 +21,13 @@ def _typed(read: Any, flag: str) -> Any:
     return parse
 
 
-def add_declared(parser: argparse.ArgumentParser, request: type, skip: tuple[str, ...] = ()
-                 ) -> None:
-    """Each field of the dataclass ``request`` (but ``skip``) as ``parser``'s argument."""
+def add_declared(parser: argparse.ArgumentParser, request: type, skip: tuple[str, ...] = (),
+                 only: tuple[str, ...] | None = None) -> None:
+    """Each field of the dataclass ``request`` (but ``skip``; with ``only``, those alone) as
+    ``parser``'s argument, in the fields' order (a command whose help shows an option of its
+    own between them adds them in two calls)."""
     for field in dataclasses.fields(request):
-        if field.name in skip:
+        if field.name in skip or (only is not None and field.name not in only):
             continue
         spelt = option_of(field)
         read = field.metadata["read"]

@@ -2,32 +2,16 @@
 ``-o``/``--output`` and ``--force`` (their help texts then match across subcommands)."""
 import argparse
 
+from ..app.declared import INTEGRATOR_HELP, MODEL_HELP, SHOT_HELP
+from ..app.diff import ATOL_HELP, RTOL_HELP, a_tolerance
 from ..choices import INTEGRATORS, MODELS
 
-INTEGRATOR_HELP = ("legacy: ArtSim's scheme (the default); newmark: average-acceleration "
-                   "Newmark, unconditionally stable for the OBR chain")
-MODEL_HELP = "4-mass: ArtSim (the default); rigid: the previous rigid-body model"
-#: The help of ``--rtol`` and ``--atol``, in diff and compare.
-RTOL_HELP = ("relative to each column's largest magnitude (default 1e-12: Calc and Excel keep "
-             "15 digits)")
-ATOL_HELP = "absolute tolerance (default 0)"
+__all__ = ["ATOL_HELP", "INTEGRATOR_HELP", "MODEL_HELP", "RTOL_HELP", "SHOT_HELP"]
 
 
 def tolerance(option, text):
-    """A tolerance option's value: a number >= 0 [-]."""
-    from ..errors import OptionError
-
-    try:
-        value = float(text)
-    except ValueError:
-        value = -1.0
-    if not value >= 0:
-        raise OptionError(f"{option}: found {text!r}, expected a number >= 0")
-    return value
-
-
-#: The help of every subcommand's positional shot workbook.
-SHOT_HELP = "the shot's workbook, in the report's layout (.xlsx, .xlsm or .xls)"
+    """A tolerance option's value: a number >= 0 [-] (``diff``'s grammar)."""
+    return a_tolerance(text, option)
 
 
 def add_integrator(p, repeated=False):
