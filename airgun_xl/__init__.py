@@ -435,9 +435,9 @@ def recording(path: str | os.PathLike[str]) -> RecordingOutcome:
     AirgunXlError
         A file that cannot be read as a recording, named.
     """
-    from .app.recording import run
+    from .app.recording import RecordingRequest, run
 
-    return run(os.fspath(path))
+    return run(RecordingRequest.given(path=path))
 
 
 @_paths_checked
@@ -462,9 +462,9 @@ def serve(archive: str | os.PathLike[str], *, host: str = "127.0.0.1",
 def template(output: str | os.PathLike[str], *, force: bool = False) -> os.PathLike[str]:
     """Write a fresh shot A workbook in the report's layout, as ``airgun-xl template``
     does; the path written."""
-    from .app.template import run
+    from .app.template import TemplateRequest, run
 
-    return run(os.fspath(output), force)
+    return run(TemplateRequest.given(output=output, force=force))
 
 
 def _texts(value: str | Sequence[str] | None) -> tuple[str, ...]:

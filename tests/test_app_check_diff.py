@@ -40,7 +40,7 @@ def test_diff_of_the_appendix_run_and_its_fill_is_the_same(tmp_path):
     changed = airgun_xl.diff(LEGACY / "shot_a_appendix_5us_legacy.xlsx",
                              tmp_path / "changed.xlsx")
     assert not changed.same and changed.report.inputs
-    with pytest.raises(OptionError, match=r"^rtol: found 'x', expected a number >= 0$"):  # the keyword
+    with pytest.raises(OptionError, match=r"^rtol: found 'x', expected a number >= 0$"):
         airgun_xl.diff(out, out, rtol="x")
 
 

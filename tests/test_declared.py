@@ -17,13 +17,17 @@ import airgun_xl
 from airgun_xl.app.check import CheckRequest
 from airgun_xl.app.declared import option_of
 from airgun_xl.app.diff import DiffRequest
+from airgun_xl.app.recording import RecordingRequest
 from airgun_xl.app.srs import SrsRequest
+from airgun_xl.app.template import TemplateRequest
 from airgun_xl.cli.commands import build_parser
 from airgun_xl.errors import OptionError
 
 #: The commands declared once so far: (command, API function, request).
 DECLARED = [("srs", airgun_xl.srs, SrsRequest), ("check", airgun_xl.check, CheckRequest),
-            ("diff", airgun_xl.diff, DiffRequest)]
+            ("diff", airgun_xl.diff, DiffRequest),
+            ("recording", airgun_xl.recording, RecordingRequest),
+            ("template", airgun_xl.template, TemplateRequest)]
 
 
 def _subparser(command):
@@ -135,3 +139,15 @@ def test_diffs_command_line_names_the_flag(capsys):
 
     assert main(["diff", str(TEMPLATE), str(TEMPLATE), "--atol", "-2"]) == 2
     assert capsys.readouterr().err.strip().endswith("--atol: found '-2', expected a number >= 0")
+
+
+def test_a_recording_is_kept_as_the_text_given():
+    """A workbook's columns are text with colons (``trace.xlsx:Sheet1!A:B``): kept as given,
+    not made a path (Windows reads a colon as a drive's); a path given as one is its text;
+    anything else refused naming the keyword."""
+    from pathlib import Path
+
+    assert RecordingRequest.given(path="t.xlsx:Sheet1!A:B").path == "t.xlsx:Sheet1!A:B"
+    assert RecordingRequest.given(path=Path("r.csv")).path == "r.csv"
+    with pytest.raises(OptionError, match=r"^path: found b'r.csv', expected a recording's"):
+        RecordingRequest.given(path=b"r.csv")

@@ -137,6 +137,17 @@ def a_path_or_none(value: Any, who: str) -> Path | None:
     return None if value is None else a_path(value, who)
 
 
+def a_recording(value: Any, who: str) -> str:
+    """A recording: a file's path, or a workbook's columns as text
+    (``trace.xlsx:Sheet1!A:B``), kept as the text given (a path would read its colon as
+    a drive's on Windows)."""
+    if isinstance(value, os.PathLike):
+        value = os.fspath(value)
+    if isinstance(value, str) and value.strip():
+        return value
+    raise OptionError(f"{who}: found {value!r}, expected a recording's path")
+
+
 def a_number(value: Any, who: str) -> float:
     """A number, given as one or as text (``"0.95"``); a bool is no number."""
     if isinstance(value, bool):
@@ -208,6 +219,9 @@ CRUSH_LAW_HELP = ("workbook: the law the workbook's Crush law sheet names (a cal
                   "workbook's fitted law), else the macro's (default); legacy: the macro's "
                   "polynomial, Eq. (8), whatever the workbook says; NAME or NAME@N: a law of "
                   "the --archive's library (calibrate --archive --name)")
+RECORDING_HELP = ("a CSV (time, acceleration, units in the header), a workbook's columns "
+                  "(trace.xlsx:Sheet1!A:B), a LabVIEW TDMS file, a MATLAB .mat file, an "
+                  "ASAM MDF file, a Universal File (dataset 58) or an ISO 13499 MME test")
 ARCHIVE_HELP = ("the archive whose library --crush-law NAME is read from (default: "
                 "$AIRGUN_XL_ARCHIVE when set)")
 
@@ -215,6 +229,11 @@ ARCHIVE_HELP = ("the archive whose library --crush-law NAME is read from (defaul
 def shot(help: str = SHOT_HELP) -> Any:
     """The shot's workbook (``SHOT.xlsx``)."""
     return positional("shot", help=help, metavar="SHOT.xlsx", read=a_path)
+
+
+def recording(help: str = RECORDING_HELP) -> Any:
+    """A recording file (``RECORDING``)."""
+    return positional("recording", help=help, metavar="RECORDING", read=a_recording)
 
 
 def output(what: str, default: str, metavar: str = "OUT.xlsx") -> Any:

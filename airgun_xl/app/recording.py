@@ -1,14 +1,26 @@
 """Recording: what a recording file holds, as the reading commands would read it (its format
 and its channels, with their names, units, rates, lengths and starts); no samples judged.
 
-:func:`run` takes the file and returns a :class:`RecordingOutcome`; the CLI (``airgun-xl
-recording``) is this."""
+:func:`run` takes a :class:`RecordingRequest` and returns a :class:`RecordingOutcome`; the
+CLI (``airgun-xl recording``) and the Python API (:func:`airgun_xl.recording`) are both
+this."""
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from . import declared
+
+
+@dataclass(frozen=True, kw_only=True)
+class RecordingRequest(declared.Checked):
+    """The recording file (or a workbook's columns, as text). Declared once
+    (:mod:`.declared`): the command's argument and the API's keyword."""
+
+    path: str = declared.positional("path", help=declared.RECORDING_HELP, metavar="RECORDING",
+                                    read=declared.a_recording)
 
 
 @dataclass(frozen=True)
@@ -54,8 +66,8 @@ class RecordingOutcome:
             for k, c in enumerate(self.channels, start=1)]})
 
 
-def run(path: str | Path) -> RecordingOutcome:
-    """List the channels of the recording at ``path``.
+def run(request: RecordingRequest) -> RecordingOutcome:
+    """List the channels of the recording the request names.
 
     Raises
     ------
@@ -65,7 +77,7 @@ def run(path: str | Path) -> RecordingOutcome:
     from ..readers import formats
     from ..readers.recording import RANGE, list_channels
 
-    text = str(path)
+    path = text = request.path
     if RANGE.match(text) and not Path(text).exists():
         kind = "workbook range"
     else:

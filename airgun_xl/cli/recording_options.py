@@ -3,7 +3,10 @@
 anti-alias model."""
 import argparse
 
+from ..app.declared import RECORDING_HELP
 from ..specification import CFC_CLASSES
+
+__all__ = ["RECORDING_HELP"]
 from .vocabulary import Alias
 
 
@@ -95,9 +98,6 @@ def anti_alias_value(text):
 
 
 #: The help of a command's recording argument (compare-measured, accept).
-RECORDING_HELP = ("a CSV (time, acceleration, units in the header), a workbook's columns "
-                  "(trace.xlsx:Sheet1!A:B), a LabVIEW TDMS file, a MATLAB .mat file, an "
-                  "ASAM MDF file, a Universal File (dataset 58) or an ISO 13499 MME test")
 
 
 def add_recording_options(p, channel_help="the channel of a file of several (TDMS, .mat, .mf4, "
