@@ -371,15 +371,11 @@ def convergence(shot: str | os.PathLike[str], levels: str | Sequence[str] | None
     AirgunXlError
         Bad input, named; nothing is written.
     """
-    from pathlib import Path
-
     from .app.convergence import ConvergenceRequest, run
 
-    steps = None if levels is None else ",".join(_texts(levels))
-    return run(ConvergenceRequest(
-        Path(shot), steps, _texts(integrators), str(rtol),
-        Path(output) if output is not None else None, force, crush_law,
-        Path(archive) if archive is not None else None))
+    return run(ConvergenceRequest.given(shot=shot, levels=levels, integrators=integrators,
+                                        rtol=rtol, output=output, force=force,
+                                        crush_law=crush_law, archive=archive))
 
 
 @_paths_checked

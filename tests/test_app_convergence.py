@@ -47,12 +47,26 @@ def test_the_command_prints_the_functions_ladder(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("given, said", [
-    ({"levels": "10us"}, "--levels: found '10us', expected at least two time steps"),
-    ({"levels": "10us,5us", "rtol": "2"}, "--rtol: found '2', expected a number between"),
-    ({"levels": "10 furlongs,5us"}, "--levels: found"),
+    ({"levels": "10us"}, "levels: found '10us', expected at least two time steps"),
+    ({"levels": "10us,5us", "rtol": "2"}, "rtol: found '2', expected a number between"),
+    ({"levels": "10 furlongs,5us"}, "levels: found"),
+    ({"levels": [1e-5, -5e-6]}, "levels: found [1e-05, -5e-06], expected positive time"),
+    ({"integrators": ["legacy", "rk4"]}, "integrators: found 'rk4', expected one of "),
 ])
 def test_bad_keywords_are_one_line_and_write_nothing(given, said, tmp_path):
     with pytest.raises(OptionError) as caught:
         airgun_xl.convergence(TEMPLATE, output=tmp_path / "c.xlsx", **given)
     assert str(caught.value).startswith(said) and "\n" not in str(caught.value)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_command_line_names_the_flags(tmp_path, capsys):
+    """The same refusals on the command line name the options: the request's field read by
+    the same grammar, its keyword replaced by the flag (one line, exit 2, nothing written)."""
+    for argv, said in ((["--levels", "10us"], "--levels: found '10us', expected at least"),
+                       (["--levels", "10us,5us", "--rtol", "2"], "--rtol: found '2'")):
+        assert main(["convergence", str(TEMPLATE), "-o", str(tmp_path / "c.xlsx"),
+                     *argv]) == 2
+        err = capsys.readouterr().err.strip()
+        assert said in err and "\n" not in err, err
     assert list(tmp_path.iterdir()) == []

@@ -44,7 +44,8 @@ def test_convergence_at_the_finest_level_says_what_to_do(tmp_path, capsys):
     shot = _variant(tmp_path, E2=5e-9, E6=1e-5)
     assert main(["convergence", str(shot)]) == 2
     err = capsys.readouterr().err
-    assert "already at the finest default level (5 ns)" in err and "--levels 10ns" in err
+    assert "already at the finest default level (5 ns)" in err
+    assert err.startswith("airgun-xl: error: --levels: ") and "e.g. 10ns,5ns,2ns" in err, err
 
 
 @pytest.mark.parametrize("command,words", [

@@ -15,6 +15,7 @@ from conftest import TEMPLATE
 
 import airgun_xl
 from airgun_xl.app.check import CheckRequest
+from airgun_xl.app.convergence import ConvergenceRequest
 from airgun_xl.app.declared import option_of
 from airgun_xl.app.diff import DiffRequest
 from airgun_xl.app.recording import RecordingRequest
@@ -27,7 +28,11 @@ from airgun_xl.errors import OptionError
 DECLARED = [("srs", airgun_xl.srs, SrsRequest), ("check", airgun_xl.check, CheckRequest),
             ("diff", airgun_xl.diff, DiffRequest),
             ("recording", airgun_xl.recording, RecordingRequest),
-            ("template", airgun_xl.template, TemplateRequest)]
+            ("template", airgun_xl.template, TemplateRequest),
+            ("convergence", airgun_xl.convergence, ConvergenceRequest)]
+
+#: A keyword a function has always taken by position too (documented so): (function, name).
+POSITIONAL = {("convergence", "levels")}
 
 
 def _subparser(command):
@@ -48,7 +53,8 @@ def test_the_functions_keywords_are_its_requests_fields(command, function, reque
             assert parameter.default is inspect.Parameter.empty, name
         else:
             assert parameter.default == field.default, name
-            assert parameter.kind is inspect.Parameter.KEYWORD_ONLY, name
+            assert parameter.kind is inspect.Parameter.KEYWORD_ONLY or \
+                (command, name) in POSITIONAL, name
 
 
 @pytest.mark.parametrize("command,function,request_type", DECLARED,

@@ -13,26 +13,62 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import OptionError
+from . import declared
 
 #: The warning where the PNG could not be drawn.
 NO_PNG = "matplotlib is not installed: no PNG (pip install 'airgun-xl[plots]')"
 
 
-@dataclass(frozen=True)
-class ConvergenceRequest:
-    """The ladder: ``levels`` the time steps as typed (``"5us,2us,1us"``; None: the sheet's
-    E2, then 1-2-5 steps down to 5 ns), run with each of ``integrators``; ``rtol`` the
-    tolerance on the peak [-], as typed. ``output`` None writes no workbook (the CLI gives
-    its default, ``SHOT.convergence.xlsx``, and the PNG beside it)."""
+def a_ladder(value: Any, who: str) -> tuple[float, ...] | None:
+    """A ladder of time steps [s]: text (``"5us,2us,1us"``), a sequence of durations as text
+    or numbers [s], or None (the sheet's E2, then 1-2-5 steps down to 5 ns); at least two."""
+    from ..units import parse_duration
 
-    shot: Path
-    levels: str | None = None
-    integrators: tuple[str, ...] = ("legacy",)
-    rtol: str = "1e-3"
-    output: Path | None = None
-    force: bool = False
-    crush_law: str = "workbook"
-    archive: Path | None = None  # where a library law is read from
+    if value is None:
+        return None
+    texts = ([t for t in value.split(",") if t.strip()] if isinstance(value, str) else
+             list(value) if isinstance(value, (list, tuple)) else [value])
+    steps = tuple(declared.a_number(t, who) if isinstance(t, (int, float))
+                  and not isinstance(t, bool) else parse_duration(t, who) for t in texts)
+    if not all(0 < d < math.inf for d in steps):
+        raise OptionError(f"{who}: found {value!r}, expected positive time steps")
+    if len(steps) < 2:
+        raise OptionError(f"{who}: found {value!r}, expected at least two time steps")
+    return steps
+
+
+def a_peak_tolerance(value: Any, who: str) -> float:
+    """The tolerance on the peak [-]: a number between 0 and 1."""
+    try:
+        found = declared.a_number(value, who)
+    except OptionError:
+        found = math.nan
+    if not 0 < found < 1:
+        raise OptionError(f"{who}: found {value!r}, expected a number between 0 and 1")
+    return found
+
+
+@dataclass(frozen=True, kw_only=True)
+class ConvergenceRequest(declared.Checked):
+    """The ladder: ``levels`` the time steps [s] (None: the sheet's E2, then 1-2-5 steps down
+    to 5 ns), run with each of ``integrators``; ``rtol`` the tolerance on the peak [-].
+    ``output`` None writes no workbook (the CLI gives its default,
+    ``SHOT.convergence.xlsx``, and the PNG beside it). Declared once (:mod:`.declared`): the
+    command's options and the API's keywords."""
+
+    shot: Path = declared.shot()
+    levels: tuple[float, ...] | None = declared.option(
+        None, "--levels", read=a_ladder,
+        help="comma-separated time steps, e.g. 5us,2us,1us,500ns (default: the sheet's E2, "
+             "then 1-2-5 steps down to 5ns)")
+    integrators: tuple[str, ...] = declared.integrators()
+    rtol: float = declared.option(1e-3, "--rtol", read=a_peak_tolerance,
+                                  help="tolerance on the peak (default 0.1%%)")
+    output: Path | None = declared.output("workbook; the PNG goes beside it",
+                                          "SHOT.convergence.xlsx")
+    force: bool = declared.force()
+    crush_law: str = declared.crush_law()
+    archive: Path | None = declared.archive()  # where a library law is read from
 
 
 @dataclass(frozen=True)
@@ -70,27 +106,16 @@ def run(request: ConvergenceRequest) -> ConvergenceOutcome:
         Bad input, named; nothing is written.
     """
     from ..archive.laws import shot_with_law
-    from ..studies.convergence import default_ladder, ladder, parse_duration
+    from ..studies.convergence import default_ladder, ladder
     from ..transaction import check_output
 
     shot = shot_with_law(request.shot, request.crush_law, request.archive)
-    try:
-        rtol = float(request.rtol)
-    except ValueError:
-        rtol = math.nan
-    if not 0 < rtol < 1:
-        raise OptionError(f"--rtol: found {request.rtol!r}, expected a number between 0 and 1")
-    if request.levels:
-        deltas = [parse_duration(t) for t in request.levels.split(",") if t.strip()]
-    else:
-        deltas = default_ladder(shot.params.delta)
-    if len(deltas) < 2 and not request.levels:
-        raise OptionError(f"--levels: the sheet's time step E2 = {shot.params.delta:g} s is "
-                          "already at the finest default level (5 ns), expected --levels with "
-                          "two or more time steps, e.g. --levels 10ns,5ns,2ns")
+    deltas = (list(request.levels) if request.levels is not None
+              else default_ladder(shot.params.delta))
     if len(deltas) < 2:
-        raise OptionError(f"--levels: found {request.levels!r}, expected at least two time "
-                          "steps")
+        raise OptionError(f"levels: the sheet's time step E2 = {shot.params.delta:g} s is "
+                          "already at the finest default level (5 ns), expected two or more "
+                          "time steps, e.g. 10ns,5ns,2ns")
     for d in deltas:
         shot.params.replace(delta=d)  # each level is a valid shot (raises on the cell)
     png = request.output.with_suffix(".png") if request.output is not None else None
@@ -98,7 +123,8 @@ def run(request: ConvergenceRequest) -> ConvergenceOutcome:
         check_output(request.output, request.force, inputs=[request.shot])
         check_output(png, request.force, inputs=[request.shot], suffixes=(".png",))
     warnings = [str(w) for w in shot.warnings]
-    ladders = tuple(ladder(shot, deltas, name, rtol) for name in request.integrators)
+    ladders = tuple(ladder(shot, deltas, name, request.rtol)
+                    for name in request.integrators)
     files: tuple[Path, ...] = ()
     if request.output is not None:
         from ..reports.convergence import write_convergence

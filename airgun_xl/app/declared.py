@@ -53,8 +53,9 @@ class Option:
         The value's placeholder in the help.
     kind : str
         ``"value"`` (given once, its value read by the grammar), ``"switch"`` (present or
-        not), ``"choice"`` (one of ``choices``), ``"cfc"`` (a J211 class or ``none``, told
-        apart from a specification's) or ``"positional"``.
+        not), ``"choice"`` (one of ``choices``), ``"integrators"`` (an integrator, given
+        again for each run side by side), ``"cfc"`` (a J211 class or ``none``, told apart
+        from a specification's) or ``"positional"``.
     choices : tuple of str
         For a ``"choice"``.
     aliases : tuple of tuple of str
@@ -175,6 +176,19 @@ def one_of(choices: tuple[str, ...]) -> Read:
     return read
 
 
+def some_of(choices: tuple[str, ...]) -> Read:
+    """One or more of ``choices``: a text or a sequence of them, each once, in order."""
+    pick = one_of(choices)
+
+    def read(value: Any, who: str) -> tuple[str, ...]:
+        given = [value] if isinstance(value, str) else value
+        if not isinstance(given, (list, tuple)) or not given:
+            raise OptionError(f"{who}: found {value!r}, expected one or more of "
+                              f"{', '.join(sorted(choices))}")
+        return tuple(dict.fromkeys(pick(v, who) for v in given))
+    return read
+
+
 def a_law(value: Any, who: str) -> str:
     """A crush law's name: ``workbook``, ``legacy`` or ``NAME[@N]`` (checked against the
     archive where it is read)."""
@@ -252,6 +266,15 @@ def force(metavar: str = "OUT.xlsx") -> Any:
 def integrator() -> Any:
     return option("legacy", "--integrator", help=INTEGRATOR_HELP, kind="choice",
                   choices=tuple(sorted(INTEGRATORS)), read=one_of(tuple(INTEGRATORS)))
+
+
+def integrators() -> Any:
+    """``--integrator``, given once for each integrator run side by side."""
+    return option(("legacy",), "--integrator", kind="integrators",
+                  metavar="{" + ",".join(sorted(INTEGRATORS)) + "}",
+                  help=INTEGRATOR_HELP + "; give it again to run another side by side: "
+                                         "--integrator legacy --integrator newmark",
+                  read=some_of(tuple(INTEGRATORS)))
 
 
 def model() -> Any:

@@ -4,12 +4,15 @@ read by the field's own grammar naming the flag; and the request from what was p
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
+from collections.abc import Iterator
 from typing import Any
 
 from ..app.declared import option_of
 from ..errors import OptionError
 from .recording_options import CfcOption, cfc_value
+from .run_options import Integrators
 from .vocabulary import Alias, One
 
 
@@ -39,6 +42,10 @@ def add_declared(parser: argparse.ArgumentParser, request: type, skip: tuple[str
         elif spelt.kind == "choice":
             parser.add_argument(*spelt.flags, choices=spelt.choices, default=field.default,
                                 help=spelt.help)
+        elif spelt.kind == "integrators":  # each given once more, into a list
+            assert isinstance(field.default, tuple), field.name
+            parser.add_argument(*spelt.flags, action=Integrators, default=list(field.default),
+                                metavar=spelt.metavar, help=spelt.help, dest=field.name)
         elif spelt.kind == "cfc":  # argparse's own line, as every command's --cfc gives
             parser.add_argument(*spelt.flags, type=cfc_value, default=field.default,
                                 metavar=spelt.metavar, action=CfcOption, help=spelt.help)
@@ -58,11 +65,20 @@ def request_of(request: type, args: argparse.Namespace, **given: Any) -> Any:
     fields = dataclasses.fields(request)
     values = {f.name: given[f.name] if f.name in given else getattr(args, f.name)
               for f in fields}
-    try:
+    with flags_named(request):
         return request(**values)
-    except OptionError as exc:  # "q: ..." or, of two fields together, "lo/hi: ..."
+
+
+@contextlib.contextmanager
+def flags_named(request: type) -> Iterator[None]:
+    """A refusal that names fields of ``request`` (``q: ...``; of two fields together,
+    ``lo/hi: ...``), raised while making it or running it, said with their flags instead
+    (``--srs-q: ...``)."""
+    try:
+        yield
+    except OptionError as exc:
         prefix, colon, rest = str(exc).partition(": ")
-        flags = {f.name: option_of(f).flags[-1] for f in fields}
+        flags = {f.name: option_of(f).flags[-1] for f in dataclasses.fields(request)}
         names = prefix.split("/")
         if colon and all(name in flags for name in names):
             raise OptionError("/".join(flags[n] for n in names) + ": " + rest) from None
