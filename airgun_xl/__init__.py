@@ -335,17 +335,13 @@ def compare_measured(shot: str | os.PathLike[str], recording: str | os.PathLike[
     AirgunXlError
         Bad input, named; nothing is written.
     """
-    from pathlib import Path
-
     from .app.compare_measured import CompareMeasuredRequest, run
-    from .app.specifying import record_filter
 
-    record = record_filter(cfc)
-    return run(CompareMeasuredRequest(
-        Path(shot), os.fspath(recording), record, str(align), anti_alias,
-        _number("--sign", sign), time_unit,
-        accel_unit, channel, integrator, model, Path(output) if output is not None else None,
-        force, crush_law, Path(archive) if archive is not None else None))
+    return run(CompareMeasuredRequest.given(
+        shot=shot, recording=recording, cfc=cfc, align=align, anti_alias=anti_alias,
+        sign=sign, time_unit=time_unit, accel_unit=accel_unit, channel=channel,
+        integrator=integrator, model=model, output=output, force=force, crush_law=crush_law,
+        archive=archive))
 
 
 @_paths_checked

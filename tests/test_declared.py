@@ -15,6 +15,7 @@ from conftest import TEMPLATE
 
 import airgun_xl
 from airgun_xl.app.check import CheckRequest
+from airgun_xl.app.compare_measured import CompareMeasuredRequest
 from airgun_xl.app.convergence import ConvergenceRequest
 from airgun_xl.app.declared import option_of
 from airgun_xl.app.diff import DiffRequest
@@ -29,7 +30,8 @@ DECLARED = [("srs", airgun_xl.srs, SrsRequest), ("check", airgun_xl.check, Check
             ("diff", airgun_xl.diff, DiffRequest),
             ("recording", airgun_xl.recording, RecordingRequest),
             ("template", airgun_xl.template, TemplateRequest),
-            ("convergence", airgun_xl.convergence, ConvergenceRequest)]
+            ("convergence", airgun_xl.convergence, ConvergenceRequest),
+            ("compare-measured", airgun_xl.compare_measured, CompareMeasuredRequest)]
 
 #: A keyword a function has always taken by position too (documented so): (function, name).
 POSITIONAL = {("convergence", "levels")}

@@ -10,35 +10,42 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+from . import declared
 
-from ..errors import OptionError
+if TYPE_CHECKING:  # numpy loads with a comparison, not with the command's parser
+    pass
 
 
-@dataclass(frozen=True)
-class CompareMeasuredRequest:
+@dataclass(frozen=True, kw_only=True)
+class CompareMeasuredRequest(declared.Checked):
     """The shot and its recording, read as the options say; ``align`` ``threshold`` or
     ``xcorr``; ``anti_alias`` the recorder's filter modelled on the prediction [Hz], auto or
     none. ``output`` None writes no workbook (the CLI gives its default,
-    ``SHOT.measured.xlsx``)."""
+    ``SHOT.measured.xlsx``). Declared once (:mod:`.declared`): the command's options, in this
+    order, and the API's keywords."""
 
-    shot: Path
-    recording: str
-    cfc: int | None = None
-    align: str = "threshold"
-    anti_alias: str | float = "auto"
-    sign: float = 1.0
-    time_unit: str | None = None
-    accel_unit: str | None = None
-    channel: str | None = None
-    integrator: str = "legacy"
-    model: str = "4-mass"
-    output: Path | None = None
-    force: bool = False
-    crush_law: str = "workbook"
-    archive: Path | None = None  # where a library law is read from
+    shot: Path = declared.shot()
+    recording: str = declared.recording("the measured pulse: " + declared.RECORDING_HELP)
+    output: Path | None = declared.output("scores and traces", "SHOT.measured.xlsx")
+    force: bool = declared.force()
+    channel: str | None = declared.channel()
+    cfc: int | None = declared.cfc()
+    sign: float = declared.sign()
+    time_unit: str | None = declared.time_unit()
+    accel_unit: str | None = declared.accel_unit()
+    anti_alias: str | float = declared.anti_alias()
+    align: str = declared.option(
+        "threshold", "--align", kind="choice", choices=("threshold", "xcorr"),
+        read=declared.one_of(("threshold", "xcorr")),
+        help="impact instant: where the zeroed pulse first holds 5%% of its peak (or 5 sigma "
+             "of its pre-trigger noise, if more) for 0.05 ms (default), or the "
+             "cross-correlation's best lag; each checks the other")
+    integrator: str = declared.integrator()
+    model: str = declared.model()
+    crush_law: str = declared.crush_law()
+    archive: Path | None = declared.archive()  # where a library law is read from
 
 
 @dataclass(frozen=True)
@@ -82,20 +89,15 @@ def run(request: CompareMeasuredRequest) -> CompareMeasuredOutcome:
     airgun_xl.errors.AirgunXlError
         Bad input, named; nothing is written.
     """
+    import numpy as np
+
     from ..archive.laws import shot_with_law
     from ..models import apply_model
     from ..readers.recording import input_file, read_trace
     from ..studies.check import after_run
     from ..studies.measured import ANTI_ALIAS_ORDER, compare
-    from ..studies.shock import CFC_CLASSES, cfc_coefficients
     from ..transaction import check_output
 
-    if request.sign not in (1.0, -1.0):
-        raise OptionError(f"--sign: found {request.sign!r}, expected 1 or -1")
-    if request.align not in ("threshold", "xcorr"):
-        raise OptionError(f"--align: found {request.align!r}, expected threshold or xcorr")
-    if request.cfc is not None and request.cfc not in CFC_CLASSES:
-        cfc_coefficients(request.cfc, 1.0)  # its one-line error, before the run
     if request.output is not None:
         check_output(request.output, request.force,
                      inputs=[request.shot, input_file(request.recording)])

@@ -189,6 +189,40 @@ def some_of(choices: tuple[str, ...]) -> Read:
     return read
 
 
+def a_text_or_none(value: Any, who: str) -> str | None:
+    """A name as text (a number given is its text: ``channel=2`` is ``"2"``), or None."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (str, int)):
+        raise OptionError(f"{who}: found {value!r}, expected a name or a number as text")
+    return str(value)
+
+
+def a_sign(value: Any, who: str) -> float:
+    """1 or -1 (``"+1"``, ``1.0`` and ``"-1.0"`` read the same) [-]."""
+    try:
+        found = a_number(value, who)
+    except OptionError:
+        found = math.nan
+    if found not in (1.0, -1.0):
+        raise OptionError(f"{who}: found {value!r}, expected 1 or -1")
+    return found
+
+
+def an_anti_alias(value: Any, who: str) -> str | float:
+    """The recorder's anti-alias filter modelled: ``"auto"``, ``"none"`` or a frequency [Hz]
+    (checked against the rates once they are known)."""
+    if isinstance(value, str) and value.strip().lower() in ("auto", "none"):
+        return value.strip().lower()
+    try:
+        found = a_number(value, who)
+    except OptionError:
+        found = math.nan
+    if not 0 < found < math.inf:
+        raise OptionError(f"{who}: found {value!r}, expected auto, none or a frequency in Hz")
+    return found
+
+
 def a_law(value: Any, who: str) -> str:
     """A crush law's name: ``workbook``, ``legacy`` or ``NAME[@N]`` (checked against the
     archive where it is read)."""
@@ -248,6 +282,49 @@ def shot(help: str = SHOT_HELP) -> Any:
 def recording(help: str = RECORDING_HELP) -> Any:
     """A recording file (``RECORDING``)."""
     return positional("recording", help=help, metavar="RECORDING", read=a_recording)
+
+
+CHANNEL_HELP = ("the channel of a file of several (TDMS, .mat, .mf4, .uff, .mme): its name, "
+                "or its number as 'airgun-xl recording FILE' lists it (default: the first)")
+CFC_BOTH_HELP = ("filter both pulses: SAE J211 class 60, 180, 600 or 1000, or none (the "
+                 "default) (refused where the filter is unstable, below 4.155 x the class in "
+                 "samples a second; a warning below J211's 10 x)")
+
+
+def channel(help: str = CHANNEL_HELP) -> Any:
+    """``--channel NAME|N``: which channel of a file of several (None: the first)."""
+    return option(None, "--channel", metavar="NAME|N", help=help, read=a_text_or_none)
+
+
+def cfc(help: str = CFC_BOTH_HELP) -> Any:
+    """``--cfc N|none``: a SAE J211 class, or None for none."""
+    return option(None, "--cfc", metavar="N|none", kind="cfc", help=help, read=a_cfc)
+
+
+def sign() -> Any:
+    """``--sign 1|-1``: the recorder's axis against the macro's."""
+    return option(1.0, "--sign", metavar="1|-1", read=a_sign,
+                  help="1 (the default), or -1 when the recorder's axis is opposite to the "
+                       "macro's")
+
+
+def time_unit() -> Any:
+    return option(None, "--time-unit", help="s, ms or us (default: from the header)",
+                  read=a_text_or_none)
+
+
+def accel_unit() -> Any:
+    return option(None, "--accel-unit", read=a_text_or_none,
+                  help="g, kG or m/s^2 (default: from the header); g is standard gravity, "
+                       "9.80665 m/s^2")
+
+
+def anti_alias() -> Any:
+    """``--anti-alias HZ``: the recorder's filter modelled on a prediction."""
+    return option("auto", "--anti-alias", metavar="HZ", read=an_anti_alias,
+                  help="the recorder's anti-alias filter, modelled on the prediction as a "
+                       "4-pole Butterworth at HZ: auto (a fifth of the record's rate, the "
+                       "default), a frequency, or none")
 
 
 def output(what: str, default: str, metavar: str = "OUT.xlsx") -> Any:

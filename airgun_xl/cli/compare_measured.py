@@ -1,11 +1,15 @@
-"""``airgun-xl compare-measured SHOT.xlsx RECORDING``: the prediction against the test."""
+"""``airgun-xl compare-measured SHOT.xlsx RECORDING``: the prediction against the test; its
+options are its request's fields
+(:class:`airgun_xl.app.compare_measured.CompareMeasuredRequest`)."""
 from pathlib import Path
 
-from .recording_options import RECORDING_HELP, add_recording_options
-from .run_options import SHOT_HELP, add_crush_law, add_force, add_json, add_output, add_run_options
+from .declared import add_declared, flags_named, request_of
+from .run_options import add_json
 
 
 def add_parser(sub):
+    from ..app.compare_measured import CompareMeasuredRequest
+
     p = sub.add_parser("compare-measured",
                        help="compare the shot's predicted pulse with a measured one (a "
                             "CSV, a workbook range or a recorder's file)",
@@ -14,17 +18,7 @@ def add_parser(sub):
                                    "filter both alike (SAE J211), align them at the impact, "
                                    "and score the peak, its time, the pulse, the velocity "
                                    "change and their correlation.")
-    p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
-    p.add_argument("measured", metavar="RECORDING", help="the measured pulse: " + RECORDING_HELP)
-    add_output(p, "scores and traces", "SHOT.measured.xlsx")
-    add_force(p)
-    add_recording_options(p)
-    p.add_argument("--align", default="threshold", choices=("threshold", "xcorr"),
-                   help="impact instant: where the zeroed pulse first holds 5%% of its peak "
-                        "(or 5 sigma of its pre-trigger noise, if more) for 0.05 ms (default),"
-                        " or the cross-correlation's best lag; each checks the other")
-    add_run_options(p)
-    add_crush_law(p)
+    add_declared(p, CompareMeasuredRequest)
     add_json(p, "the scores")
     p.set_defaults(run=run)
 
@@ -35,11 +29,8 @@ def run(args):
     from .messages import report
 
     shot_path = Path(args.shot)
-    output = Path(args.output) if args.output else shot_path.with_name(
-        shot_path.stem + ".measured.xlsx")
-    request = CompareMeasuredRequest(
-        shot_path, args.measured, args.cfc, args.align, args.anti_alias, args.sign,
-        args.time_unit, args.accel_unit, args.channel, args.integrator, args.model, output,
-        args.force, args.crush_law, Path(args.archive) if args.archive else None)
-    outcome = compare_measured(request)
+    default = shot_path.with_name(shot_path.stem + ".measured.xlsx")
+    request = request_of(CompareMeasuredRequest, args, output=args.output or default)
+    with flags_named(CompareMeasuredRequest):
+        outcome = compare_measured(request)
     return report(outcome, lines(request, outcome), args.json)
