@@ -653,9 +653,9 @@ def show(entry: str, archive: str | os.PathLike[str] | None = None) -> ShowOutco
     """One archived run (``"SHOT"``, ``"SHOT@VERSION"`` or ``"#ID"``): ``doc`` holds its
     inputs, figures, provenance and files as stored; refused when ``archive verify`` would
     report it."""
-    from .app.archive import show as shown
+    from .app.archive import ShowRequest, show as run  # noqa: I001 (one import, as each)
 
-    return shown(entry, os.fspath(archive) if archive is not None else None)
+    return run(ShowRequest.given(entry=entry, archive=archive))
 
 
 @_paths_checked
@@ -665,13 +665,10 @@ def compare(entry1: str, entry2: str, archive: str | os.PathLike[str] | None = N
             force: bool = False) -> CompareOutcome:
     """Two archived runs compared, inputs first, then every series of their histories, as
     ``airgun-xl compare`` does: ``same``, ``report`` (the error table), ``files``."""
-    from .app.archive import CompareRequest
-    from .app.archive import compare as compared
+    from .app.archive import CompareRequest, compare as run  # noqa: I001 (one import)
 
-    return compared(CompareRequest(
-        entry1, entry2, os.fspath(archive) if archive is not None else None,
-        _number("--rtol", rtol), _number("--atol", atol),
-        os.fspath(report) if report is not None else None, force))
+    return run(CompareRequest.given(entry1=entry1, entry2=entry2, archive=archive, rtol=rtol,
+                                    atol=atol, report=report, force=force))
 
 
 @_paths_checked

@@ -74,5 +74,6 @@ def test_compare_measured_scores_the_recording_against_the_prediction(tmp_path, 
                  "1000", "-o", str(tmp_path / "c.xlsx")]) == 0
     assert (f"  peak {c.predicted.peak_kg:.4f} kG predicted, {c.measured.peak_kg:.4f} "
             "measured") in capsys.readouterr().out
-    with pytest.raises(OptionError, match="^align: found 'best', expected one of threshold, xcorr$"):
+    with pytest.raises(OptionError, match="^align: found 'best', expected one of "
+                                          "threshold, xcorr$"):
         airgun_xl.compare_measured(TEMPLATE, RECORDING, align="best")

@@ -14,6 +14,7 @@ import pytest
 from conftest import TEMPLATE
 
 import airgun_xl
+from airgun_xl.app.archive import CompareRequest, ShowRequest
 from airgun_xl.app.check import CheckRequest
 from airgun_xl.app.compare_measured import CompareMeasuredRequest
 from airgun_xl.app.convergence import ConvergenceRequest
@@ -31,10 +32,11 @@ DECLARED = [("srs", airgun_xl.srs, SrsRequest), ("check", airgun_xl.check, Check
             ("recording", airgun_xl.recording, RecordingRequest),
             ("template", airgun_xl.template, TemplateRequest),
             ("convergence", airgun_xl.convergence, ConvergenceRequest),
-            ("compare-measured", airgun_xl.compare_measured, CompareMeasuredRequest)]
+            ("compare-measured", airgun_xl.compare_measured, CompareMeasuredRequest),
+            ("show", airgun_xl.show, ShowRequest), ("compare", airgun_xl.compare, CompareRequest)]
 
 #: A keyword a function has always taken by position too (documented so): (function, name).
-POSITIONAL = {("convergence", "levels")}
+POSITIONAL = {("convergence", "levels"), ("show", "archive"), ("compare", "archive")}
 
 
 def _subparser(command):

@@ -25,6 +25,8 @@ from ..archive.store import prestart_index
 from ..cells import BY_ADDRESS
 from ..errors import ArchiveError, OptionError
 from ..transaction import check_output, display
+from . import declared
+from .diff import ATOL_HELP, DEFAULT_RTOL, RTOL_HELP, a_tolerance
 
 if TYPE_CHECKING:
     from .diff import DiffReport
@@ -294,9 +296,19 @@ class ShowOutcome:
     lines: tuple[str, ...]
 
 
-def show(entry: str, archive: str | None = None) -> ShowOutcome:
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class ShowRequest(declared.Checked):
+    """``show``: one archived run. Declared once (:mod:`.declared`): the command's options and
+    the API's keywords."""
+
+    entry: str = declared.positional("entry", metavar="ENTRY", read=declared.a_text,
+                                     help="SHOT (its latest run), SHOT@VERSION or #ID")
+    archive: str | None = declared.the_archive()
+
+
+def show(request: ShowRequest) -> ShowOutcome:
     """One archived run (``airgun-xl show ENTRY``): SHOT, SHOT@VERSION or #ID."""
-    return show_entry(Archive(archive_dir(archive)), entry)
+    return show_entry(Archive(archive_dir(request.archive)), request.entry)
 
 
 def show_entry(found: Archive, entry: str | Entry,
@@ -348,17 +360,24 @@ def _verdict_lines(verdict: dict[str, Any]) -> list[str]:
 # -- compare -----------------------------------------------------------------------------
 
 
-@dataclasses.dataclass(frozen=True)
-class CompareRequest:
-    """``compare``: two archived runs, inputs first, then every series of their histories."""
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class CompareRequest(declared.Checked):
+    """``compare``: two archived runs, inputs first, then every series of their histories,
+    each within ``rtol`` [-] of the series' largest magnitude (or ``atol``). Declared once
+    (:mod:`.declared`): the command's options and the API's keywords."""
 
-    entry1: str
-    entry2: str
-    archive: str | None = None
-    rtol: float = 1e-12
-    atol: float = 0.0
-    report: str | None = None  # REPORT.xlsx
-    force: bool = False
+    entry1: str = declared.positional("entry1", metavar="ENTRY1", read=declared.a_text,
+                                      help="SHOT, SHOT@VERSION or #ID")
+    entry2: str = declared.positional("entry2", metavar="ENTRY2", read=declared.a_text,
+                                      help="SHOT, SHOT@VERSION or #ID")
+    archive: str | None = declared.the_archive()
+    rtol: float = declared.option(DEFAULT_RTOL, "--rtol", read=a_tolerance,
+                                  help=RTOL_HELP.replace("column", "series"))
+    atol: float = declared.option(0.0, "--atol", help=ATOL_HELP, read=a_tolerance)
+    report: str | None = declared.option(
+        None, "--report", metavar="REPORT.xlsx", read=declared.a_folder_or_none,
+        help="also write a workbook: the input cells that differ and the error table")
+    force: bool = declared.force("REPORT.xlsx")
 
 
 @dataclasses.dataclass(frozen=True)

@@ -149,6 +149,20 @@ def a_recording(value: Any, who: str) -> str:
     raise OptionError(f"{who}: found {value!r}, expected a recording's path")
 
 
+def a_text(value: Any, who: str) -> str:
+    """Text, not empty."""
+    if not isinstance(value, str) or not value.strip():
+        raise OptionError(f"{who}: found {value!r}, expected text")
+    return value
+
+
+def a_folder_or_none(value: Any, who: str) -> str | None:
+    """A folder's path as text (a path given is its text), or None."""
+    if value is None:
+        return None
+    return str(a_path(value, who))
+
+
 def a_number(value: Any, who: str) -> float:
     """A number, given as one or as text (``"0.95"``); a bool is no number."""
     if isinstance(value, bool):
@@ -361,6 +375,12 @@ def model() -> Any:
 
 def crush_law() -> Any:
     return option("workbook", "--crush-law", help=CRUSH_LAW_HELP, metavar="LAW", read=a_law)
+
+
+def the_archive() -> Any:
+    """``--archive DIR``: the archive a command reads (None: $AIRGUN_XL_ARCHIVE)."""
+    return option(None, "--archive", help="the archive folder", metavar="DIR",
+                  read=a_folder_or_none)
 
 
 def archive() -> Any:

@@ -7,7 +7,8 @@ from ..app.archive import is_role
 from ..choices import ARCHIVE_ENV as ENV
 from ..choices import INDEX_ENV
 from ..untrusted_json import printable
-from .run_options import ATOL_HELP, RTOL_HELP, add_force, add_json, tolerance
+from .declared import add_declared, request_of
+from .run_options import add_force, add_json
 from .vocabulary import One
 
 WHERE = f"DIR defaults to ${ENV}."
@@ -52,30 +53,27 @@ def _add_history(sub):
 
 
 def _add_show(sub):
+    from ..app.archive import ShowRequest
+
     where = WHERE
     s = sub.add_parser("show", help="print one archived run: inputs, figures, provenance",
                        description=f"Print one archived run. {where}")
-    s.add_argument("entry", metavar="ENTRY", help="SHOT (its latest run), SHOT@VERSION or #ID")
-    s.add_argument("--archive", metavar="DIR", action=One, help="the archive folder")
+    add_declared(s, ShowRequest)
     s.add_argument("--json", action="store_true", help="print the run as JSON")
     s.set_defaults(run=run_show)
 
 
 def _add_compare(sub):
+    from ..app.archive import CompareRequest
+
     where = WHERE
     c = sub.add_parser("compare", help="diff two archived runs: inputs, then every series",
                        description=f"Compare two archived runs: the parameter cells first, "
                                    f"then every series of their full histories. Exit 0 when "
                                    f"they agree, 1 when they differ. {where}")
-    c.add_argument("entry1", metavar="ENTRY1", help="SHOT, SHOT@VERSION or #ID")
-    c.add_argument("entry2", metavar="ENTRY2", help="SHOT, SHOT@VERSION or #ID")
-    c.add_argument("--archive", metavar="DIR", action=One, help="the archive folder")
-    c.add_argument("--rtol", default="1e-12", help=RTOL_HELP.replace("column", "series"))
-    c.add_argument("--atol", default="0", help=ATOL_HELP)
+    add_declared(c, CompareRequest, skip=("report", "force"))
     c.add_argument("--json", action="store_true", help="print the report as JSON, as diff does")
-    c.add_argument("--report", metavar="REPORT.xlsx", action=One,
-                   help="also write a workbook: the input cells that differ and the error table")
-    add_force(c, "REPORT.xlsx")
+    add_declared(c, CompareRequest, only=("report", "force"))
     c.set_defaults(run=run_compare)
 
 
@@ -156,9 +154,9 @@ def _run_chain(args):
 
 
 def run_show(args):
-    from ..app.archive import show
+    from ..app.archive import ShowRequest, show
 
-    outcome = show(args.entry, args.archive)
+    outcome = show(request_of(ShowRequest, args))
     if args.json:
         print(json.dumps(outcome.doc, indent=1))
     else:
@@ -169,9 +167,7 @@ def run_show(args):
 def run_compare(args):
     from ..app.archive import CompareRequest, compare
 
-    rtol, atol = tolerance("--rtol", args.rtol), tolerance("--atol", args.atol)
-    outcome = compare(CompareRequest(args.entry1, args.entry2, args.archive, rtol, atol,
-                                     args.report, args.force))
+    outcome = compare(request_of(CompareRequest, args))
     if args.json:
         print(json.dumps(outcome.report.as_dict(), indent=1, default=str))
     else:
