@@ -21,7 +21,11 @@ this recorder's noise would be). Then:
   shot fired from the workbook it wrote;
 - **by hand**: the velocity scaled by (target / measured peak) ^ (1 / gamma), gamma the
   model's own d ln(peak) / d ln(v) on the nominal law at the velocity fired.
-Both meet the same lots and the same draws of the gun, zeta and the recorder's noise.
+Both meet the same lots and the same draws of the gun, zeta and the recorder's noise. Beside
+each shot fired from a proposal, `--replicates` more (3 by default: draws of their own) are
+fired and judged, so that each band of predicted P(PASS) holds enough shots to be judged; they
+do not enter the lot's chain. Each proposal's expected judged figures and the measured ones of
+its shots are placed in their tolerances (the middle half: within half the half-width).
 
 `--call` times one `airgun-xl next` as a whole process on a lot of 5 recorded shots (the
 fifth, with the default 2,000 draws a setting; alone, with `--vary E13`, and with `--gun`
@@ -37,6 +41,7 @@ least as good as by hand at every shot count, and every band of 30 or more shots
 mean prediction inside the observed rate's interval).
 """
 import argparse
+import dataclasses
 import math
 import statistics
 import sys
@@ -66,13 +71,21 @@ RECORDER = Recorder(rate=51_200, noise=0.01, offset_g=20.0, pre_trigger=1.5e-3, 
                     colour=0.9, colour_share=0.5, full_scale=30.0, bits=16)
 
 
+#: The harder lab's settings (main's options): the gun's mean offset [-], the spread of a
+#: curvature of the law with speed the model's scale and tilt cannot take [-], the recorder.
+LAB = {"bias": 0.0, "curvature": 0.0, "recorder": RECORDER}
+
+
 def true_law(rng):
-    """A lot's law: the report's, scaled and tilted with speed."""
+    """A lot's law: the report's, scaled and tilted with speed (and, with ``--curvature``,
+    bent: a shape the update's scale and tilt cannot represent)."""
     scale = max(0.6, rng.normal(1.0, LOT_SPREAD))
     tilt = rng.normal(0.0, TILT_SPREAD)
+    bend = rng.normal(0.0, LAB["curvature"]) if LAB["curvature"] else 0.0
     lo, hi = CRUSH_FIT_RANGE
     nodes = _chebyshev_nodes(lo, hi, 7)
-    values = crush_factor(nodes, LEGACY_LAW) * scale * (1 + tilt * (nodes - 240.0) / 240.0)
+    x = (nodes - 240.0) / 240.0
+    values = crush_factor(nodes, LEGACY_LAW) * scale * (1 + tilt * x) * (1 + bend * x * x)
     return law_through(nodes, values, CRUSH_FIT_RANGE)
 
 
@@ -87,9 +100,9 @@ def with_velocity(path, v):
 def fire(workbook, law, draws, path):
     """The lab fires ``workbook`` on a lot of law ``law``; the recorder's CSV at ``path``."""
     p = airgun_xl.load(workbook).params
-    v = p.v31 * (1 + GUN * draws[0])
+    v = p.v31 * (1 + LAB["bias"] + GUN * draws[0])
     q = p.replace(v31=v, v32=v, v33=v, zeta=p.zeta * (1 + ZETA * draws[1]), crush_law=law)
-    trace = RECORDER.record(airgun_xl.Shot(params=q).run(), seed=int(draws[2]))
+    trace = LAB["recorder"].record(airgun_xl.Shot(params=q).run(), seed=int(draws[2]))
     path.write_text("time [s],acceleration [kG]\n" + "".join(
         f"{t!r},{a!r}\n" for t, a in zip(trace.time.tolist(), trace.accel_kg.tolist(),
                                            strict=True)))
@@ -131,13 +144,45 @@ def by_hand(lot, law, first, work, draws):
 REFUSED: list[tuple[int, int, str]] = []
 
 
-def with_next(lot, law, first, work, draws, n_draws, calls, vary=None, gun=None):
+#: Where each tolerance's nominal and half-width sit: (nominal, half-width) in the verdict's
+#: units (kG, ms), from SPEC.
+TOLERANCES = {"peak": (8.5, 0.425), "duration": (5.0, 1.0)}
+
+#: Per proposal fired: {"expected": {figure: position}, "measured": [{figure: position}]},
+#: a position (value - nominal) / half-width (-1 and 1 the limits; the middle half within
+#: 0.5).
+CENTRES: list[dict] = []
+
+
+def positions(figures):
+    """{figure: (value - nominal) / half-width} of ``figures`` {name: value in kG or ms}."""
+    return {k: (figures[k] - mid) / half for k, (mid, half) in TOLERANCES.items()
+            if k in figures and math.isfinite(figures[k])}
+
+
+def replicates(shot, law, lot, k, count, work):
+    """``count`` more shots fired from the proposal ``shot`` (the lot's ``k``-th shot), each
+    its own draw of the gun, zeta and the recorder's noise (a stream of its own, so the lot's
+    own draws stay the by-hand rule's): [(passed, {figure: value})]."""
+    rng = np.random.default_rng([1000 + lot, k, 77])
+    out = []
+    for r in range(count):
+        draw = (rng.normal(), rng.normal(), int(rng.integers(1 << 30)))
+        rec = fire(shot, law, draw, work / f"rep{k}_{r}.csv")
+        verdict = airgun_xl.accept(shot, rec, **SPEC)
+        out.append((verdict.passed, {c.name: c.value for c in verdict.criteria}))
+    return out
+
+
+def with_next(lot, law, first, work, draws, n_draws, calls, vary=None, gun=None,
+              count=0):
     """Shots to the first PASS by next; each (predicted P(PASS), passed) of a proposal
-    fired. Every lot in one archive (``work``'s parent's), as a lab keeps one; with ``gun``,
-    the gun's scatter pooled over them (``next --gun``); ``calls`` gets (seconds, the gun's
-    words, the law's update)."""
+    fired, and of ``count`` replicates fired from each proposal beside it. Every lot in one
+    archive (``work``'s parent's), as a lab keeps one; with ``gun``, the gun's scatter
+    pooled over them (``next --gun``); ``calls`` gets (seconds, the gun's words, the law's
+    update)."""
     shot = with_velocity(work / "next0.xlsx", first)
-    predicted, record = None, []
+    predicted, record, expected = None, [], {}
     # one lab, one archive: the lots' pairs of expected and measured figures are the model
     # error's record (issue 60); with a per-lot archive every lot drew the prior
     archive = work.parent / "archive"
@@ -156,9 +201,16 @@ def with_next(lot, law, first, work, draws, n_draws, calls, vary=None, gun=None)
         calls.append((time.perf_counter() - started, out.gun, out.update))
         if predicted is not None:
             record.append((predicted, out.verdict.passed))
+            fired = [(out.verdict.passed, {c.name: c.value for c in out.verdict.criteria}),
+                     *replicates(shot, law, lot, k, count, work)]
+            record += [(predicted, passed) for passed, _ in fired[1:]]
+            CENTRES.append({"expected": expected,
+                            "measured": [positions(f) for _, f in fired]})
         if out.verdict.passed:
             return k + 1, record
         predicted, shot = out.best.probability, out.output
+        expected = positions({name: v[1] * (1e3 if name == "duration" else 1.0)
+                              for name, v in out.best.figures.items()})
     return MOST_SHOTS + 1, record
 
 
@@ -296,6 +348,16 @@ def main():
                              "over the lots once they hold 7 shots beyond each lot's first")
     parser.add_argument("--call", action="store_true",
                         help="time one next on a lot of 5 shots as a whole process")
+    parser.add_argument("--gun-bias", type=float, default=0.0, metavar="F",
+                        help="the gun's mean offset, e.g. -0.02: 2 %% slow (default 0)")
+    parser.add_argument("--curvature", type=float, default=0.0, metavar="F",
+                        help="the spread of a bend of each lot's law with speed, "
+                             "(1 + c ((v - 240) / 240)^2), that scale and tilt cannot take")
+    parser.add_argument("--rate", type=float, default=RECORDER.rate, metavar="HZ",
+                        help="the recorder's rate (default 51,200; its anti-alias a fifth)")
+    parser.add_argument("--replicates", type=int, default=3,
+                        help="more shots fired from each proposal, each judged: the bands of "
+                             "predicted P(PASS) get enough shots to be judged (default 3)")
     parser.add_argument("--quick", action="store_true",
                         help="one lot, 200 draws: shows the benchmark runs, measures nothing")
     args = parser.parse_args()
@@ -309,6 +371,8 @@ def main():
                       "met" if wall <= 10 and rss <= 1024 else "NOT met")
             print(f"{label:<36} {wall:6.2f} s  {rss:6.0f} MB  (target 10 s, 1 GB: {judged})")
         return 0
+    LAB.update(bias=args.gun_bias, curvature=args.curvature,
+               recorder=dataclasses.replace(RECORDER, rate=args.rate))
     lots, n_draws = (1, 200) if args.quick else (args.lots, args.draws)
     started = time.perf_counter()
     first, p_first = first_setting(max(n_draws, 400))
@@ -323,7 +387,8 @@ def main():
             work = Path(tmp) / f"lot{lot}"
             work.mkdir()
             shots, record = with_next(lot, law, first, work, draws, n_draws, calls,
-                                      args.vary, "GUN-1" if args.gun else None)
+                                      args.vary, "GUN-1" if args.gun else None,
+                                      1 if args.quick else args.replicates)
             results["next"].append(shots)
             honest_record += record
             results["by hand"].append(by_hand(lot, law, first, work, draws))
@@ -344,7 +409,9 @@ def main():
                f"law); {time.perf_counter() - started:.0f} s, next"
                f"{f' --vary {args.vary}' if args.vary else ''}"
                f"{' --gun' if args.gun else ''} "
-               f"{statistics.median(c for c, _, _ in calls):.2f} s a call (median)\n")
+               f"{statistics.median(c for c, _, _ in calls):.2f} s a call (median); the lab: "
+               f"gun offset {args.gun_bias:+.1%}, law bend spread {args.curvature:.0%}, "
+               f"recorder {args.rate:,.0f} Hz\n")
     widths = [max(len(r[i]) for r in rows) for i in range(6)]
     for r in rows:
         print("  ".join(cell.ljust(w) for cell, w in zip(r, widths, strict=True)))
@@ -372,9 +439,20 @@ def main():
         print(f"\nnext --gun: {len(calls) - len(pooled)} calls drew the scatter given, "
               f"{len(pooled)} the pooled estimate; the last: "
               f"{pooled[-1] if pooled else 'none'}")
+    if CENTRES:
+        print(f"\ncentring, {len(CENTRES)} proposals fired (with {args.replicates} replicates "
+              "each): the share in the middle half of each tolerance, and the mean position "
+              "(-1 and 1 the limits)")
+        for name in TOLERANCES:
+            exp = [c["expected"][name] for c in CENTRES if name in c["expected"]]
+            got = [m[name] for c in CENTRES for m in c["measured"] if name in m]
+            print(f"  {name}: expected {np.mean(np.abs(exp) <= 0.5):.1%} in the middle half "
+                  f"(mean {np.mean(exp):+.2f}); measured {np.mean(np.abs(got) <= 0.5):.1%} "
+                  f"(mean {np.mean(got):+.2f}, {len(got)} shots)")
     if honest_record:
         predicted, passed = zip(*honest_record, strict=True)
-        print(f"\nnext's predictions, {len(predicted)} shots fired from its proposals: Brier "
+        print(f"\nnext's predictions, {len(predicted)} shots fired from its proposals "
+              f"({args.replicates} replicates with each): Brier "
               f"{brier(predicted, passed):.4f}")
         for band in reliability(predicted, passed):
             if band.shots:
