@@ -171,7 +171,7 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
     return run(AcceptRequest(
         Path(shot), os.fspath(recording), fields, Path(output) if output is not None else None,
         force, Path(archive) if archive is not None else None, channel,
-        _number("--sign", sign), time_unit, accel_unit, ("accept",), crush_law,
+        _sign(sign), time_unit, accel_unit, ("accept",), crush_law,
         _path("--pdf", pdf) if pdf is not None else None, bool(reproducible)))
 
 
@@ -217,7 +217,7 @@ def calibrate(*files: str | os.PathLike[str], law: bool = False,
     names = fit if fit is None or isinstance(fit, str) else ",".join(fit)
     return run(CalibrateRequest(
         tuple(zip(texts[::2], texts[1::2], strict=True)), law, names, objective,
-        _whole("--degree", degree), record, _number("--sign", sign), time_unit, accel_unit,
+        _whole("--degree", degree), record, _sign(sign), time_unit, accel_unit,
         channel, anti_alias, integrator,
         Path(output) if output is not None else None, force,
         Path(archive) if archive is not None else None, name, ("calibrate",)))
@@ -488,6 +488,14 @@ def _number(option: str, value: object) -> float:
         raise OptionError(f"{option}: found {value!r}, expected a number") from None
 
 
+def _sign(value: object) -> float:
+    """``sign``: 1 or -1, read as every converted request reads it
+    (:func:`airgun_xl.app.declared.a_sign`), a refusal naming the keyword."""
+    from .app.declared import a_sign
+
+    return a_sign(value, "sign")
+
+
 def _whole(option: str, value: object) -> int:
     """A whole number given as one or as text (``"64"``); else one line naming the option."""
     number = _number(option, value)
@@ -715,7 +723,7 @@ def next_shot(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *
     return run(NextRequest(
         Path(shot), os.fspath(recording), Path(archive), lot, fields, new_lot, _texts(sd),
         _number("--confidence", confidence), _whole("--shots", shots), _whole("--seed", seed),
-        channel, _number("--sign", sign), time_unit, accel_unit, integrator,
+        channel, _sign(sign), time_unit, accel_unit, integrator,
         Path(output) if output is not None else None, force, ("next",),
         None if vary is None else str(vary), None if scheduler is None else str(scheduler),
         None if workers is None else _whole("--workers", workers),

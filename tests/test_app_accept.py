@@ -104,7 +104,7 @@ def test_nothing_is_written_unless_asked_and_what_is_written_is_listed(tmp_path,
 @pytest.mark.parametrize("given, named", [
     ({"peak": "12KG"}, "--peak: found the unit 'KG'"),
     ({"peak": "40g:10%", "cfc": 42}, "--cfc: found '42', expected a J211 class"),
-    ({"peak": "40g:10%", "sign": 2}, "--sign: found 2.0, expected 1 or -1"),
+    ({"peak": "40g:10%", "sign": 2}, "sign: found 2, expected 1 or -1"),
     ({"peak": "40g:10%", "archive": "lab"}, "--archive: found no verdict workbook"),
     ({}, "its Specification sheet is empty and no option gives a criterion"),
 ])

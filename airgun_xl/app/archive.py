@@ -296,12 +296,21 @@ class ShowOutcome:
     lines: tuple[str, ...]
 
 
+def an_entry(value: Any, who: str) -> str:
+    """An archived run's name: ``SHOT``, ``SHOT@VERSION`` or ``#ID`` (found in the archive
+    where it is read)."""
+    if not isinstance(value, str) or not value.strip():
+        found = "an empty name" if value == "" else repr(value)
+        raise OptionError(f"{who}: found {found}, expected SHOT, SHOT@VERSION or #ID")
+    return value
+
+
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class ShowRequest(declared.Checked):
     """``show``: one archived run. Declared once (:mod:`.declared`): the command's options and
     the API's keywords."""
 
-    entry: str = declared.positional("entry", metavar="ENTRY", read=declared.a_text,
+    entry: str = declared.positional("entry", metavar="ENTRY", read=an_entry,
                                      help="SHOT (its latest run), SHOT@VERSION or #ID")
     archive: str | None = declared.the_archive()
 
@@ -366,9 +375,9 @@ class CompareRequest(declared.Checked):
     each within ``rtol`` [-] of the series' largest magnitude (or ``atol``). Declared once
     (:mod:`.declared`): the command's options and the API's keywords."""
 
-    entry1: str = declared.positional("entry1", metavar="ENTRY1", read=declared.a_text,
+    entry1: str = declared.positional("entry1", metavar="ENTRY1", read=an_entry,
                                       help="SHOT, SHOT@VERSION or #ID")
-    entry2: str = declared.positional("entry2", metavar="ENTRY2", read=declared.a_text,
+    entry2: str = declared.positional("entry2", metavar="ENTRY2", read=an_entry,
                                       help="SHOT, SHOT@VERSION or #ID")
     archive: str | None = declared.the_archive()
     rtol: float = declared.option(DEFAULT_RTOL, "--rtol", read=a_tolerance,

@@ -149,13 +149,6 @@ def a_recording(value: Any, who: str) -> str:
     raise OptionError(f"{who}: found {value!r}, expected a recording's path")
 
 
-def a_text(value: Any, who: str) -> str:
-    """Text, not empty."""
-    if not isinstance(value, str) or not value.strip():
-        raise OptionError(f"{who}: found {value!r}, expected text")
-    return value
-
-
 def a_folder_or_none(value: Any, who: str) -> str | None:
     """A folder's path as text (a path given is its text), or None."""
     if value is None:

@@ -69,16 +69,24 @@ def request_of(request: type, args: argparse.Namespace, **given: Any) -> Any:
         return request(**values)
 
 
+def _spelt(spelt: Any) -> str:
+    """How the command line names an option: its flag, or a positional's metavar
+    (``ENTRY``)."""
+    if spelt.kind == "positional" and spelt.metavar:
+        return str(spelt.metavar)
+    return str(spelt.flags[-1])
+
+
 @contextlib.contextmanager
 def flags_named(request: type) -> Iterator[None]:
     """A refusal that names fields of ``request`` (``q: ...``; of two fields together,
     ``lo/hi: ...``), raised while making it or running it, said with their flags instead
-    (``--srs-q: ...``)."""
+    (``--srs-q: ...``; a positional by its metavar, ``ENTRY: ...``)."""
     try:
         yield
     except OptionError as exc:
         prefix, colon, rest = str(exc).partition(": ")
-        flags = {f.name: option_of(f).flags[-1] for f in dataclasses.fields(request)}
+        flags = {f.name: _spelt(option_of(f)) for f in dataclasses.fields(request)}
         names = prefix.split("/")
         if colon and all(name in flags for name in names):
             raise OptionError("/".join(flags[n] for n in names) + ": " + rest) from None
