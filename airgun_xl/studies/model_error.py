@@ -13,8 +13,10 @@ Each measured figure differs from the model's median for two reasons: the inputs
 draws anyway (the gun's scatter, zeta's, the law's own uncertainty), and the model's error. A
 pair carries the spread the drawn inputs explain (the standard deviation of the log, from the
 90 % range of the model's own draws before its error was drawn); the model's error is the rest:
-the pairs' variance less the mean explained variance, never below :data:`MIN_SD` squared (the
-inputs drawn twice would make a probability too low; the rest not taken out, too high).
+the pairs' variance less the mean explained variance, never below the sampling error of that
+variance (``s^2 sqrt(2 / (n - 1))`` of ``n`` pairs: a rest the pairs cannot tell from zero is not
+claimed as zero) nor :data:`MIN_SD` squared (the inputs drawn twice would make a probability
+too low; the rest not taken out, too high).
 
 - A figure with :data:`MIN_PAIRS` or more pairs is learnt: the figures so learnt take the
   pairs' sample mean and covariance (over the pairs complete in them; the variances net of
@@ -179,7 +181,12 @@ class ModelError:
         net of the variances the inputs explain; the others the prior's."""
         sample = np.atleast_2d(np.cov(logs, rowvar=False, ddof=1))
         inputs = variances.mean(axis=0)
-        net = np.sqrt(np.maximum(np.diag(sample) - inputs, MIN_SD ** 2))
+        # what is left once the inputs are taken out, never below the sampling error of the
+        # pairs' own variance (a normal's: s^2 sqrt(2 / (n - 1))): a rest the pairs cannot
+        # tell from zero is not claimed as zero
+        resolution = np.diag(sample) * math.sqrt(2 / (n - 1))
+        net = np.sqrt(np.maximum.reduce([np.diag(sample) - inputs, resolution,
+                                         np.full(len(inputs), MIN_SD ** 2)]))
         raw = np.sqrt(np.diag(sample))
         with np.errstate(invalid="ignore", divide="ignore"):
             corr = sample / np.outer(raw, raw)
