@@ -3,15 +3,9 @@
 import argparse
 
 from ..app.declared import INTEGRATOR_HELP, MODEL_HELP, SHOT_HELP
-from ..app.diff import ATOL_HELP, RTOL_HELP, a_tolerance
 from ..choices import INTEGRATORS, MODELS
 
-__all__ = ["ATOL_HELP", "INTEGRATOR_HELP", "MODEL_HELP", "RTOL_HELP", "SHOT_HELP"]
-
-
-def tolerance(option, text):
-    """A tolerance option's value: a number >= 0 [-] (``diff``'s grammar)."""
-    return a_tolerance(text, option)
+__all__ = ["INTEGRATOR_HELP", "MODEL_HELP", "SHOT_HELP"]
 
 
 def add_integrator(p, repeated=False):
