@@ -177,7 +177,7 @@ class ModelError:
         sds: list[float] = []
         spreads: list[float] = []
         means: list[float] = []
-        k = float(PRIOR_PAIRS)
+        w = float(PRIOR_PAIRS)
         for j, f in enumerate(FIGURES):
             has = np.isfinite(logs[:, j])
             column = logs[has, j]
@@ -189,13 +189,13 @@ class ModelError:
             # (as learnt; with 3 pairs or fewer that error is the variance itself)
             net = max(seen - inputs, seen * min(1.0, math.sqrt(2 / (m - 1))) if m >= 2
                       else 0.0, MIN_SD ** 2)
-            # the conjugate normal model's weighing: the prior as k pairs of its variance
+            # the conjugate normal model's weighing: the prior as w pairs of its variance
             # and no bias, the pairs' own variance on m - 1 degrees, and their mean's
             # distance from the prior's none
-            pooled = (k * PRIOR_SD[f] ** 2 + (m - 1) * net * (m >= 2)
-                      + k * m * mean ** 2 / (k + m)) / (k + m)
+            pooled = (w * PRIOR_SD[f] ** 2 + (m - 1) * net * (m >= 2)
+                      + w * m * mean ** 2 / (w + m)) / (w + m)
             sds.append(math.sqrt(pooled))
-            means.append(m * mean / (k + m))
+            means.append(m * mean / (w + m))
             spreads.append(math.sqrt(inputs))
         return cls._diagonal(sds, len(logs), tuple(spreads), tuple(means))
 
