@@ -507,11 +507,11 @@ def _whole(option: str, value: object) -> int:
 @_paths_checked
 def sweep(shot: str | os.PathLike[str], vary: str | Sequence[str] = (), *,
           mc: int | str | None = None, sd: str | Sequence[str] = (),
-          sobol: int | str | None = None, seed: int = 1, integrator: str = "legacy",
+          sobol: int | str | None = None, seed: int | str = 1, integrator: str = "legacy",
           model: str = "4-mass", output: str | os.PathLike[str] | None = None,
-          force: bool = False, crush_law: str = "workbook",
-          archive: str | os.PathLike[str] | None = None, scheduler: str | None = None,
-          workers: int | None = None, chunk: int | None = None) -> SweepOutcome:
+          force: bool = False, scheduler: str | None = None, workers: int | None = None,
+          chunk: int | None = None, crush_law: str = "workbook",
+          archive: str | os.PathLike[str] | None = None) -> SweepOutcome:
     """Run a grid of shots, a Monte Carlo or Sobol indices, as ``airgun-xl sweep`` does.
 
     Parameters
@@ -540,15 +540,12 @@ def sweep(shot: str | os.PathLike[str], vary: str | Sequence[str] = (), *,
     AirgunXlError
         Bad input, named; nothing is written.
     """
-    from pathlib import Path
-
     from .app.sweep import SweepRequest, run
 
-    return run(SweepRequest(
-        Path(shot), _texts(vary), None if mc is None else str(mc), _texts(sd),
-        None if sobol is None else str(sobol), _whole("--seed", seed), integrator, model,
-        Path(output) if output is not None else None, force, crush_law,
-        Path(archive) if archive is not None else None, scheduler, workers, chunk))
+    return run(SweepRequest.given(
+        shot=shot, vary=vary, mc=mc, sd=sd, sobol=sobol, seed=seed, integrator=integrator,
+        model=model, output=output, force=force, scheduler=scheduler, workers=workers,
+        chunk=chunk, crush_law=crush_law, archive=archive))
 
 
 def _fill_settings(command: str, output: str | os.PathLike[str] | None,

@@ -45,7 +45,26 @@ class OutputError(AirgunXlError):
 
 
 class OptionError(AirgunXlError):
-    """A command-line option has a value the command cannot use."""
+    """An option (a keyword of the Python API, a flag of the command line) has a value the
+    command cannot use.
+
+    Parameters
+    ----------
+    message : str
+        The line, naming the keywords as the Python API spells them.
+    template : str, optional
+        The line with the keywords as ``{0}``, ``{1}``... (in ``fields``' order) and any
+        other value as a named field of ``values``: the command line says it again with its
+        flags (:func:`airgun_xl.cli.declared.flags_named`).
+    fields : tuple of str
+        The keywords the line names.
+    values : dict
+        The template's other fields.
+    """
+
+    def __init__(self, message, template=None, fields=(), values=None):
+        super().__init__(message)
+        self.template, self.fields, self.values = template, tuple(fields), dict(values or {})
 
 
 class ResourceError(AirgunXlError):

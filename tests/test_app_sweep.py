@@ -52,7 +52,7 @@ def test_a_monte_carlo_repeats_from_its_seed_and_its_spread_is_the_frames():
 
 def test_the_workbook_written_holds_the_frames_figures(tmp_path, capsys):
     out = tmp_path / "s.xlsx"
-    outcome = run(SweepRequest(TEMPLATE, ("A28=150:250:3",), output=out))
+    outcome = run(SweepRequest(shot=TEMPLATE, vary=("A28=150:250:3",), output=out))
     assert outcome.files == (out,) and out.is_file()
     assert outcome.warnings[0].endswith(f"see the Warnings column and sheet of {out}")
     book = openpyxl.load_workbook(out, read_only=True)
@@ -67,15 +67,41 @@ def test_the_workbook_written_holds_the_frames_figures(tmp_path, capsys):
             "over the grid") in capsys.readouterr().out
 
 
-@pytest.mark.parametrize("given, said", [
-    ({"vary": "A99=1:2:3"}, "--vary: found 'A99'"),
-    ({"vary": "A28=1:2:0"}, "--vary: found 'A28=1:2:0'"),
-    ({"mc": 10}, "--mc: found '10' without --sd"),
-    ({"mc": 10, "sobol": 8, "sd": "E40=3%"}, "--sobol: found it with --mc"),
-    ({}, "--vary: found none"),
-])
-def test_bad_keywords_are_one_line_naming_the_option_and_write_nothing(given, said, tmp_path):
+#: (keywords, the API's line, the command line's arguments, its line): the API names the
+#: keyword, the command its flag, in one line each, and neither writes anything.
+BAD = [
+    ({"vary": "A99=1:2:3"}, "vary: found 'A99'", ["--vary", "A99=1:2:3"], "--vary: found 'A99'"),
+    ({"vary": "A28=1:2:0"}, "vary: found 'A28=1:2:0'", ["--vary", "A28=1:2:0"],
+     "--vary: found 'A28=1:2:0'"),
+    ({"mc": 10}, "mc: found 10 without sd, expected the spreads of the inputs to draw (sd "
+     "CELL=SD[%])", ["--mc", "10"], "--mc: found 10 without --sd, expected the spreads of the "
+     "inputs to draw (--sd CELL=SD[%])"),
+    ({"mc": 10, "sobol": 8, "sd": "E40=3%"}, "sobol: found it with mc, expected one or the other",
+     ["--mc", "10", "--sobol", "8", "--sd", "E40=3%"],
+     "--sobol: found it with --mc, expected one or the other"),
+    ({}, "vary: found none, expected CELL=LO:HI:N (or mc N with sd)", [],
+     "--vary: found none, expected CELL=LO:HI:N (or --mc N with --sd)"),
+    ({"mc": 1}, "mc: found 1, expected a number of shots from 2 to 10,000,000",
+     ["--mc", "1"], "--mc: found '1', expected a number of shots from 2 to 10,000,000"),
+    ({"sd": ["E40=3%", "E40=5%"], "mc": 8}, "sd: found E40 twice",
+     ["--sd", "E40=3%", "--sd", "E40=5%", "--mc", "8"], "--sd: found E40 twice"),
+    ({"seed": -1, "mc": 8, "sd": "E40=3%"}, "seed: found -1, expected a whole number from 0",
+     ["--seed", "-1", "--mc", "8", "--sd", "E40=3%"],
+     "--seed: found '-1', expected a whole number from 0"),
+    ({"workers": "two", "vary": "A28=1:2:2"}, "workers: found 'two', expected a whole number",
+     ["--workers", "two", "--vary", "A28=1:2:2"], "--workers: found 'two', expected a whole "
+     "number"),
+]
+
+
+@pytest.mark.parametrize("given, said, argv, flagged", BAD, ids=[b[1][:24] for b in BAD])
+def test_bad_keywords_are_one_line_naming_the_option_and_write_nothing(given, said, argv,
+                                                                       flagged, tmp_path,
+                                                                       capsys):
     with pytest.raises(OptionError) as caught:
         airgun_xl.sweep(TEMPLATE, output=tmp_path / "s.xlsx", **given)
     assert str(caught.value).startswith(said) and "\n" not in str(caught.value)
+    assert main(["sweep", str(TEMPLATE), "-o", str(tmp_path / "c.xlsx"), *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"airgun-xl: error: {flagged}") and err.count("\n") == 1, err
     assert list(tmp_path.iterdir()) == []

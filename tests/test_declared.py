@@ -22,6 +22,7 @@ from airgun_xl.app.declared import option_of
 from airgun_xl.app.diff import DiffRequest
 from airgun_xl.app.recording import RecordingRequest
 from airgun_xl.app.srs import SrsRequest
+from airgun_xl.app.sweep import SweepRequest
 from airgun_xl.app.template import TemplateRequest
 from airgun_xl.cli.commands import build_parser
 from airgun_xl.errors import OptionError
@@ -33,10 +34,12 @@ DECLARED = [("srs", airgun_xl.srs, SrsRequest), ("check", airgun_xl.check, Check
             ("template", airgun_xl.template, TemplateRequest),
             ("convergence", airgun_xl.convergence, ConvergenceRequest),
             ("compare-measured", airgun_xl.compare_measured, CompareMeasuredRequest),
-            ("show", airgun_xl.show, ShowRequest), ("compare", airgun_xl.compare, CompareRequest)]
+            ("show", airgun_xl.show, ShowRequest), ("compare", airgun_xl.compare, CompareRequest),
+            ("sweep", airgun_xl.sweep, SweepRequest)]
 
 #: A keyword a function has always taken by position too (documented so): (function, name).
-POSITIONAL = {("convergence", "levels"), ("show", "archive"), ("compare", "archive")}
+POSITIONAL = {("convergence", "levels"), ("show", "archive"), ("compare", "archive"),
+              ("sweep", "vary")}
 
 
 def _subparser(command):

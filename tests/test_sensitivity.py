@@ -88,7 +88,7 @@ def test_monte_carlo_workbook_has_the_band_sheet(tmp_path):
                                                              "power of 2"),
     (["--sobol", "64", "--sd", "E40=3%"], "--sd: found 1, expected two or more"),
     (["--sobol", "64", "--mc", "10", "--sd", "E40=3%"], "--sobol: found it with --mc"),
-    (["--sobol", "64"], "--sobol: found '64' without --sd"),
+    (["--sobol", "64"], "--sobol: found 64 without --sd"),
 ])
 def test_bad_sobol_options(tmp_path, capsys, args, start):
     out = tmp_path / "o.xlsx"

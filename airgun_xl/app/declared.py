@@ -54,16 +54,17 @@ class Option:
     kind : str
         ``"value"`` (given once, its value read by the grammar), ``"switch"`` (present or
         not), ``"choice"`` (one of ``choices``), ``"integrators"`` (an integrator, given
-        again for each run side by side), ``"cfc"`` (a J211 class or ``none``, told apart
-        from a specification's) or ``"positional"``.
+        again for each run side by side), ``"repeated"`` (given once for each value, the
+        values read together), ``"cfc"`` (a J211 class or ``none``, told apart from a
+        specification's) or ``"positional"``.
     choices : tuple of str
         For a ``"choice"``.
     aliases : tuple of tuple of str
         Old spellings kept one release, each ``(flag, idea)`` (the idea as
         :data:`airgun_xl.cli.vocabulary.VOCABULARY` names it).
-    cli_default : object
-        What the command line stores when the option is not given, when it is not the
-        field's default (``--output``'s None stands for the command's own default name).
+    group : str or None
+        Options of one group name exclude each other on the command line (``--scheduler``
+        or ``--workers``).
     """
 
     flags: tuple[str, ...]
@@ -72,18 +73,27 @@ class Option:
     kind: str = "value"
     choices: tuple[str, ...] = ()
     aliases: tuple[tuple[str, str], ...] = ()
+    group: str | None = None
 
 
 def _keep(value: Any, who: str) -> Any:
     return value
 
 
+def refusal(template: str, *fields: str, **values: Any) -> OptionError:
+    """A refusal naming several fields (``{0}`` ... in ``template``, ``fields`` their names,
+    the other fields ``values``): the Python API's line names the keywords, the command
+    line's the flags (``refusal("{0}: found it with {1}", "sobol", "mc")``)."""
+    return OptionError(template.format(*fields, **values), template, fields, values)
+
+
 def option(default: Any, *flags: str, help: str, read: Read = _keep,
            metavar: str | None = None, kind: str = "value", choices: tuple[str, ...] = (),
-           aliases: tuple[tuple[str, str], ...] = ()) -> Any:
+           aliases: tuple[tuple[str, str], ...] = (), group: str | None = None) -> Any:
     """A request's field with a default, spelt ``flags`` on the command line."""
     return dataclasses.field(default=default, metadata={
-        "option": Option(tuple(flags), help, metavar, kind, choices, aliases), "read": read})
+        "option": Option(tuple(flags), help, metavar, kind, choices, aliases, group),
+        "read": read})
 
 
 def positional(name: str, *, help: str, read: Read = _keep, metavar: str | None = None
@@ -194,6 +204,52 @@ def some_of(choices: tuple[str, ...]) -> Read:
                               f"{', '.join(sorted(choices))}")
         return tuple(dict.fromkeys(pick(v, who) for v in given))
     return read
+
+
+def a_whole(value: Any, who: str, lo: int | None = None, hi: int | None = None) -> int:
+    """A whole number, given as one (an ``int``, or a float without a fraction) or as text
+    (``"64"``, ``"1e3"``), within ``lo`` to ``hi`` when given; a bool is no number."""
+    found: int | None = None
+    if isinstance(value, int) and not isinstance(value, bool):
+        found = value
+    elif isinstance(value, str) and value.strip().lstrip("+-").isdigit():
+        found = int(value)
+    else:
+        try:
+            number = a_number(value, who)
+        except OptionError:
+            number = math.nan
+        if math.isfinite(number) and number.is_integer():
+            found = int(number)
+    span = ("" if lo is None and hi is None else f" from {lo:,}" if hi is None
+            else f" from {lo:,} to {hi:,}" if lo is not None else f" up to {hi:,}")
+    if found is None or (lo is not None and found < lo) or (hi is not None and found > hi):
+        raise OptionError(f"{who}: found {value!r}, expected a whole number{span}")
+    return found
+
+
+def a_whole_or_none(value: Any, who: str) -> int | None:
+    """A whole number, or None."""
+    return None if value is None else a_whole(value, who)
+
+
+def a_seed(value: Any, who: str) -> int:
+    """A seed of random draws: a whole number from 0 to 2**128 - 1 (numpy's)."""
+    try:
+        return a_whole(value, who, 0, 2**128 - 1)
+    except OptionError:
+        raise OptionError(f"{who}: found {value!r}, expected a whole number from 0 to "
+                          "2**128 - 1") from None
+
+
+def texts(value: Any, who: str) -> tuple[str, ...]:
+    """One text or several (None: none), as a tuple of text; anything else refused."""
+    if value is None:
+        return ()
+    given = [value] if isinstance(value, str) else value
+    if not isinstance(given, (list, tuple)) or not all(isinstance(t, str) for t in given):
+        raise OptionError(f"{who}: found {value!r}, expected a text or a list of texts")
+    return tuple(given)
 
 
 def a_text_or_none(value: Any, who: str) -> str | None:
@@ -379,3 +435,27 @@ def the_archive() -> Any:
 def archive() -> Any:
     """``--archive DIR``, where a library law is read from (None: $AIRGUN_XL_ARCHIVE)."""
     return option(None, "--archive", help=ARCHIVE_HELP, metavar="DIR", read=a_path_or_none)
+
+
+def seed(help: str) -> Any:
+    """``--seed``: of a study's random draws (default 1)."""
+    return option(1, "--seed", help=help, read=a_seed)
+
+
+def scheduler() -> Any:
+    """``--scheduler ADDRESS``: the Dask cluster a study runs on (or ``--workers``)."""
+    return option(None, "--scheduler", metavar="ADDRESS", group="cluster", read=a_text_or_none,
+                  help="run the shots on a Dask cluster: the address of its scheduler, e.g. "
+                       "tcp://10.0.0.5:8786 (docs/studies.md, 'Studies on several machines')")
+
+
+def workers() -> Any:
+    """``--workers N``: a local Dask cluster of N processes (or ``--scheduler``)."""
+    return option(None, "--workers", metavar="N", group="cluster", read=a_whole_or_none,
+                  help="run the shots on a local Dask cluster of N worker processes")
+
+
+def chunk() -> Any:
+    """``--chunk SHOTS``: shots a cluster task."""
+    return option(None, "--chunk", metavar="SHOTS", read=a_whole_or_none,
+                  help="shots a cluster task (default 512)")

@@ -11,10 +11,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from .. import limits
 from ..errors import OptionError
+from . import declared
 from .running import cluster_runner, shots_progress
 
 if TYPE_CHECKING:
@@ -23,29 +22,71 @@ if TYPE_CHECKING:
     from ..studies.sweep import SweepResult
 
 
-@dataclass(frozen=True)
-class SweepRequest:
+def some_varied(value: Any, who: str) -> tuple[str, ...]:
+    """Grids of cells: ``CELL=LO:HI:N`` each (a text, or a list of them), each checked
+    (:func:`~airgun_xl.studies.sweep.parse_vary`); several make a grid."""
+    from ..studies.sweep import parse_vary
+
+    found = declared.texts(value, who)
+    for text in found:
+        parse_vary(text, who)
+    return found
+
+
+def some_spreads(value: Any, who: str) -> tuple[str, ...]:
+    """Spreads of uncertain inputs: ``CELL=SD[%]`` each (a text, or a list of them), each
+    cell once (:func:`~airgun_xl.studies.sweep.parse_sds`)."""
+    from ..studies.sweep import parse_sds
+
+    found = declared.texts(value, who)
+    parse_sds(list(found), who)
+    return found
+
+
+def some_shots_or_none(value: Any, who: str) -> int | None:
+    """A Monte Carlo's or Sobol's number: a whole number from 2 to
+    :data:`~airgun_xl.limits.MAX_SHOTS`, or None."""
+    if value is None:
+        return None
+    try:
+        return declared.a_whole(value, who, 2, limits.MAX_SHOTS)
+    except OptionError:
+        raise OptionError(f"{who}: found {value!r}, expected a number of shots from 2 to "
+                          f"{limits.MAX_SHOTS:,}") from None
+
+
+@dataclass(frozen=True, kw_only=True)
+class SweepRequest(declared.Checked):
     """The study: a grid (``vary``: ``CELL=LO:HI:N`` each, several make a grid), or ``mc``
     (a Monte Carlo of that many shots) or ``sobol`` (N x (inputs + 2) shots) with the
-    spreads ``sd`` (``CELL=SD[%]`` each), drawn from ``seed``; the options as the CLI's,
-    their values as typed. ``output`` None writes no workbook (the CLI gives its default,
-    ``SHOT.sweep.xlsx``)."""
+    spreads ``sd`` (``CELL=SD[%]`` each), drawn from ``seed``. ``output`` None writes no
+    workbook (the CLI gives its default, ``SHOT.sweep.xlsx``). Declared once
+    (:mod:`.declared`): the command's options and the API's keywords."""
 
-    shot: Path
-    vary: tuple[str, ...] = ()
-    mc: str | None = None
-    sd: tuple[str, ...] = ()
-    sobol: str | None = None
-    seed: int = 1
-    integrator: str = "legacy"
-    model: str = "4-mass"
-    output: Path | None = None
-    force: bool = False
-    crush_law: str = "workbook"  # workbook, legacy or NAME[@N] of the archive's library
-    archive: Path | None = None  # where a library law is read from
-    scheduler: str | None = None  # a Dask scheduler's address
-    workers: int | None = None  # a local Dask cluster of this many processes
-    chunk: int | None = None  # shots a cluster task
+    shot: Path = declared.shot()
+    vary: tuple[str, ...] = declared.option(
+        (), "--vary", kind="repeated", metavar="CELL=LO:HI:N", read=some_varied,
+        help="a parameter cell and its values, e.g. A28=100:260:161")
+    mc: int | None = declared.option(None, "--mc", metavar="N", read=some_shots_or_none,
+                                     help="Monte Carlo: this many shots")
+    sd: tuple[str, ...] = declared.option(
+        (), "--sd", kind="repeated", metavar="CELL=SD[%]", read=some_spreads,
+        help="spread of an uncertain input, e.g. E40=3%% (Monte Carlo)")
+    sobol: int | None = declared.option(
+        None, "--sobol", metavar="N", read=some_shots_or_none,
+        help="Sobol indices of the peak, pulse and crush to the --sd inputs (SALib): N (a "
+             "power of 2) x (inputs + 2) shots")
+    seed: int = declared.seed("seed of the Monte Carlo's and Sobol's draws (default 1, so "
+                              "that a run repeats; printed with the results)")
+    integrator: str = declared.integrator()
+    model: str = declared.model()
+    output: Path | None = declared.output("table and charts", "SHOT.sweep.xlsx")
+    force: bool = declared.force()
+    scheduler: str | None = declared.scheduler()
+    workers: int | None = declared.workers()
+    chunk: int | None = declared.chunk()
+    crush_law: str = declared.crush_law()
+    archive: Path | None = declared.archive()  # where a library law is read from
 
 
 @dataclass(frozen=True)
@@ -89,6 +130,7 @@ class SweepOutcome:
         (``peak_kg`` [kG], ``time_of_peak`` [s], ``filtered_peak_kg`` [kG],
         ``pulse_duration`` [s], ``max_crush`` [m]), ``diverged``, ``invalid``, and each
         shot's ``warnings`` (a tuple of text). A figure the run could not give is NaN."""
+        import numpy as np
         import pandas as pd
 
         from ..engine.batch import FIGURES
@@ -101,19 +143,6 @@ class SweepOutcome:
         flags = result.flags or [[] for _ in result.values]
         data["warnings"] = [tuple(found) for found in flags]
         return pd.DataFrame(data)
-
-
-def _count(option: str, text: str | None, sds: list[Any]) -> int:
-    """A Monte Carlo's or Sobol's number of shots, checked."""
-    try:
-        n = int(str(text))
-    except ValueError:
-        n = 0
-    if n < 2 or n > limits.MAX_SHOTS or not sds:
-        raise OptionError(f"{option}: found {text!r}{'' if sds else ' without --sd'}, "
-                          f"expected a number of shots from 2 to {limits.MAX_SHOTS:,}, "
-                          "with --sd")
-    return n
 
 
 def run(request: SweepRequest,
@@ -133,21 +162,24 @@ def run(request: SweepRequest,
     from ..transaction import check_output
 
     shot = shot_with_law(request.shot, request.crush_law, request.archive)
-    varies = [parse_vary(v) for v in request.vary]
-    sds = parse_sds(list(request.sd))
+    varies = [parse_vary(v, "vary") for v in request.vary]
+    sds = parse_sds(list(request.sd), "sd")
     if request.mc is not None and request.sobol is not None:
-        raise OptionError("--sobol: found it with --mc, expected one or the other")
+        raise declared.refusal("{0}: found it with {1}, expected one or the other", "sobol",
+                               "mc")
     n = 1
     if request.mc is not None or request.sobol is not None:
-        random = "--mc" if request.mc is not None else "--sobol"
-        n = _count(random, request.mc if request.mc is not None else request.sobol, sds)
-        if not 0 <= request.seed < 2**128:
-            raise OptionError(f"--seed: found {request.seed}, expected a whole number from 0 "
-                              "to 2**128 - 1")
+        random = "mc" if request.mc is not None else "sobol"
+        n = request.mc if request.mc is not None else request.sobol or 0
+        if not sds:
+            raise declared.refusal("{0}: found {n} without {1}, expected the spreads of the "
+                                   "inputs to draw ({1} CELL=SD[%])", random, "sd", n=n)
         if varies:
-            raise OptionError(f"--vary: found a grid with {random}, expected one or the other")
+            raise declared.refusal("{0}: found a grid with {1}, expected one or the other",
+                                   "vary", random)
     elif not varies:
-        raise OptionError("--vary: found none, expected CELL=LO:HI:N (or --mc N with --sd)")
+        raise declared.refusal("{0}: found none, expected CELL=LO:HI:N (or {1} N with {2})",
+                               "vary", "mc", "sd")
     if request.output is not None:
         check_output(request.output, request.force, inputs=[request.shot])
     total = n if request.mc is not None else n * (len(sds) + 2) \
@@ -199,6 +231,8 @@ def run(request: SweepRequest,
 def lines(request: SweepRequest, outcome: SweepOutcome) -> list[str]:
     """What ``sweep`` prints: the shots run, how fast, how many diverged; the peak's range
     over a grid or its spread over the draws; Sobol's indices."""
+    import numpy as np
+
     result, stats = outcome.result, outcome.stats
     said = [f"wrote {outcome.output}: {outcome.shots:,} shots in {outcome.seconds:.2f} s "
             f"({outcome.steps_per_second:.3g} shot-steps/s); {int(result.diverged.sum())} "

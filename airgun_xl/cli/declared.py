@@ -24,17 +24,23 @@ def _typed(read: Any, flag: str) -> Any:
     return parse
 
 
-def add_declared(parser: argparse.ArgumentParser, request: type, skip: tuple[str, ...] = (),
+def add_declared(original: argparse.ArgumentParser, request: type, skip: tuple[str, ...] = (),
                  only: tuple[str, ...] | None = None) -> None:
     """Each field of the dataclass ``request`` (but ``skip``; with ``only``, those alone) as
-    ``parser``'s argument, in the fields' order (a command whose help shows an option of its
+    ``original``'s argument, in the fields' order (a command whose help shows an option of its
     own between them adds them in two calls)."""
+    groups: dict[str, Any] = {}
     for field in dataclasses.fields(request):
         if field.name in skip or (only is not None and field.name not in only):
             continue
         spelt = option_of(field)
         read = field.metadata["read"]
         flag = spelt.flags[-1]
+        parser = original
+        if spelt.group is not None:  # options that exclude each other
+            if spelt.group not in groups:
+                groups[spelt.group] = original.add_mutually_exclusive_group()
+            parser = groups[spelt.group]
         if spelt.kind == "positional":
             parser.add_argument(field.name, metavar=spelt.metavar, help=spelt.help)
         elif spelt.kind == "switch":
@@ -46,6 +52,9 @@ def add_declared(parser: argparse.ArgumentParser, request: type, skip: tuple[str
             assert isinstance(field.default, tuple), field.name
             parser.add_argument(*spelt.flags, action=Integrators, default=list(field.default),
                                 metavar=spelt.metavar, help=spelt.help, dest=field.name)
+        elif spelt.kind == "repeated":  # given once for each value, read together
+            parser.add_argument(*spelt.flags, action="append", default=[],
+                                metavar=spelt.metavar, help=spelt.help, dest=field.name)
         elif spelt.kind == "cfc":  # argparse's own line, as every command's --cfc gives
             parser.add_argument(*spelt.flags, type=cfc_value, default=field.default,
                                 metavar=spelt.metavar, action=CfcOption, help=spelt.help)
@@ -54,7 +63,7 @@ def add_declared(parser: argparse.ArgumentParser, request: type, skip: tuple[str
                                 metavar=spelt.metavar, action=One, help=spelt.help,
                                 dest=field.name)
         for alias, idea in spelt.aliases:
-            parser.add_argument(alias, type=_typed(read, flag), dest=field.name,
+            original.add_argument(alias, type=_typed(read, flag), dest=field.name,
                                 metavar=spelt.metavar, action=Alias, idea=idea)
 
 
@@ -87,6 +96,9 @@ def flags_named(request: type) -> Iterator[None]:
     except OptionError as exc:
         prefix, colon, rest = str(exc).partition(": ")
         flags = {f.name: _spelt(option_of(f)) for f in dataclasses.fields(request)}
+        if exc.template is not None and all(name in flags for name in exc.fields):
+            raise OptionError(exc.template.format(*(flags[n] for n in exc.fields),
+                                                  **exc.values)) from None
         names = prefix.split("/")
         if colon and all(name in flags for name in names):
             raise OptionError("/".join(flags[n] for n in names) + ": " + rest) from None

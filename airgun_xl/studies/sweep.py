@@ -27,8 +27,8 @@ def fields_of(cell, option):
     return cell, (BY_ADDRESS[cell].name,)
 
 
-def parse_vary(text):
-    """``A28=100:260:161`` -> (cell, fields, values)."""
+def parse_vary(text, who="--vary"):
+    """``A28=100:260:161`` -> (cell, fields, values); a refusal names ``who``."""
     match = re.fullmatch(r"\s*([A-Za-z]+[0-9]+)\s*=\s*([^:]+):([^:]+):(\d+)\s*", text)
     try:
         if match is None:
@@ -37,15 +37,16 @@ def parse_vary(text):
     except ValueError:
         n = 0
     if n < 1 or n > limits.MAX_SHOTS or not (math.isfinite(lo) and math.isfinite(hi)):
-        raise OptionError(f"--vary: found {text!r}, expected CELL=LO:HI:N with finite LO and "
+        raise OptionError(f"{who}: found {text!r}, expected CELL=LO:HI:N with finite LO and "
                           f"HI and 1 <= N <= {limits.MAX_SHOTS:,}, such as A28=100:260:161")
     assert match is not None  # n = 0 above otherwise
-    cell, fields = fields_of(match.group(1), "--vary")
+    cell, fields = fields_of(match.group(1), who)
     return cell, fields, np.linspace(lo, hi, n)
 
 
-def parse_sd(text):
-    """``E40=3%`` (relative) or ``E40=8e5`` (absolute) -> (cell, fields, sd, relative)."""
+def parse_sd(text, who="--sd"):
+    """``E40=3%`` (relative) or ``E40=8e5`` (absolute) -> (cell, fields, sd, relative); a
+    refusal names ``who``."""
     match = re.fullmatch(r"\s*([A-Za-z]+[0-9]+)\s*=\s*([0-9.eE+-]+)\s*(%?)\s*", text)
     try:
         if match is None:
@@ -54,21 +55,21 @@ def parse_sd(text):
     except ValueError:
         sd = -1.0
     if not (sd >= 0 and math.isfinite(sd)):
-        raise OptionError(f"--sd: found {text!r}, expected CELL=SD or CELL=SD% such as E40=3%")
+        raise OptionError(f"{who}: found {text!r}, expected CELL=SD or CELL=SD% such as E40=3%")
     assert match is not None  # sd = -1 above otherwise
-    cell, fields = fields_of(match.group(1), "--sd")
+    cell, fields = fields_of(match.group(1), who)
     return cell, fields, sd / 100 if match.group(3) else sd, bool(match.group(3))
 
 
-def parse_sds(texts):
+def parse_sds(texts, who="--sd"):
     """Every ``--sd``, by :func:`parse_sd`; a cell scattered twice is refused (the last one
     would silently win)."""
     sds = []
     seen: dict[str, str] = {}
     for text in texts:
-        sd = parse_sd(text)
+        sd = parse_sd(text, who)
         if sd[0] in seen:
-            raise OptionError(f"--sd: found {sd[0]} twice ({seen[sd[0]]!r} and {text!r}), "
+            raise OptionError(f"{who}: found {sd[0]} twice ({seen[sd[0]]!r} and {text!r}), "
                               "expected one scatter per cell")
         seen[sd[0]] = text
         sds.append(sd)
