@@ -433,21 +433,21 @@ def recording(path: str | os.PathLike[str]) -> RecordingOutcome:
 
 
 @_paths_checked
-def serve(archive: str | os.PathLike[str], *, host: str = "127.0.0.1",
-          port: int = 8765) -> None:
+def serve(archive: str | os.PathLike[str] | None = None, *, host: str = "127.0.0.1",
+          port: int | str = 8765) -> None:
     """Serve the archive's read-only view in a browser until Ctrl-C, as ``airgun-xl serve``
-    does (needs the ``web`` extra): the loopback address unless ``host`` says otherwise (the
-    page has no login); ``port`` 0 takes any free port. The address is printed once it
-    listens.
+    does (needs the ``web`` extra): ``archive`` (None: $AIRGUN_XL_ARCHIVE), on the loopback
+    address unless ``host`` says otherwise (the page has no login); ``port`` 0 takes any
+    free port. The address is printed once it listens.
 
     Raises
     ------
     AirgunXlError
         No such archive, a port in use, or the extra missing, named.
     """
-    from .web.server import serve as run
+    from .web.command import ServeRequest, run
 
-    run(os.fspath(archive), host, _whole("port", port))
+    return run(ServeRequest.given(archive=archive, host=host, port=port))
 
 
 @_paths_checked

@@ -26,6 +26,7 @@ from airgun_xl.app.sweep import SweepRequest
 from airgun_xl.app.template import TemplateRequest
 from airgun_xl.cli.commands import build_parser
 from airgun_xl.errors import OptionError
+from airgun_xl.web.command import ServeRequest
 
 #: The commands declared once so far: (command, API function, request).
 DECLARED = [("srs", airgun_xl.srs, SrsRequest), ("check", airgun_xl.check, CheckRequest),
@@ -35,11 +36,11 @@ DECLARED = [("srs", airgun_xl.srs, SrsRequest), ("check", airgun_xl.check, Check
             ("convergence", airgun_xl.convergence, ConvergenceRequest),
             ("compare-measured", airgun_xl.compare_measured, CompareMeasuredRequest),
             ("show", airgun_xl.show, ShowRequest), ("compare", airgun_xl.compare, CompareRequest),
-            ("sweep", airgun_xl.sweep, SweepRequest)]
+            ("sweep", airgun_xl.sweep, SweepRequest), ("serve", airgun_xl.serve, ServeRequest)]
 
 #: A keyword a function has always taken by position too (documented so): (function, name).
 POSITIONAL = {("convergence", "levels"), ("show", "archive"), ("compare", "archive"),
-              ("sweep", "vary")}
+              ("sweep", "vary"), ("serve", "archive")}
 
 
 def _subparser(command):
@@ -164,3 +165,20 @@ def test_a_recording_is_kept_as_the_text_given():
     assert RecordingRequest.given(path=Path("r.csv")).path == "r.csv"
     with pytest.raises(OptionError, match=r"^path: found b'r.csv', expected a recording's"):
         RecordingRequest.given(path=b"r.csv")
+
+
+def test_serve_refuses_naming_the_keyword_and_the_command_its_flag(tmp_path, capsys,
+                                                                   monkeypatch):
+    """``serve(port=70000)`` and no archive at all: one line naming the keyword from the
+    API, the flag from the command line, before anything listens."""
+    from airgun_xl.cli import main
+
+    monkeypatch.delenv("AIRGUN_XL_ARCHIVE", raising=False)
+    with pytest.raises(OptionError, match=r"^port: found 70000, expected a port from 0 to "
+                                          r"65535$"):
+        airgun_xl.serve(tmp_path, port=70000)
+    with pytest.raises(OptionError, match=r"^archive: found no archive, expected archive DIR"):
+        airgun_xl.serve()
+    assert main(["serve"]) == 2
+    assert capsys.readouterr().err == ("airgun-xl: error: --archive: found no archive, "
+                                       "expected --archive DIR (or $AIRGUN_XL_ARCHIVE)\n")

@@ -197,7 +197,7 @@ def test_the_web_extra_missing_is_one_line_from_the_cli_and_the_api(tmp_path, ca
 def test_no_archive_or_a_bad_port_is_one_line(tmp_path, capsys):
     for args, said in ((["--archive", str(tmp_path / "none")], "no such archive"),
                        (["--archive", str(tmp_path), "--port", "70000"],
-                        "--port: found 70000, expected 0 to 65535")):
+                        "--port: found '70000', expected a port from 0 to 65535")):
         assert main(["serve", *args]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and said in err, err

@@ -21,6 +21,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from ..errors import OptionError
 from ..units import PEAK_UNITS
 from .pages import finite as pages_finite
 from .pages import real
@@ -448,12 +449,10 @@ def listen(host: str, port: int) -> Any:
     """
     import socket
 
-    from ..errors import OptionError
-
     try:
         info = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)[0]
     except (socket.gaierror, UnicodeError) as exc:
-        raise OptionError(f"--host: found {host!r}, which does not resolve ({exc}), expected "
+        raise OptionError(f"host: found {host!r}, which does not resolve ({exc}), expected "
                           "an address of this machine such as 127.0.0.1") from None
     sock = socket.socket(info[0], socket.SOCK_STREAM)
     try:
@@ -462,7 +461,7 @@ def listen(host: str, port: int) -> Any:
         sock.listen(64)
     except OSError as exc:
         sock.close()
-        raise OptionError(f"--port: {host}:{port} cannot be listened on ({exc.strerror}), "
+        raise OptionError(f"port: {host}:{port} cannot be listened on ({exc.strerror}), "
                           "expected a free port (another server holds this one?)") from None
     return sock
 
@@ -502,8 +501,6 @@ def serve(archive: str | Path, host: str = "127.0.0.1", port: int = 8765,
     OptionError
         The extra missing, a port out of range or in use, a host that does not resolve.
     """
-    from ..errors import OptionError
-
     try:
         import jinja2  # noqa: F401 - each is needed: checked before anything starts
         import starlette  # noqa: F401
@@ -511,7 +508,7 @@ def serve(archive: str | Path, host: str = "127.0.0.1", port: int = 8765,
     except ImportError:
         raise OptionError(MISSING) from None
     if not 0 <= port <= 65535:
-        raise OptionError(f"--port: found {port}, expected 0 to 65535")
+        raise OptionError(f"port: found {port}, expected a port from 0 to 65535")
     sock = listen(host, port)  # first: a refusal comes alone, before the archive is opened
     try:
         app = build_app(archive, () if host in LOOPBACK else (host,))
