@@ -31,6 +31,7 @@ from .errors import (
 from .version import __version__
 
 if TYPE_CHECKING:
+    import datetime
     from collections.abc import Sequence
     from pathlib import Path
     from typing import Unpack
@@ -638,19 +639,17 @@ def campaign(shots: str | os.PathLike[str] | Sequence[str | os.PathLike[str]], *
 
 @_paths_checked
 def history(archive: str | os.PathLike[str] | None = None, *, shot: str | None = None,
-            since: str | None = None, where: str | Sequence[str] = (),
+            since: str | datetime.date | None = None, where: str | Sequence[str] = (),
             output: str | os.PathLike[str] | None = None,
             force: bool = False) -> HistoryOutcome:
     """The runs stored in an archive (default ``$AIRGUN_XL_ARCHIVE``), as ``airgun-xl
     history`` lists them: ``rows`` (one a run: its figures and provenance, what its records
     could not give named), the archive's ``laws`` and ``verdicts``; ``where`` selects by
     input cell (``"E40=2.6e7:2.8e7"``); ``output`` also writes the table."""
-    from .app.archive import HistoryRequest
-    from .app.archive import history as listed
+    from .app.archive import HistoryRequest, history as run  # noqa: I001 (one import)
 
-    return listed(HistoryRequest(os.fspath(archive) if archive is not None else None, shot,
-                                 since, _texts(where),
-                                 os.fspath(output) if output is not None else None, force))
+    return run(HistoryRequest.given(archive=archive, shot=shot, since=since, where=where,
+                                    output=output, force=force))
 
 
 @_paths_checked

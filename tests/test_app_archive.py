@@ -34,8 +34,16 @@ def test_history_lists_what_the_fills_stored(filled, capsys):
     assert [r["v0"] for r in only.rows] == [250.0] and only.lines[-1] == "1 entry of 2 (--where)"
     assert main(["history", "--archive", str(root)]) == 0
     assert capsys.readouterr().out.splitlines() == list(outcome.lines)
-    with pytest.raises(OptionError, match="--where: found 'Z9=1'"):
+    # a bad selection: the API names the keyword, the command line its flag (issue 61)
+    with pytest.raises(OptionError, match="^where: found 'Z9=1'"):
         airgun_xl.history(root, where="Z9=1")
+    with pytest.raises(OptionError, match="^since: found 'yesterday', expected a date such as "
+                                          "2026-11-01$"):
+        airgun_xl.history(root, since="yesterday")
+    for args, said in ((["--where", "Z9=1"], "--where: found 'Z9=1'"),
+                       (["--since", "11/01"], "--since: found '11/01', expected a date")):
+        assert main(["history", "--archive", str(root), *args]) == 2
+        assert capsys.readouterr().err.startswith(f"airgun-xl: error: {said}")
 
 
 def test_show_gives_the_entrys_records(filled, capsys):

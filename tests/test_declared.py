@@ -14,7 +14,7 @@ import pytest
 from conftest import TEMPLATE
 
 import airgun_xl
-from airgun_xl.app.archive import CompareRequest, ShowRequest
+from airgun_xl.app.archive import CompareRequest, HistoryRequest, ShowRequest
 from airgun_xl.app.check import CheckRequest
 from airgun_xl.app.compare_measured import CompareMeasuredRequest
 from airgun_xl.app.convergence import ConvergenceRequest
@@ -36,11 +36,12 @@ DECLARED = [("srs", airgun_xl.srs, SrsRequest), ("check", airgun_xl.check, Check
             ("convergence", airgun_xl.convergence, ConvergenceRequest),
             ("compare-measured", airgun_xl.compare_measured, CompareMeasuredRequest),
             ("show", airgun_xl.show, ShowRequest), ("compare", airgun_xl.compare, CompareRequest),
-            ("sweep", airgun_xl.sweep, SweepRequest), ("serve", airgun_xl.serve, ServeRequest)]
+            ("sweep", airgun_xl.sweep, SweepRequest), ("serve", airgun_xl.serve, ServeRequest),
+            ("history", airgun_xl.history, HistoryRequest)]
 
 #: A keyword a function has always taken by position too (documented so): (function, name).
 POSITIONAL = {("convergence", "levels"), ("show", "archive"), ("compare", "archive"),
-              ("sweep", "vary"), ("serve", "archive")}
+              ("sweep", "vary"), ("serve", "archive"), ("history", "archive")}
 
 
 def _subparser(command):

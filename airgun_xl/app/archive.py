@@ -62,8 +62,9 @@ def _count(n: int, one: str, many: str) -> str:
 Where = tuple[str, float, float]
 
 
-def parse_where(text: str) -> Where:
-    """``E40=2.703e7`` -> ("E40", 2.703e7, 2.703e7); ``E40=2.6e7:2.8e7`` -> a range."""
+def parse_where(text: str, who: str = "where") -> Where:
+    """``E40=2.703e7`` -> ("E40", 2.703e7, 2.703e7); ``E40=2.6e7:2.8e7`` -> a range; a
+    refusal names ``who``."""
     cell, _, value = str(text).partition("=")
     cell = cell.strip().upper()
     lo = hi = math.nan
@@ -74,7 +75,7 @@ def parse_where(text: str) -> Where:
     except ValueError:
         ok = False
     if cell not in BY_ADDRESS or not ok:
-        raise OptionError(f"--where: found {text!r}, expected CELL=VALUE or CELL=LO:HI with "
+        raise OptionError(f"{who}: found {text!r}, expected CELL=VALUE or CELL=LO:HI with "
                           "a parameter cell, e.g. E40=2.703e7 or A28=200:250")
     return cell, lo, hi
 
@@ -155,16 +156,53 @@ def _unreadable_row(e: Entry, exc: Exception) -> Row:
             "crush_law": f"unreadable: {exc}"}
 
 
-@dataclasses.dataclass(frozen=True)
-class HistoryRequest:
-    """``history``: the archive's runs, filtered; ``output`` also writes their table."""
+def a_date_or_none(value: Any, who: str) -> str | None:
+    """An ISO date (``"2026-11-01"``, or a time on it; a :class:`datetime.date` is its ISO
+    text), or None."""
+    if value is None:
+        return None
+    if isinstance(value, datetime.date):
+        return value.isoformat()
+    try:
+        datetime.date.fromisoformat(str(value)[:10])
+        ok = isinstance(value, str)
+    except ValueError:
+        ok = False
+    if not ok:
+        raise OptionError(f"{who}: found {value!r}, expected a date such as 2026-11-01")
+    return str(value)
 
-    archive: str | None = None
-    shot: str | None = None
-    since: str | None = None  # ISO date
-    where: tuple[str, ...] = ()  # CELL=VALUE or CELL=LO:HI
-    output: str | None = None
-    force: bool = False
+
+def some_wheres(value: Any, who: str) -> tuple[str, ...]:
+    """Selections by input cell, ``CELL=VALUE`` or ``CELL=LO:HI`` each (a text, or a list of
+    them), each checked (:func:`parse_where`)."""
+    found = declared.texts(value, who)
+    for text in found:
+        parse_where(text, who)
+    return found
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class HistoryRequest(declared.Checked):
+    """``history``: the archive's runs (``archive`` None: $AIRGUN_XL_ARCHIVE), filtered;
+    ``output`` also writes their table. Declared once (:mod:`.declared`): the command's
+    options and the API's keywords."""
+
+    archive: str | None = declared.the_archive()
+    shot: str | None = declared.option(None, "--shot", metavar="NAME",
+                                       read=declared.a_text_or_none,
+                                       help="only this shot's runs")
+    since: str | None = declared.option(
+        None, "--since", metavar="DATE", read=a_date_or_none,
+        help="only runs from this ISO date on, e.g. 2026-11-01")
+    where: tuple[str, ...] = declared.option(
+        (), "--where", kind="repeated", metavar="CELL=VALUE", read=some_wheres,
+        help="only runs whose input cell holds VALUE (to 1e-9 of it) or lies in LO:HI, e.g. "
+             "E40=2.703e7 or E40=2.6e7:2.8e7 (a honeycomb lot); may be repeated")
+    output: str | None = declared.option(
+        None, "-o", "--output", metavar="SHOTS.xlsx", read=declared.a_folder_or_none,
+        help="also write the table across the runs, with the peak against v0")
+    force: bool = declared.force("SHOTS.xlsx")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -187,12 +225,6 @@ def _cell(value: Any, fmt: str, width: int) -> str:
 
 def history(request: HistoryRequest) -> HistoryOutcome:
     """List the archive's runs (``airgun-xl history``)."""
-    if request.since:
-        try:
-            datetime.date.fromisoformat(request.since[:10])
-        except ValueError:
-            raise OptionError(f"--since: found {request.since!r}, expected a date such as "
-                              "2026-11-01") from None
     where = [parse_where(w) for w in request.where]
     if request.output:
         check_output(request.output, request.force)  # before reading the entries

@@ -7,8 +7,8 @@ from ..app.archive import is_role
 from ..choices import ARCHIVE_ENV as ENV
 from ..choices import INDEX_ENV
 from ..untrusted_json import printable
-from .declared import add_declared, request_of
-from .run_options import add_force, add_json
+from .declared import add_declared, flags_named, request_of
+from .run_options import add_json
 from .vocabulary import One
 
 WHERE = f"DIR defaults to ${ENV}."
@@ -22,15 +22,17 @@ def add_parser(sub):
 
 
 def _add_history(sub):
+    from ..app.archive import HistoryRequest
+
     where = WHERE
     h = sub.add_parser("history", help="list the runs stored in an archive, and its crush laws",
                        description=f"List archived runs with their key figures (peak, "
                                    f"filtered peak, pulse, crush, warnings, integrator, crush "
                                    f"law) and the archive's crush laws. {where}")
-    h.add_argument("--archive", metavar="DIR", action=One, help="the archive folder")
+    add_declared(h, HistoryRequest, only=("archive",))
     h.add_argument("dir", nargs="?", metavar="DIR",
                    help="old spelling of --archive DIR, kept one release")
-    h.add_argument("--shot", metavar="NAME", help="only this shot's runs")
+    add_declared(h, HistoryRequest, only=("shot",))
     h.add_argument("--lot", metavar="NAME",
                    help="a lot's chain instead (airgun-xl next): each shot fired, its "
                         "verdict, the P(PASS) predicted for it, the law version, the next "
@@ -39,15 +41,7 @@ def _add_history(sub):
                    help="the record of next's predictions instead: P(PASS) predicted before "
                         "each shot against its verdict, in bands, with the Brier score (-o "
                         "writes it with a reliability chart)")
-    h.add_argument("--since", metavar="DATE", help="only runs from this ISO date on, e.g. "
-                                                   "2026-11-01")
-    h.add_argument("--where", action="append", default=[], metavar="CELL=VALUE",
-                   help="only runs whose input cell holds VALUE (to 1e-9 of it) or lies in "
-                        "LO:HI, e.g. E40=2.703e7 or E40=2.6e7:2.8e7 (a honeycomb lot); may "
-                        "be repeated")
-    h.add_argument("-o", "--output", metavar="SHOTS.xlsx", action=One,
-                   help="also write the table across the runs, with the peak against v0")
-    add_force(h, "SHOTS.xlsx")
+    add_declared(h, HistoryRequest, only=("since", "where", "output", "force"))
     h.add_argument("--json", action="store_true", help="print the list as JSON")
     h.set_defaults(run=run_history)
 
@@ -133,8 +127,8 @@ def run_history(args):
         record = prediction_record(_history_archive(args), args.output, args.force)
         print(record.to_json() if args.json else "\n".join(record.lines()))
         return 0
-    outcome = history(HistoryRequest(_history_archive(args), args.shot, args.since,
-                                     tuple(args.where), args.output, args.force))
+    with flags_named(HistoryRequest):
+        outcome = history(request_of(HistoryRequest, args, archive=_history_archive(args)))
     if args.json:  # the index row of each entry, with its figures and its law
         print(json.dumps(list(outcome.rows), indent=1))
     else:
