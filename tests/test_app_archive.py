@@ -79,6 +79,33 @@ def test_init_and_verify(tmp_path, filled):
     assert len(broken.problems) == 1 and "summary.json" in broken.problems[0]
 
 
+@pytest.mark.parametrize("args, said", [
+    (["init", "{new}", "--writers", "lab;drop"],
+     "--writers: found 'lab;drop', expected a role name: letters, digits and _, at most 63"),
+    (["init", "{new}", "--writers", "lab"],
+     "--writers: found roles for an archive whose index is in its folder, expected --index "
+     "or $AIRGUN_XL_INDEX (a server's roles)"),
+    (["verify", "{new}", "--writers", "lab"],
+     "--writers: found roles with verify, expected them with init or migrate"),
+    (["check", "{new}"], "argument action: invalid choice: 'check'"),
+])
+def test_archive_maintenance_refuses_in_one_line_naming_the_flag(args, said, tmp_path, capsys,
+                                                                  monkeypatch):
+    """archive's request (issue 61): a role that is no identifier, roles for a folder's own
+    index or for verify; one line, exit 2, nothing made; the request names the keyword."""
+    from airgun_xl.app.archive import ArchiveRequest, maintain
+    from airgun_xl.errors import OptionError
+
+    monkeypatch.delenv("AIRGUN_XL_INDEX", raising=False)
+    new = tmp_path / "new"
+    assert main(["archive", *(a.format(new=new) for a in args)]) == 2
+    err = capsys.readouterr().err
+    assert said in err and err.count("\n") == 1 and not new.exists(), err
+    with pytest.raises(OptionError, match="^writers: found roles for an archive whose index"):
+        maintain(ArchiveRequest(action="init", folder=str(new), writers=("lab",)))
+    assert not new.exists()
+
+
 def test_archive_verify_json_lists_the_problems(filled, capsys):
     root, _ = filled
     assert main(["archive", "verify", str(root), "--json"]) == 0

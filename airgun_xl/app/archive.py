@@ -512,6 +512,57 @@ class MaintenanceOutcome:
                       "problems": self.problems, "lines": self.lines})
 
 
+def some_roles(value: Any, who: str) -> tuple[str, ...]:
+    """PostgreSQL role names (a text, or a list of them): plain identifiers
+    (:func:`is_role`)."""
+    found = declared.texts(value, who)
+    for text in found:
+        if not is_role(text):
+            raise OptionError(f"{who}: found {text[:40]!r}, expected a role name: letters, "
+                              "digits and _, at most 63")
+    return found
+
+
+#: What ``archive`` does.
+ACTIONS = ("init", "migrate", "verify")
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class ArchiveRequest(declared.Checked):
+    """``archive init|migrate|verify``: on ``folder`` (None: $AIRGUN_XL_ARCHIVE), its index
+    on the server ``index`` (None: $AIRGUN_XL_INDEX, else the folder's SQLite), the roles
+    ``writers`` granted a writer's rights. Declared once (:mod:`.declared`)."""
+
+    action: str = declared.positional(
+        "action", choices=ACTIONS, read=declared.one_of(ACTIONS),
+        help="init: make a new archive; migrate: move an archive's SQLite index to the "
+             "--index server; verify: check one")
+    folder: str | None = declared.optional_positional(
+        "folder", metavar="DIR", read=declared.a_folder_or_none, help="the archive folder")
+    index: str | None = declared.option(
+        None, "--index", metavar="postgresql://HOST/DB", read=declared.a_text_or_none,
+        help=f"the PostgreSQL server of the archive's index (default ${INDEX_ENV}, else "
+             "libpq's PGHOST, PGSERVICE and service file); never a password: ~/.pgpass or "
+             "$PGPASSWORD hold it")
+    writers: tuple[str, ...] = declared.option(
+        (), "--writers", kind="repeated", metavar="ROLE", read=some_roles,
+        help="init and migrate on a server, run by the schema's owner: grant the engineers' "
+             "role what a writer needs and no more (read, add entries; no update, delete or "
+             "schema change); may be repeated")
+
+
+def maintain(request: ArchiveRequest) -> MaintenanceOutcome:
+    """Do what ``request`` asks: :func:`init`, :func:`migrate` or :func:`verify`."""
+    if request.action == "init":
+        return init(request.folder, request.index, request.writers)
+    if request.action == "migrate":
+        return migrate(request.folder, request.index, request.writers)
+    if request.writers:
+        raise declared.refusal("{0}: found roles with verify, expected them with init or "
+                               "migrate", "writers")
+    return verify(request.folder, request.index)
+
+
 def init(folder: str | None, index: str | None = None,
          writers: Sequence[str] = ()) -> MaintenanceOutcome:
     """Make a new archive: its index in the folder, or on a server with ``index`` (or
@@ -519,8 +570,9 @@ def init(folder: str | None, index: str | None = None,
     root = archive_dir(folder)
     server = index is not None or bool(os.environ.get(INDEX_ENV))
     if writers and not server:
-        raise OptionError("--writers: found roles for an archive whose index is in its folder, "
-                          f"expected --index or ${INDEX_ENV} (a server's roles)")
+        raise declared.refusal("{0}: found roles for an archive whose index is in its "
+                               "folder, expected {1} or ${env} (a server's roles)", "writers",
+                               "index", env=INDEX_ENV)
     archive = Archive.init(root, index, server=server, writers=list(writers))
     where = (f"its index on {archive.index.shown}" if archive.index.kind == "server"
              else "its index in the folder")

@@ -56,7 +56,7 @@ class Option:
         not), ``"choice"`` (one of ``choices``), ``"integrators"`` (an integrator, given
         again for each run side by side), ``"repeated"`` (given once for each value, the
         values read together), ``"cfc"`` (a J211 class or ``none``, told apart from a
-        specification's) or ``"positional"``.
+        specification's), ``"positional"`` or ``"positional?"`` (one that may be left out).
     choices : tuple of str
         For a ``"choice"``.
     aliases : tuple of tuple of str
@@ -96,11 +96,20 @@ def option(default: Any, *flags: str, help: str, read: Read = _keep,
         "read": read})
 
 
-def positional(name: str, *, help: str, read: Read = _keep, metavar: str | None = None
-               ) -> Any:
-    """A request's field without a default: the command's positional argument ``name``."""
+def positional(name: str, *, help: str, read: Read = _keep, metavar: str | None = None,
+               choices: tuple[str, ...] = ()) -> Any:
+    """A request's field without a default: the command's positional argument ``name``
+    (one of ``choices`` when given)."""
     return dataclasses.field(metadata={
-        "option": Option((name,), help, metavar, "positional"), "read": read})
+        "option": Option((name,), help, metavar, "positional", choices), "read": read})
+
+
+def optional_positional(name: str, *, help: str, read: Read = _keep,
+                        metavar: str | None = None) -> Any:
+    """A request's field of default None: the command's positional argument ``name``, which
+    may be left out."""
+    return dataclasses.field(default=None, metadata={
+        "option": Option((name,), help, metavar, "positional?"), "read": read})
 
 
 def option_of(field: dataclasses.Field[Any]) -> Option:

@@ -3,13 +3,10 @@ archive, and find archived shots again."""
 import json
 import sys
 
-from ..app.archive import is_role
 from ..choices import ARCHIVE_ENV as ENV
-from ..choices import INDEX_ENV
 from ..untrusted_json import printable
 from .declared import add_declared, flags_named, request_of
 from .run_options import add_json
-from .vocabulary import One
 
 WHERE = f"DIR defaults to ${ENV}."
 
@@ -72,6 +69,8 @@ def _add_compare(sub):
 
 
 def _add_archive(sub):
+    from ..app.archive import ArchiveRequest
+
     where = WHERE
     a = sub.add_parser("archive", help="archive maintenance: init, migrate, verify",
                        description=f"init: make a new archive in a new or empty folder, its "
@@ -84,31 +83,9 @@ def _add_archive(sub):
                                    f"re-hash every file of every entry, and list anything "
                                    f"missing, altered or out of place. Exit 0 clean, 1 with "
                                    f"problems. {where}")
-    a.add_argument("action", choices=["init", "migrate", "verify"],
-                   help="init: make a new archive; migrate: move an archive's SQLite index to "
-                        "the --index server; verify: check one")
-    a.add_argument("dir", nargs="?", metavar="DIR", help="the archive folder")
-    a.add_argument("--index", metavar="postgresql://HOST/DB", action=One,
-                   help=f"the PostgreSQL server of the archive's index (default "
-                        f"${INDEX_ENV}, else libpq's PGHOST, PGSERVICE and service file); "
-                        "never a password: ~/.pgpass or $PGPASSWORD hold it")
-    a.add_argument("--writers", action="append", default=[], metavar="ROLE",
-                   type=_role,
-                   help="init and migrate on a server, run by the schema's owner: grant the "
-                        "engineers' role what a writer needs and no more (read, add entries; "
-                        "no update, delete or schema change); may be repeated")
+    add_declared(a, ArchiveRequest)
     add_json(a, "what was done (verify: every problem)")
     a.set_defaults(run=run_archive)
-
-
-def _role(text):
-    """``--writers``: a PostgreSQL role name (a plain identifier)."""
-    import argparse
-
-    if not is_role(text):
-        raise argparse.ArgumentTypeError(f"found {str(text)[:40]!r}, expected a role name: "
-                                         "letters, digits and _, at most 63")
-    return str(text)
 
 
 def _print(lines):
@@ -186,14 +163,10 @@ def _history_archive(args):
 
 
 def run_archive(args):
-    from ..app import archive
+    from ..app.archive import ArchiveRequest, maintain
 
-    if args.action == "init":
-        outcome = archive.init(args.dir, args.index, args.writers)
-    elif args.action == "migrate":
-        outcome = archive.migrate(args.dir, args.index, args.writers)
-    else:
-        outcome = archive.verify(args.dir, args.index)
+    with flags_named(ArchiveRequest):
+        outcome = maintain(request_of(ArchiveRequest, args))
     if args.json:
         print(outcome.to_json())
     else:

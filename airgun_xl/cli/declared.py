@@ -42,7 +42,10 @@ def add_declared(original: argparse.ArgumentParser, request: type, skip: tuple[s
                 groups[spelt.group] = original.add_mutually_exclusive_group()
             parser = groups[spelt.group]
         if spelt.kind == "positional":
-            parser.add_argument(field.name, metavar=spelt.metavar, help=spelt.help)
+            parser.add_argument(field.name, metavar=spelt.metavar, help=spelt.help,
+                                choices=spelt.choices or None)
+        elif spelt.kind == "positional?":
+            parser.add_argument(field.name, nargs="?", metavar=spelt.metavar, help=spelt.help)
         elif spelt.kind == "switch":
             parser.add_argument(*spelt.flags, action="store_true", help=spelt.help)
         elif spelt.kind == "choice":
@@ -81,7 +84,7 @@ def request_of(request: type, args: argparse.Namespace, **given: Any) -> Any:
 def _spelt(spelt: Any) -> str:
     """How the command line names an option: its flag, or a positional's metavar
     (``ENTRY``)."""
-    if spelt.kind == "positional" and spelt.metavar:
+    if spelt.kind in ("positional", "positional?") and spelt.metavar:
         return str(spelt.metavar)
     return str(spelt.flags[-1])
 
