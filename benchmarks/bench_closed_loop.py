@@ -153,6 +153,11 @@ TOLERANCES = {"peak": (8.5, 0.425), "duration": (5.0, 1.0)}
 #: 0.5).
 CENTRES: list[dict] = []
 
+#: Per shot fired from a proposal (``--dump``): the lot, the shot's place in it, whether a
+#: replicate, the P(PASS) predicted, the verdict, the model error drawn (its words), and the
+#: expected and measured positions in the tolerances.
+SHOTS: list[dict] = []
+
 
 def positions(figures):
     """{figure: (value - nominal) / half-width} of ``figures`` {name: value in kG or ms}."""
@@ -182,7 +187,7 @@ def with_next(lot, law, first, work, draws, n_draws, calls, vary=None, gun=None,
     pooled over them (``next --gun``); ``calls`` gets (seconds, the gun's words, the law's
     update)."""
     shot = with_velocity(work / "next0.xlsx", first)
-    predicted, record, expected = None, [], {}
+    predicted, record, expected, error = None, [], {}, ""
     # one lab, one archive: the lots' pairs of expected and measured figures are the model
     # error's record (issue 60); with a per-lot archive every lot drew the prior
     archive = work.parent / "archive"
@@ -206,9 +211,13 @@ def with_next(lot, law, first, work, draws, n_draws, calls, vary=None, gun=None,
             record += [(predicted, passed) for passed, _ in fired[1:]]
             CENTRES.append({"expected": expected,
                             "measured": [positions(f) for _, f in fired]})
+            SHOTS.extend({"lot": lot, "shot": k + 1, "replicate": r > 0,
+                          "predicted": predicted, "passed": passed, "model_error": error,
+                          "expected": expected, "measured": positions(f)}
+                         for r, (passed, f) in enumerate(fired))
         if out.verdict.passed:
             return k + 1, record
-        predicted, shot = out.best.probability, out.output
+        predicted, shot, error = out.best.probability, out.output, out.model_error
         expected = positions({name: v[1] * (1e3 if name == "duration" else 1.0)
                               for name, v in out.best.figures.items()})
     return MOST_SHOTS + 1, record
@@ -358,6 +367,9 @@ def main():
     parser.add_argument("--replicates", type=int, default=3,
                         help="more shots fired from each proposal, each judged: the bands of "
                              "predicted P(PASS) get enough shots to be judged (default 3)")
+    parser.add_argument("--dump", metavar="FILE.json",
+                        help="also write every shot fired from a proposal (lot, place, "
+                             "P(PASS), verdict, the model error drawn, positions) as JSON")
     parser.add_argument("--quick", action="store_true",
                         help="one lot, 200 draws: shows the benchmark runs, measures nothing")
     args = parser.parse_args()
@@ -463,6 +475,10 @@ def main():
                 print(f"  P(PASS) {band.low:.2f}-{band.high:.2f}: {band.shots} shots, mean "
                       f"predicted {band.mean_predicted:.3f}, passed {band.rate:.3f} "
                       f"[{lo:.3f}, {hi:.3f}]: {judged}")
+    if args.dump:
+        import json
+
+        Path(args.dump).write_text(json.dumps(SHOTS, indent=0))
     return 0
 
 
