@@ -30,12 +30,25 @@ import os
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field, fields, replace
-from decimal import Decimal, InvalidOperation, localcontext
+from decimal import Decimal, localcontext
 from pathlib import Path
 from typing import Any
 
 from .errors import OptionError
-from .units import KG_MS2, NAMED_UNITS, PEAK_UNITS, TIME_UNITS, VELOCITY_UNITS, G
+from .units import (
+    KG_MS2,
+    PEAK_UNITS,
+    SHOWN_UNITS,
+    SIGNED,
+    TIME_UNITS,
+    VELOCITY_UNITS,
+    quantity,
+    quoted,
+    refuse,
+    scaled,
+    split_quantity,
+    unit_of,
+)
 
 #: The pulse shapes a specification can name; "none" judges the limits only (no corridor).
 SHAPES = ("half-sine", "sawtooth", "trapezoid", "none")
@@ -343,87 +356,19 @@ def judged_fields() -> tuple[str, ...]:
 
 # -- the grammar -------------------------------------------------------------------------------
 
-#: A number as the grammar reads it: digits, a point, an exponent; its sign is read apart.
-_NUMBER = r"(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
-_SIGNED = re.compile(r"^\s*(?P<sign>[-+±]?)\s*" + _NUMBER + r"\s*(?P<unit>.*?)\s*$")
-
-#: Units of each quantity: the one table (:mod:`airgun_xl.units`).
-_SHOWN_UNITS = NAMED_UNITS
-
-
-def _q(text: object) -> str:
-    """A value as a message quotes it: its repr, cut to a readable length."""
-    shown = repr(text)
-    return shown if len(shown) <= 60 else f"{shown[:50]}... ({len(shown):,} characters)"
-
-
-def _refuse(where: str, text: object, expected: str) -> OptionError:
-    return OptionError(f"{where}: found {_q(text)}, expected {expected}")
-
-
-def _split(text: str, where: str, expected: str) -> tuple[str, Decimal, str]:
-    """(sign, magnitude, unit text) of a number with an optional sign and unit."""
-    if not text.strip():
-        raise OptionError(f"{where}: found an empty value, expected {expected}")
-    match = _SIGNED.match(text)
-    if not match:
-        raise _refuse(where, text, expected)
-    try:
-        magnitude = Decimal(match.group("num"))
-    except InvalidOperation:
-        raise _refuse(where, text, expected) from None
-    return match.group("sign"), magnitude, match.group("unit")
-
-
-def _unit(unit: str, units: dict, text: str, where: str, expected: str) -> Any:
-    if unit in units:
-        return units[unit]
-    if not unit:
-        raise OptionError(f"{where}: found {_q(text)} without a unit, expected {expected}")
-    near = [u for u in units if u.lower() == unit.lower()]
-    hint = f" (did you mean {near[0]}?)" if near else ""
-    raise OptionError(f"{where}: found the unit {_q(unit)} in {_q(text)}{hint}, expected "
-                      f"{expected}")
-
-
-def _quantity(text: str, where: str, what: str, units: dict, example: str, cap: float,
-              cap_text: str, zero: bool = False, floor: float = 0.0,
-              floor_text: str = "") -> float:
-    """A positive (or, with ``zero``, non-negative) quantity with its unit, at least
-    ``floor`` and at most ``cap`` in the inside unit; times scaled exactly in decimal, then
-    rounded once."""
-    low = "from 0" if zero else f"from {floor_text}" if floor else "above 0"
-    expected = (f"{what} such as {example} (units "
-                f"{', '.join(u for u in units if u in _SHOWN_UNITS)}), "
-                f"{low} and at most {cap_text}")
-    sign, magnitude, unit_text = _split(text, where, expected)
-    factor = _unit(unit_text, units, text, where, expected)
-    if sign:
-        raise OptionError(f"{where}: found the sign {sign!r} in {_q(text)}, where none is "
-                          f"meaningful; expected {expected}")
-    if isinstance(factor, str):  # a time: "5e0us" and "5us" give float("5e-6")
-        value = _scaled(magnitude, factor)
-    else:
-        value = float(magnitude) * factor
-    if not (math.isfinite(value) and (value >= 0 if zero else value > 0 and value >= floor)
-            and value <= cap):
-        raise _refuse(where, text, expected)
-    return value
-
-
 def _percent(text: str, where: str, what: str, low_open: bool, allow_sign: bool = False
              ) -> tuple[str, float]:
     """(sign, fraction) of ``N%``; the fraction from 0 (above 0 with ``low_open``) to
     below 1."""
     expected = f"{what} {'above' if low_open else 'from'} 0% to below 100%, such as 10%"
-    sign, magnitude, unit_text = _split(text, where, expected)
-    _unit(unit_text, {"%": 1}, text, where, expected)
+    sign, magnitude, unit_text = split_quantity(text, where, expected)
+    unit_of(unit_text, {"%": 1}, text, where, expected)
     if sign and not allow_sign:
-        raise OptionError(f"{where}: found the sign {sign!r} in {_q(text)}, where none is "
+        raise OptionError(f"{where}: found the sign {sign!r} in {quoted(text)}, where none is "
                           f"meaningful; expected {expected}")
-    value = _scaled(magnitude, "0.01")
+    value = scaled(magnitude, "0.01")
     if not (math.isfinite(value) and (value > 0 if low_open else value >= 0) and value < 1):
-        raise _refuse(where, text, expected)
+        raise refuse(where, text, expected)
     return sign, value
 
 
@@ -438,16 +383,16 @@ def parse_tolerance_text(text: str, where: str) -> tuple[float, float]:
     if len(parts) == 1:
         sign, value = _percent(parts[0], where, "a tolerance", False, allow_sign=True)
         if sign in ("-", "+"):
-            raise OptionError(f"{where}: found {_q(text)}, a single signed tolerance, which is "
+            raise OptionError(f"{where}: found {quoted(text)}, a single signed tolerance, which is "
                               f"ambiguous; expected {TOLERANCE_EXPECTED}")
         return value, value
     if len(parts) != 2:
-        raise _refuse(where, text, TOLERANCE_EXPECTED)
+        raise refuse(where, text, TOLERANCE_EXPECTED)
     signed = [_percent(p, where, "a tolerance", False, allow_sign=True) for p in parts]
     minus = [v for s, v in signed if s == "-"]
     plus = [v for s, v in signed if s == "+"]
     if len(minus) != 1 or len(plus) != 1:
-        raise OptionError(f"{where}: found {_q(text)}, expected the lower tolerance with - and "
+        raise OptionError(f"{where}: found {quoted(text)}, expected the lower tolerance with - and "
                           "the upper with + (-10%,+20%)")
     return minus[0], plus[0]
 
@@ -457,12 +402,12 @@ def _db(text: str, where: str, side: str) -> float:
     expected = (f"the {side} SRS tolerance in dB, such as {'-3dB' if side == 'lower' else '+6dB'}"
                 f", {'from -' if side == 'lower' else 'from 0 to '}"
                 f"{CAPS['db']:g}{' to 0' if side == 'lower' else ''} dB")
-    sign, magnitude, unit_text = _split(text, where, expected)
-    _unit(unit_text, {"dB": 1}, text, where, expected)
+    sign, magnitude, unit_text = split_quantity(text, where, expected)
+    unit_of(unit_text, {"dB": 1}, text, where, expected)
     value = float(-magnitude if sign == "-" else magnitude)
     if sign == "±" or not math.isfinite(value) or abs(value) > CAPS["db"] or (
             value > 0 if side == "lower" else value < 0):
-        raise _refuse(where, text, expected)
+        raise refuse(where, text, expected)
     return value
 
 
@@ -470,14 +415,14 @@ def parse_db_pair(text: str, where: str = "--srs-tol") -> tuple[float, float]:
     """``-3dB,+6dB`` -> (-3.0, 6.0)."""
     parts = str(text).split(",")
     if len(parts) != 2:
-        raise _refuse(where, text, "a lower and an upper tolerance in dB, such as -3dB,+6dB")
+        raise refuse(where, text, "a lower and an upper tolerance in dB, such as -3dB,+6dB")
     return _db(parts[0], where, "lower"), _db(parts[1], where, "upper")
 
 
 def _name(text: str, where: str, names: tuple, what: str) -> str:
     value = str(text).strip().lower()
     if value not in names:
-        raise _refuse(where, text, f"{what}: one of {', '.join(names)}")
+        raise refuse(where, text, f"{what}: one of {', '.join(names)}")
     return value
 
 
@@ -490,19 +435,19 @@ def parse_record(text: str, where: str = "record") -> JudgedRecord:
         return UNFILTERED
     if match and int(match.group(1)) in CFC_CLASSES:
         return JudgedRecord("cfc", int(match.group(1)))
-    raise _refuse(where, text, "unfiltered or one of 60, 180, 600, 1000 (cfc600)")
+    raise refuse(where, text, "unfiltered or one of 60, 180, 600, 1000 (cfc600)")
 
 
 def parse_q(text: str, where: str = "--srs-q") -> float:
     """The SRS's quality factor: a number without a unit, above 0.5."""
     expected = f"a quality factor without a unit or sign, above 0.5 and at most " \
                f"{CAPS['srs_q']:,g}, such as 10"
-    sign, magnitude, unit_text = _split(text, where, expected)
+    sign, magnitude, unit_text = split_quantity(text, where, expected)
     if sign or unit_text:
-        raise _refuse(where, text, expected)
+        raise refuse(where, text, expected)
     value = float(magnitude)
     if not (0.5 < value <= CAPS["srs_q"]):
-        raise _refuse(where, text, expected)
+        raise refuse(where, text, expected)
     return value
 
 
@@ -530,12 +475,6 @@ class Key:
     show: Callable[[Any], str]
 
 
-def _scaled(magnitude: Decimal, scale: str) -> float:
-    """A decimal times a power of ten (``"1e-3"``), rounded once to a float: how the grammar
-    reads a time in ms or a percentage, and how :func:`_shortest` checks what it prints."""
-    return float(magnitude * Decimal(scale))
-
-
 def _shortest(value: float, scale: str, unit: str) -> str:
     """The shortest decimal text N + ``unit`` that the grammar reads back as ``value``
     exactly (N x ``scale`` rounded once); 17 significant digits always do."""
@@ -546,9 +485,9 @@ def _shortest(value: float, scale: str, unit: str) -> str:
         exact = Decimal(value) / Decimal(scale)
     for digits in range(1, 18):
         text = _plain_decimal(format(exact, f".{digits - 1}e"))
-        if _scaled(Decimal(text), scale) == value:
+        if scaled(Decimal(text), scale) == value:
             return text + unit
-    raise AssertionError(f"no 17-digit text for {_q(value)}")  # a double always has one
+    raise AssertionError(f"no 17-digit text for {quoted(value)}")  # a double always has one
 
 
 def _plain_decimal(text: str) -> str:
@@ -592,17 +531,17 @@ def parse_window(text: str, where: str) -> tuple:
     """``0.4D,0.1D`` -> ((0.4, "D"), (0.1, "D")); ``0.5ms`` -> the same both sides [s]."""
     parts = str(text).split(",")
     if len(parts) not in (1, 2):
-        raise _refuse(where, text, WINDOW_EXPECTED)
+        raise refuse(where, text, WINDOW_EXPECTED)
     sides = []
     for part in parts:
-        sign, magnitude, unit = _split(part, where, WINDOW_EXPECTED)
+        sign, magnitude, unit = split_quantity(part, where, WINDOW_EXPECTED)
         if unit == "D":
             if sign:
-                raise OptionError(f"{where}: found the sign {sign!r} in {_q(text)}, where "
+                raise OptionError(f"{where}: found the sign {sign!r} in {quoted(text)}, where "
                                   f"none is meaningful; expected {WINDOW_EXPECTED}")
             value = float(magnitude)
             if not (math.isfinite(value) and value <= CAPS["window_d"]):
-                raise _refuse(where, text, WINDOW_EXPECTED)
+                raise refuse(where, text, WINDOW_EXPECTED)
             sides.append((value, "D"))
         else:
             sides.append((_time("window", zero=True)(part, where), "s"))
@@ -628,21 +567,21 @@ def show_window(window: tuple) -> str:
 
 
 def _peak(text: str, where: str) -> float:
-    return _quantity(text, where, "a peak", PEAK_UNITS, "12kG, 11750g or 1.2e5m/s^2",
+    return quantity(text, where, "a peak", PEAK_UNITS, "12kG, 11750g or 1.2e5m/s^2",
                      CAPS["peak"], f"{CAPS['peak']:,g} kG", floor=FLOORS["peak"],
                      floor_text="1e-6 kG")
 
 
 def _time(name: str, zero: bool = False) -> Callable[[str, str], float]:
     def parse(text: str, where: str) -> float:
-        return _quantity(text, where, f"a {name}", TIME_UNITS, "5ms or 500us", CAPS[name],
+        return quantity(text, where, f"a {name}", TIME_UNITS, "5ms or 500us", CAPS[name],
                          f"{CAPS[name]:g} s", zero, floor=FLOORS["duration"],
                          floor_text="1 ns")
     return parse
 
 
 def _velocity(text: str, where: str) -> float:
-    return _quantity(text, where, "a velocity change", VELOCITY_UNITS, "35m/s",
+    return quantity(text, where, "a velocity change", VELOCITY_UNITS, "35m/s",
                      CAPS["velocity_change"], f"{CAPS['velocity_change']:,g} m/s",
                      floor=FLOORS["velocity_change"], floor_text="1e-6 m/s")
 
@@ -689,19 +628,9 @@ OPTIONS = {"shape": "--shape", "peak": "--peak", "peak_tolerance": "--peak",
            "srs_upper_db": "--srs-tol", "srs_outside": "--srs-outside"}
 
 
-#: The units a verdict reports the peak and the duration in, as their nominal was given:
-#: unit typed -> (unit shown, factor from the inside unit, kG or s).
-SHOWN_UNITS = {
-    "peak": {"kG": ("kG", 1.0), "g": ("g", KG_MS2 / G), "m/s^2": ("m/s^2", KG_MS2),
-             "m/s2": ("m/s^2", KG_MS2), "m/s²": ("m/s^2", KG_MS2)},
-    "duration": {"s": ("s", 1.0), "ms": ("ms", 1e3), "us": ("us", 1e6), "µs": ("us", 1e6),
-                 "ns": ("ns", 1e9)},
-}
-
-
 def typed_unit(text: str) -> str:
     """The unit a quantity's text ends in (``500g`` -> ``g``)."""
-    match = _SIGNED.match(text.partition(":")[0])
+    match = SIGNED.match(text.partition(":")[0])
     return match.group("unit") if match else ""
 
 
@@ -771,23 +700,23 @@ def parse_key(key: str, value: object, where: str) -> Any:
     if isinstance(value, str):
         return k.parse(value, where)
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise _refuse(where, value, f"text or a number in {k.unit}" if k.unit else "text")
+        raise refuse(where, value, f"text or a number in {k.unit}" if k.unit else "text")
     if isinstance(value, int) and not -10**18 <= value <= 10**18:  # past a float's integers
         raise OptionError(f"{where}: found an integer of more than 18 digits, expected "
                           f"{'a number in ' + k.unit if k.unit else 'text'}")
     number = float(value)
     if not math.isfinite(number):
-        raise _refuse(where, value, f"a finite number{' in ' + k.unit if k.unit else ''}")
+        raise refuse(where, value, f"a finite number{' in ' + k.unit if k.unit else ''}")
     if key == "record":
         return k.parse(f"cfc{int(number)}" if number.is_integer() and number else
                        ("unfiltered" if number == 0 else repr(number)), where)
     if not k.unit:
         if key == "srs_q":
             return k.parse(_plain(number), where)
-        raise _refuse(where, value, "text")
+        raise refuse(where, value, "text")
     sign = "-" if number < 0 else ""
     if key.endswith("_tolerance") and sign:
-        raise OptionError(f"{where}: found {_q(value)}, a single signed tolerance, which is "
+        raise OptionError(f"{where}: found {quoted(value)}, a single signed tolerance, which is "
                           f"ambiguous; expected {TOLERANCE_EXPECTED}")
     if key == "srs_upper_db" and number > 0:
         sign = "+"
@@ -831,7 +760,7 @@ def _alias_number(value: object, where: str) -> str:
     """The old ``window`` key's bare number: ms."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(
             value) or (isinstance(value, int) and abs(value) > 10**18):
-        raise _refuse(where, value, "a number in ms, or " + WINDOW_EXPECTED)
+        raise refuse(where, value, "a number in ms, or " + WINDOW_EXPECTED)
     return f"{'-' if value < 0 else ''}{_plain(abs(float(value)))}ms"
 
 

@@ -1,10 +1,14 @@
-"""Quantities' units, decided once: peaks in kG, g or m/s^2; durations in s, ms, us (or µs)
-and ns; velocities in m/s; the macro's kG and standard gravity. The grammar that reads a
-quantity with them is :mod:`airgun_xl.specification`'s (options, profiles, sheets, design's
-targets); recordings' headers read the same tables (:mod:`airgun_xl.readers.recording`)."""
+"""Quantities, decided once: their units (peaks in kG, g or m/s^2; durations in s, ms, us (or
+µs) and ns; velocities in m/s; the macro's kG and standard gravity), the grammar that reads a
+quantity with them (:func:`quantity`: the options, profiles, the Specification sheet,
+design's targets and convergence's time steps all read by it; the specification's keys
+build on it in :mod:`airgun_xl.specification`), and the units a verdict shows a figure in
+(:data:`SHOWN_UNITS`). Recordings' headers read the same tables
+(:mod:`airgun_xl.readers.recording`)."""
 import math
 import re
-from decimal import Decimal
+from decimal import Decimal, InvalidOperation
+from typing import Any
 
 from .errors import OptionError
 
@@ -23,19 +27,100 @@ TIME_UNITS = {"s": "1", "ms": "1e-3", "us": "1e-6", "µs": "1e-6", "ns": "1e-9"}
 VELOCITY_UNITS = {"m/s": 1.0}  # [m/s per unit]
 #: The units a message names (the others are spellings of these).
 NAMED_UNITS = ("kG", "g", "m/s^2", "s", "ms", "us", "ns", "m/s")
-_TIME = {unit: "e" + scale.partition("e")[2] if "e" in scale else "e0"
-         for unit, scale in TIME_UNITS.items()}
-_NUMBER = r"\s*([0-9]*\.?[0-9]+(?:[eE][+-]?[0-9]+)?)\s*"
+# -- the grammar every quantity is read by (options, profiles, sheets, targets, ladders) ----
+
+#: A number as the grammar reads it: digits, a point, an exponent; its sign is read apart.
+NUMBER = r"(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
+#: A quantity's text: a sign, a number, a unit.
+SIGNED = re.compile(r"^\s*(?P<sign>[-+±]?)\s*" + NUMBER + r"\s*(?P<unit>.*?)\s*$")
+
+
+def quoted(text: object) -> str:
+    """A value as a message quotes it: its repr, cut to a readable length."""
+    shown = repr(text)
+    return shown if len(shown) <= 60 else f"{shown[:50]}... ({len(shown):,} characters)"
+
+
+def refuse(where: str, text: object, expected: str) -> OptionError:
+    """The one line of a refusal: ``WHERE: found TEXT, expected EXPECTED``."""
+    return OptionError(f"{where}: found {quoted(text)}, expected {expected}")
+
+
+def split_quantity(text: str, where: str, expected: str) -> tuple[str, Decimal, str]:
+    """(sign, magnitude, unit text) of a number with an optional sign and unit."""
+    if not text.strip():
+        raise OptionError(f"{where}: found an empty value, expected {expected}")
+    match = SIGNED.match(text)
+    if not match:
+        raise refuse(where, text, expected)
+    try:
+        magnitude = Decimal(match.group("num"))
+    except InvalidOperation:
+        raise refuse(where, text, expected) from None
+    return match.group("sign"), magnitude, match.group("unit")
+
+
+def unit_of(unit: str, units: dict, text: str, where: str, expected: str) -> Any:
+    """``units[unit]``; a unit missing, or a case away from one (the one meant named),
+    refused."""
+    if unit in units:
+        return units[unit]
+    if not unit:
+        raise OptionError(f"{where}: found {quoted(text)} without a unit, expected {expected}")
+    near = [u for u in units if u.lower() == unit.lower()]
+    hint = f" (did you mean {near[0]}?)" if near else ""
+    raise OptionError(f"{where}: found the unit {quoted(unit)} in {quoted(text)}{hint}, "
+                      f"expected {expected}")
+
+
+def scaled(magnitude: Decimal, scale: str) -> float:
+    """A decimal times a power of ten (``"1e-3"``), rounded once to a float: how the grammar
+    reads a time in ms or a percentage."""
+    return float(magnitude * Decimal(scale))
+
+
+def quantity(text: str, where: str, what: str, units: dict, example: str, cap: float,
+             cap_text: str, zero: bool = False, floor: float = 0.0,
+             floor_text: str = "") -> float:
+    """A positive (or, with ``zero``, non-negative) quantity with its unit, at least
+    ``floor`` and at most ``cap`` in the inside unit; times scaled exactly in decimal, then
+    rounded once."""
+    low = "from 0" if zero else f"from {floor_text}" if floor else "above 0"
+    expected = (f"{what} such as {example} (units "
+                f"{', '.join(u for u in units if u in NAMED_UNITS)}), "
+                f"{low} and at most {cap_text}")
+    sign, magnitude, unit_text = split_quantity(text, where, expected)
+    factor = unit_of(unit_text, units, text, where, expected)
+    if sign:
+        raise OptionError(f"{where}: found the sign {sign!r} in {quoted(text)}, where none is "
+                          f"meaningful; expected {expected}")
+    if isinstance(factor, str):  # a time: "5e0us" and "5us" give float("5e-6")
+        value = scaled(magnitude, factor)
+    else:
+        value = float(magnitude) * factor
+    if not (math.isfinite(value) and (value >= 0 if zero else value > 0 and value >= floor)
+            and value <= cap):
+        raise refuse(where, text, expected)
+    return value
 
 
 def parse_duration(text, option="--target-duration"):
-    """``"5ms"`` -> 0.005 [s] (also s, us, µs, ns); the same double as typing it in seconds."""
-    match = re.fullmatch(_NUMBER + r"(s|ms|us|µs|ns)?\s*", str(text))
-    if not match:
-        raise OptionError(f"{option}: found {text!r}, expected a duration such as 5ms, 500us")
-    unit = match.group(2) or "s"
-    # the decimal product, rounded once: "5e0us" and "5us" give float("5e-6"), as typed in s
-    value = float(Decimal(match.group(1)) * Decimal("1" + _TIME[unit]))
-    if not (value > 0 and math.isfinite(value)):
-        raise OptionError(f"{option}: found {text!r}, expected a positive duration")
-    return value
+    """``"5ms"`` -> 0.005 [s] (also s, us, µs, ns) by the grammar every quantity is read by
+    (:func:`quantity`: the same double as typing it in seconds), from 1 ns to 10 s; a bare
+    number is seconds (a time step, ``"5e-6"``)."""
+    text = str(text)
+    match = SIGNED.match(text)
+    if match is not None and not match.group("unit") and not match.group("sign"):
+        text = text.strip() + "s"
+    return quantity(text, option, "a duration", TIME_UNITS, "5ms or 500us", 10.0, "10 s",
+                    floor=1e-9, floor_text="1 ns")
+
+
+#: The units a verdict reports the peak and the duration in, as their nominal was given:
+#: unit typed -> (unit shown, factor from the inside unit, kG or s).
+SHOWN_UNITS = {
+    "peak": {"kG": ("kG", 1.0), "g": ("g", KG_MS2 / G), "m/s^2": ("m/s^2", KG_MS2),
+             "m/s2": ("m/s^2", KG_MS2), "m/s²": ("m/s^2", KG_MS2)},
+    "duration": {"s": ("s", 1.0), "ms": ("ms", 1e3), "us": ("us", 1e6), "µs": ("us", 1e6),
+                 "ns": ("ns", 1e9)},
+}

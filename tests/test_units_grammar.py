@@ -92,3 +92,26 @@ def test_an_option_a_profile_a_sheet_and_a_design_target_read_a_peak_alike(text,
     option, target, profile = _option(text), _target(text), _profile(text, tmp_path)
     sheet = _sheet(text)
     assert option == target == profile == sheet, (text, option, target, profile, sheet)
+
+
+#: Durations as a user types them, among them the three the two readers once disagreed on
+#: (issue 61): a trailing point, a bare number, a step below a nanosecond.
+DURATIONS = ["5ms", "5 ms", "5.ms", ".5ms", "+5ms", "-5ms", "5e-3s", "5MS", "5µs", "5e0us",
+             "0.5e1ms", " 5ms ", "1e-12s", "5 s", "11s", "5 parsecs", ""]
+
+
+@pytest.mark.parametrize("text", DURATIONS)
+def test_a_time_step_and_a_specifications_duration_are_read_by_one_grammar(text):
+    """convergence's --levels (units.parse_duration) and the specification's duration read
+    every text alike, or refuse it in the same words; a bare number, which the ladder takes
+    as seconds, is the one difference, and reads as the same text with "s"."""
+    from airgun_xl.specification import KEYS
+
+    def read(parse, given):
+        try:
+            return parse(given, "--x")
+        except AirgunXlError as exc:
+            return str(exc)
+
+    assert read(units.parse_duration, text) == read(KEYS["duration"].parse, text)
+    assert units.parse_duration("5e-3", "--x") == read(KEYS["duration"].parse, "5e-3s")

@@ -125,7 +125,7 @@ def archive_pairs(root: str | Path) -> list[dict[str, tuple[float, ...]]]:
     is read as untrusted: a value that is no finite number is left out, a unit not known
     refused."""
     from ..archive.lots import lot_names
-    from ..specification import SHOWN_UNITS
+    from ..units import SHOWN_UNITS
 
     pairs = []
     for lot in lot_names(root):

@@ -19,7 +19,6 @@ from ..specification import (
     CFC_CLASSES,
     KEYS,
     OPTIONS,
-    SHOWN_UNITS,
     SrsRequirement,
     cfc_record,
     combine,
@@ -28,6 +27,7 @@ from ..specification import (
     spec_of_keys,
     typed_unit,
 )
+from ..units import SHOWN_UNITS
 
 if TYPE_CHECKING:
     from ..shot import Shot
