@@ -75,14 +75,10 @@ def run(request: RecordingRequest) -> RecordingOutcome:
         The file is missing, not a regular file, too large, or not a readable recording.
     """
     from ..readers import formats
-    from ..readers.recording import RANGE, list_channels
+    from ..readers.recording import list_channels
 
     path = text = request.path
-    if RANGE.match(text) and not Path(text).exists():
-        kind = "workbook range"
-    else:
-        fmt = formats.detect(path)
-        kind = fmt.NAME if fmt is not None else "CSV"
+    kind = formats.detect(path).NAME
     channels = tuple(list_channels(path))
     if not channels:  # a UFF of no time response listed "0 channels" and exited 0
         from ..errors import WorkbookError

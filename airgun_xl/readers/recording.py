@@ -8,39 +8,25 @@ regular file, size capped). Each fault is one line naming the row: a row that is
 numbers, NaN, time that does not increase, a gap in a constant sample rate, too few samples,
 a unit that cannot be told.
 """
-import csv
-import io
-import math
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .. import limits, units
-from ..errors import AirgunXlError, OptionError, WorkbookError
+from .. import limits
+from ..errors import OptionError, WorkbookError
 from ..transaction import display
 from . import formats
-from .guard import read_bytes
-
-#: Time units [s per unit]: the one table's (:data:`airgun_xl.units.TIME_UNITS`).
-TIME_UNITS = {unit: float(scale) for unit, scale in units.TIME_UNITS.items()}
-
-#: Acceleration units [kG per unit], the one table's (:data:`airgun_xl.units.PEAK_UNITS`): a
-#: recorder's g is standard gravity (units.G, 9.80665 m/s^2); the kG is the macro's, 9800
-#: m/s^2 (its Acceleration (kG's) column), so 1 g is 1.000679e-3 kG. The macro's 9800
-#: applies to the macro's columns only.
-ACCEL_UNITS = dict(units.PEAK_UNITS)
-
-#: Spellings a recorder's file may state that the options do not take [kG per unit]: ``G``
-#: (a recorder's g, as shock labs write it; as an option it would sit a case away from kG),
-#: ``mm/ms^2`` (1,000 m/s^2), and ``**`` or ``sec`` for ``^`` and ``s``.
-FILE_ACCEL_UNITS = {**ACCEL_UNITS, "G": ACCEL_UNITS["g"],
-                    "mm/ms^2": 1e3 * ACCEL_UNITS["m/s^2"], "mm/ms**2": 1e3 * ACCEL_UNITS["m/s^2"],
-                    "m/s**2": ACCEL_UNITS["m/s^2"], "m/sec^2": ACCEL_UNITS["m/s^2"],
-                    "m/sec**2": ACCEL_UNITS["m/s^2"]}
-#: The time units a file may state [s per unit]: the options' and ``sec``, ``msec``.
-FILE_TIME_UNITS = {**TIME_UNITS, "sec": 1.0, "msec": 1e-3}
+from .formats import delimited, workbook_range
+from .formats.channels import (  # noqa: F401 (the readers' tables, kept at their old path)
+    ACCEL_UNITS,
+    FILE_ACCEL_UNITS,
+    FILE_TIME_UNITS,
+    TIME_UNITS,
+    stated,
+)
+from .formats.delimited import EXPECTED  # noqa: F401 (a CSV recording's, at its old path)
+from .formats.workbook_range import EXPECTED_RANGE, RANGE  # noqa: F401 (at their old path)
 
 #: A step may differ from the median step by this fraction before the time column is taken
 #: for a recorder's clock whose stamps jitter, and fitted (:mod:`.time_base`).
@@ -49,7 +35,6 @@ GAP_TOLERANCE = 0.01
 #: Fewest samples a pulse may have.
 MIN_SAMPLES = 16
 
-EXPECTED = "expected a CSV of time and acceleration (two columns, a header row)"
 
 
 @dataclass
@@ -81,17 +66,10 @@ class Trace:
     notes: list = field(default_factory=list)
 
 
-def _stated(header):
-    """The unit a header names in brackets or parentheses (``time [ms]`` -> ``ms``; '' for
-    none)."""
-    found = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]", header)
-    return (found.group(1) if found else "").strip()
-
-
 def _unit(header, table, option, which, named=None):
     """The unit key ``header`` states (in ``table``); one line naming ``option`` otherwise.
     ``named``: the channel of a binary file, whose unit is its own field, not a header."""
-    text = _stated(header)
+    text = stated(header)
     key = _key(text)
     near = [k for k in table if k.lower() == key.lower()]
     if named is not None and key not in table and not near:
@@ -112,153 +90,10 @@ def _unit(header, table, option, which, named=None):
     return key
 
 
-def _number(text, decimal_comma):
-    text = text.strip()
-    return float(text.replace(",", ".") if decimal_comma else text)
-
-
-def _is_pair(row, decimal_comma):
-    """Whether a row starts with two numbers."""
-    if len(row) < 2:
-        return False
-    try:
-        _number(row[0], decimal_comma)
-        _number(row[1], decimal_comma)
-    except ValueError:
-        return False
-    return True
-
-
-def _looks_like_data(row):
-    """A row that starts with a number: data, where the header should have been followed by
-    two numbers."""
-    try:
-        float(row[0].strip().replace(",", "."))
-    except (ValueError, IndexError):
-        return False
-    return True
-
-
-def _body(raw, delimiter, comma):
-    """The data lines (UTF-8 bytes) as an n x 2 float array by pandas' C parser (no Python
-    list a row), or None when a line is not two numbers (the slow path then names it)."""
-    import pandas as pd
-
-    try:
-        frame = pd.read_csv(io.BytesIO(raw), sep=delimiter, header=None, usecols=[0, 1],
-                            decimal="," if comma else ".", dtype=float, engine="c",
-                            comment="#", skip_blank_lines=True, skipinitialspace=True)
-    except (ValueError, IndexError, pd.errors.ParserError, pd.errors.EmptyDataError):
-        return None
-    return frame.to_numpy(dtype=float)
-
-
-def _find_bad_line(shown, text, first, delimiter, comma, columns):
-    """Raise the one line naming the first data line that is not two finite numbers."""
-    for number, line in enumerate(text.splitlines(), start=first):
-        try:
-            row = next(csv.reader([line], delimiter=delimiter), [])
-        except csv.Error as exc:
-            raise WorkbookError(f"{shown}: line {number} is not readable CSV ({exc})") from None
-        if not any(cell.strip() for cell in row) or row[0].lstrip().startswith("#"):
-            continue
-        try:
-            a, b = _number(row[0], comma), _number(row[1], comma)
-        except (ValueError, IndexError):
-            raise WorkbookError(f"{shown}: line {number} holds {row[:2]!r}, expected two "
-                                f"numbers ({columns[0]}, {columns[1]})") from None
-        if not (math.isfinite(a) and math.isfinite(b)):
-            raise WorkbookError(f"{shown}: line {number} holds {row[0].strip()}, "
-                                f"{row[1].strip()}, expected finite numbers (no NaN or inf)")
-    raise WorkbookError(f"{shown}: is not a readable CSV of two numbers a line")
-
-
-def _dialect(lines):
-    """(delimiter, decimal comma) of a data-acquisition export's data lines: ``;`` or a tab
-    with a decimal comma (``1,5;0,25``), or a comma, semicolon or tab with a point."""
-    sample = [line for line in lines if line.strip() and not line.lstrip().startswith("#")]
-    sample = sample[-50:]  # data lines, past any metadata and the header
-    for delimiter in (";", "\t", ","):
-        if sample and all(line.count(delimiter) >= 1 for line in sample):
-            comma = delimiter != "," and any("," in line for line in sample)
-            return delimiter, comma
-    return ",", False
-
-
-def _table(path, expected, columns):
-    """(shown name, header, n x 2 values) of a two-column CSV; every row checked.
-
-    Data-acquisition exports are read as they come: ``#`` comment lines and other metadata
-    lines above the header are skipped (the header is the row above the first row of two
-    numbers); ``,``, ``;`` or tab delimiters; a decimal comma with ``;`` or tabs."""
-    shown = display(Path(path))
-    data = read_bytes(path, expected, "CSV")
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise WorkbookError(f"{shown}: is not UTF-8 text (byte {exc.start}), {expected}") \
-            from None
-    count = text.count("\n") + 1
-    if count > limits.MAX_SAMPLES + 1000:  # counted before any parsing: a bounded read
-        raise WorkbookError(f"{shown}: holds {count:,} lines, expected at most "
-                            f"{limits.MAX_SAMPLES:,} samples")
-    delimiter, comma = _dialect(text[-20_000:].splitlines()[-50:])
-    header, start, numbered = None, None, []  # the lines above the data, parsed one by one
-    offset, number = 0, 0
-    while offset <= len(text) and start is None:
-        end = text.find("\n", offset)
-        end = len(text) if end < 0 else end
-        number += 1
-        line = text[offset:end].rstrip("\r")
-        try:
-            row = next(csv.reader([line], delimiter=delimiter), [])
-        except csv.Error as exc:  # a field past csv's limit, a stray quote
-            raise WorkbookError(f"{shown}: line {number} is not readable CSV ({exc}), "
-                                f"{expected}") from None
-        if any(cell.strip() for cell in row) and not row[0].lstrip().startswith("#"):
-            if _is_pair(row, comma):
-                start = (offset, number)
-                break
-            numbered.append((number, row))
-            if len(numbered) >= 2 and not _is_pair(numbered[-2][1], comma) and \
-                    _looks_like_data(numbered[-1][1]):
-                line_no, bad = numbered[-1]  # a header, then a row that is not two numbers
-                raise WorkbookError(f"{shown}: line {line_no} holds {bad[:2]!r}, expected two "
-                                    f"numbers ({columns[0]}, {columns[1]})")
-        offset = end + 1
-    if start is None or not numbered:
-        got = numbered[0] if numbered else (number, [])
-        raise WorkbookError(f"{shown}: line {got[0]} holds {got[1][:3]!r}, {expected}; found "
-                            + ("no header row above the numbers" if start is not None else
-                               f"no row of two numbers ({delimiter!r}-delimited"
-                               + (", decimal comma" if comma else "") + ")"))
-    header_line, header = numbered[-1]
-    if len(header) < 2:
-        raise WorkbookError(f"{shown}: line {header_line} (the header) holds {header!r}, "
-                            f"{expected}")
-    # the data from their first line, as bytes: pandas reads them without a str copy a row
-    head = len(text[:start[0]].encode("utf-8")) + (3 if data.startswith(b"\xef\xbb\xbf") else 0)
-    values = _body(data[head:], delimiter, comma)
-    if values is None or not np.isfinite(values).all():
-        _find_bad_line(shown, text[start[0]:], start[1], delimiter, comma, columns)
-    if len(values) > limits.MAX_SAMPLES:
-        raise WorkbookError(f"{shown}: holds {len(values):,} rows, expected at most "
-                            f"{limits.MAX_SAMPLES:,} samples")
-    return shown, header, values
-
-
-#: ``FILE:SHEET!COL:COL``: a column range of a workbook.
-RANGE = re.compile(r"^(?P<file>.+\.(?:xlsx|xlsm|xls)):(?P<sheet>[^!]+)!(?P<a>[A-Za-z]{1,3})"
-                   r"(?:\d*)?:(?P<b>[A-Za-z]{1,3})(?:\d*)?$", re.IGNORECASE)
-
-EXPECTED_RANGE = ("expected a column range of time and acceleration with a header row, "
-                  "e.g. trace.xlsx:Sheet1!A:B")
-
-
 def input_file(spec):
     """The file a measured source names (the workbook of ``trace.xlsx:Sheet1!A:B``)."""
-    found = RANGE.match(str(spec))
-    return found["file"] if found and not Path(str(spec)).exists() else str(spec)
+    found = RANGE.match(str(spec)) if workbook_range.claims(spec) else None
+    return str(found["file"]) if found is not None else str(spec)
 
 
 def _key(text):
@@ -296,108 +131,28 @@ def _first_acceleration(path, fmt, data):
 
 
 def _source_table(path, channel=None, choose_acceleration=False):
-    """Any measured source as a :class:`~.formats.Table`, and whether a binary format read it;
-    with ``choose_acceleration`` and no ``channel``, a file of several channels whose first is
-    no acceleration gives its first that is (said in the table's notes; the channels are
-    listed only then, so the usual file is parsed once)."""
-    text = str(path)
-    found = RANGE.match(text)
-    if found and not Path(text).exists():
-        if channel is not None:
-            raise OptionError("--channel: found with a workbook range, expected it only "
-                              "with a file of several channels (TDMS, MATLAB .mat, MDF, IDE, UFF, "
-                              "MME)")
-        return formats.Table(*_range_table(found)), False
+    """Any measured source as a :class:`~.formats.Table` (its format from the registry,
+    :func:`.formats.detect`), and whether its format holds several channels; with
+    ``choose_acceleration`` and no ``channel``, a file of several channels whose first is no
+    acceleration gives its first that is (said in the table's notes; the channels are listed
+    only then, so the usual file is parsed once)."""
     fmt = formats.detect(path)
-    if fmt is not None:
-        data = formats.source(fmt, path)
-        table = fmt.read(path, data, channel)
-        if channel is None and choose_acceleration \
-                and _key(_stated(table.header[1])) not in FILE_ACCEL_UNITS:
-            chosen = _first_acceleration(path, fmt, data)
-            if chosen is not None:
-                table = fmt.read(path, data, chosen[0])
-                table = table._replace(notes=(*table.notes, chosen[1]))
-        return table, True
-    if channel is not None:
-        raise OptionError("--channel: found with a CSV file, expected it only with a file of "
-                          "several channels (TDMS, MATLAB .mat, MDF, IDE, UFF, MME)")
-    return formats.Table(*_table(path, EXPECTED, ("time", "acceleration"))), False
+    data = formats.source(fmt, path)
+    table = fmt.read(path, data, channel)
+    if fmt.SEVERAL and channel is None and choose_acceleration \
+            and _key(stated(table.header[1])) not in FILE_ACCEL_UNITS:
+        chosen = _first_acceleration(path, fmt, data)
+        if chosen is not None:
+            table = fmt.read(path, data, chosen[0])
+            table = table._replace(notes=(*table.notes, chosen[1]))
+    return table, fmt.SEVERAL
 
 
 def list_channels(path):
     """The channels of the recording at ``path`` (:class:`~.formats.ChannelInfo`): a CSV or
     a workbook range has one, its second column."""
-    text = str(path)
-    found = RANGE.match(text)
-    fmt = None if found and not Path(text).exists() else formats.detect(path)
-    if fmt is not None:
-        return fmt.channels(path, formats.source(fmt, path))
-    shown, header, values = (_range_table(found) if found and not Path(text).exists()
-                             else _table(path, EXPECTED, ("time", "acceleration")))
-    scale = FILE_TIME_UNITS.get(_stated(header[0]))
-    time = values[:, 0]
-    rate = ((len(time) - 1) / ((time[-1] - time[0]) * scale)
-            if scale and len(time) > 1 and time[-1] > time[0] else None)
-    return [formats.ChannelInfo(header[1], _stated(header[1]), rate, len(values),
-                                float(time[0]) * scale if scale else None)]
-
-
-def _column(letters):
-    n = 0
-    for ch in letters.upper():
-        n = n * 26 + ord(ch) - 64
-    return n - 1
-
-
-def _range_table(found):
-    from . import guard
-
-    path = Path(found["file"])
-    shown = f"{display(path)}:{found['sheet']}!{found['a'].upper()}:{found['b'].upper()}"
-    data, kind = guard.read_input(path)
-    if kind == "zip":
-        zf = guard.open_zip(path, data)  # sizes, ratios and entities, before any parser
-        member = guard.sheet_member(path, zf, found["sheet"])
-        if member is not None:  # its extent, before calamine makes it dense (issue 23.1)
-            rows, columns = guard.sheet_extent(path, zf, member, cap=limits.MAX_DIFF_CELLS,
-                                               what=f"sheet {found['sheet']!r}")
-            guard.check_extent(path, f"sheet {found['sheet']!r}", rows, columns,
-                               limits.MAX_DIFF_CELLS)
-        zf.close()
-    else:
-        for k, (rows, columns) in enumerate(guard.xls_extents(path, data)):
-            guard.check_extent(path, f"sheet {k + 1}", rows, columns, limits.MAX_XLS_CELLS)
-    a, b = _column(found["a"]), _column(found["b"])
-    if a == b:
-        raise OptionError(f"{shown}: names one column, {EXPECTED_RANGE}")
-    try:
-        from python_calamine import CalamineWorkbook
-
-        wb = CalamineWorkbook.from_filelike(io.BytesIO(data))
-        if found["sheet"] not in wb.sheet_names:
-            raise WorkbookError(f"{shown}: has no sheet {found['sheet']!r} (it has "
-                                f"{', '.join(map(repr, wb.sheet_names[:5]))}), "
-                                f"{EXPECTED_RANGE}")
-        rows = wb.get_sheet_by_name(found["sheet"]).to_python(skip_empty_area=False)
-    except AirgunXlError:
-        raise
-    except Exception as exc:  # noqa: BLE001 - any parser failure on untrusted bytes: one line
-        raise WorkbookError(f"{shown}: is not a readable workbook ({type(exc).__name__}), "
-                            f"{EXPECTED_RANGE}") from None
-    rows = [r for r in rows if len(r) > max(a, b) and (r[a] != "" or r[b] != "")]
-    if len(rows) < 2:
-        raise WorkbookError(f"{shown}: holds {len(rows)} rows, {EXPECTED_RANGE}")
-    header = [str(rows[0][a]), str(rows[0][b])]
-    values = np.empty((len(rows) - 1, 2))
-    for i, row in enumerate(rows[1:], start=2):
-        cells = (row[a], row[b])
-        if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in cells) \
-                or not all(math.isfinite(v) for v in cells):
-            raise WorkbookError(f"{shown}: row {i} holds {list(cells)!r}, expected two finite "
-                                "numbers (time, acceleration)")
-        values[i - 2] = cells
-    return shown, header, values
+    fmt = formats.detect(path)
+    return fmt.channels(path, formats.source(fmt, path))
 
 
 #: Frequency units [Hz per unit] of a required spectrum.
@@ -415,7 +170,7 @@ def read_spectrum(path, accel_unit=None, option="--target-srs"):
     if accel_unit is not None and accel_unit not in ACCEL_UNITS:
         raise OptionError(f"--accel-unit: found {accel_unit!r}, expected one of "
                           f"{', '.join(ACCEL_UNITS)}")
-    shown, header, values = _table(path, EXPECTED_SPECTRUM, ("frequency", "level"))
+    shown, header, values = delimited.table(path, EXPECTED_SPECTRUM, ("frequency", "level"))
     f_unit = _unit(header[0], FREQUENCY_UNITS, option, "frequency")
     a_unit = accel_unit or _unit(header[1], ACCEL_UNITS, "--accel-unit", "level")
     f = values[:, 0] * FREQUENCY_UNITS[f_unit]
@@ -510,9 +265,9 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
 def _override(shown, option, given, header, table):
     """The warning when ``option``'s unit replaces a different one the file states in
     ``header`` ('' when the file states none, or the same unit)."""
-    stated = _stated(header)
-    key = stated.replace("'s", "").replace("²", "^2").replace(" ", "")
-    if not stated or (key in table and table[key] == table[given]):
+    said = stated(header)
+    key = said.replace("'s", "").replace("²", "^2").replace(" ", "")
+    if not said or (key in table and table[key] == table[given]):
         return ""
-    return (f"{shown}: {option} {given} replaces the unit the file states ({stated}): its "
+    return (f"{shown}: {option} {given} replaces the unit the file states ({said}): its "
             f"values are read as {given}")

@@ -1,4 +1,7 @@
-"""Recording formats a recorder or analyser exports, one module each behind one interface.
+"""Recording formats a recorder or analyser exports, one module each behind one interface
+(:class:`RecordingFormat`), in one registry (:data:`FORMATS`): the binary formats told by
+content or name, a workbook's column range told by its text, and CSV, which a file no
+other format claims is read as (:func:`detect`).
 
 A format module holds:
 
@@ -12,8 +15,14 @@ A format module holds:
 - ``read(path, data, channel)``: the chosen channel as a :class:`Table` (how messages name
   it, the header naming the units as the file states them, ``time [s]``, ``acceleration [g]``,
   the (n, 2) array of time and the scaled (physical) acceleration, and the reading's notes);
+- ``named(path)``: whether the file's name is this format's, where its content did not
+  tell (its suffix; an MME channel file's ``TEST.001``; a workbook range's text);
+- ``SEVERAL``: whether a file holds several channels (``--channel`` chooses one; CSV and a
+  workbook range refuse it);
 - ``WINDOWED`` (optional, True): the format reads a file past
-  :data:`airgun_xl.limits.MAX_INPUT_BYTES` without reading it whole.
+  :data:`airgun_xl.limits.MAX_INPUT_BYTES` without reading it whole;
+- ``load(path)`` (optional): what its reader is given, where not the file's capped bytes
+  (a workbook range: its parts).
 
 The file's bytes come from :func:`airgun_xl.readers.guard.read_bytes` (a regular file, its
 size capped before it is read), so a reader parses bytes in memory and never opens a path; a
@@ -31,41 +40,72 @@ Every fault is one :class:`~airgun_xl.errors.WorkbookError` (the file) or
 from __future__ import annotations
 
 from pathlib import Path
-from types import ModuleType
+from typing import Any, Protocol
 
 from ... import limits
 from ..guard import LargeFile, large_file, read_bytes
-from . import ide, mat, mdf, mme, tdms, uff
+from . import delimited, ide, mat, mdf, mme, tdms, uff, workbook_range
 from .channels import ChannelInfo, Table, choose
+
+
+class RecordingFormat(Protocol):
+    """The interface every format module offers (a module is its implementation)."""
+
+    @property
+    def NAME(self) -> str: ...  # noqa: N802 (a module's constant)
+
+    @property
+    def SUFFIXES(self) -> tuple[str, ...]: ...  # noqa: N802
+
+    @property
+    def EXPECTED(self) -> str: ...  # noqa: N802
+
+    @property
+    def SEVERAL(self) -> bool: ...  # noqa: N802
+
+    def sniff(self, head: bytes) -> bool: ...
+
+    def named(self, path: str | Path) -> bool: ...
+
+    def channels(self, path: str | Path, data: Any) -> list[ChannelInfo]: ...
+
+    def read(self, path: str | Path, data: Any, channel: str | None) -> Table: ...
+
 
 #: Bytes read to tell a format by its content (a MATLAB v7.3 file's HDF5 signature is at 512).
 HEAD = 1024
 
-#: The formats told by content, in the order they are tried; a file none of them claims is
-#: read as CSV.
-FORMATS: tuple[ModuleType, ...] = (tdms, mat, mdf, ide, uff, mme)
+#: Every format but the fallback, in the order they are tried: by content first, then by
+#: name (a workbook range is told by its text before any file is opened).
+FORMATS: tuple[RecordingFormat, ...] = (tdms, mat, mdf, ide, uff, mme)
+
+#: What a file no format claims is read as.
+FALLBACK: RecordingFormat = delimited
 
 EXPECTED_RECORDING = ("expected a recording (CSV, TDMS, MATLAB .mat, MDF, enDAQ IDE, UFF 58 or "
                       "ISO 13499 MME)")
 
 
-def detect(path: str | Path) -> ModuleType | None:
-    """The format module of the file at ``path``: by its content, else by its suffix; None
-    for a file no format claims (read as CSV)."""
+def detect(path: str | Path) -> RecordingFormat:
+    """The format of the recording ``path`` names: a workbook's column range by its text;
+    a file by its content, else by its name (:data:`FORMATS`), else CSV (:data:`FALLBACK`)."""
+    if workbook_range.claims(path):
+        return workbook_range
     head = read_bytes(path, EXPECTED_RECORDING, "recording", head=HEAD)
     for fmt in FORMATS:
         if fmt.sniff(head):
             return fmt
-    suffix = Path(path).suffix.lower()
-    if mme.channel_file(path):
-        return mme
-    return next((fmt for fmt in FORMATS if suffix in fmt.SUFFIXES), None)
+    return next((fmt for fmt in FORMATS if fmt.named(path)), FALLBACK)
 
 
-def source(fmt: ModuleType, path: str | Path) -> bytes | LargeFile:
-    """What ``fmt``'s reader is given of the file at ``path``: its bytes (at most
+def source(fmt: RecordingFormat, path: str | Path) -> Any:
+    """What ``fmt``'s reader is given of the recording ``path`` names: the format's own
+    ``load`` where it has one; else the file's bytes (at most
     :data:`~airgun_xl.limits.MAX_INPUT_BYTES`), or, for a ``WINDOWED`` format, a larger file
     (up to :data:`~airgun_xl.limits.MAX_WINDOWED_BYTES`) as a :class:`LargeFile`."""
+    load = getattr(fmt, "load", None)
+    if load is not None:
+        return load(path)
     if getattr(fmt, "WINDOWED", False):
         large = large_file(path, fmt.EXPECTED, "recording", limits.MAX_WINDOWED_BYTES)
         if large is not None:
@@ -73,5 +113,5 @@ def source(fmt: ModuleType, path: str | Path) -> bytes | LargeFile:
     return read_bytes(path, fmt.EXPECTED, "recording")
 
 
-__all__ = ["EXPECTED_RECORDING", "FORMATS", "HEAD", "ChannelInfo", "LargeFile", "Table",
-           "choose", "detect", "source"]
+__all__ = ["EXPECTED_RECORDING", "FALLBACK", "FORMATS", "HEAD", "ChannelInfo", "LargeFile",
+           "RecordingFormat", "Table", "choose", "detect", "source"]

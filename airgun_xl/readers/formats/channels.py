@@ -1,16 +1,45 @@
 """What every recording format says of a channel (:class:`ChannelInfo`), how
-``--channel`` chooses one (:func:`choose`), and which stretch of a long channel is read
-(:func:`pulse_window`): the same in every format."""
+``--channel`` chooses one (:func:`choose`), which stretch of a long channel is read
+(:func:`pulse_window`), and the units a file's header may state (:func:`stated`, the
+``FILE_*_UNITS`` tables): the same in every format."""
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
 
+from ... import units
 from ...errors import OptionError, WorkbookError
+
+#: Time units [s per unit]: the one table's (:data:`airgun_xl.units.TIME_UNITS`).
+TIME_UNITS = {unit: float(scale) for unit, scale in units.TIME_UNITS.items()}
+
+#: Acceleration units [kG per unit], the one table's (:data:`airgun_xl.units.PEAK_UNITS`): a
+#: recorder's g is standard gravity (units.G, 9.80665 m/s^2); the kG is the macro's, 9800
+#: m/s^2 (its Acceleration (kG's) column), so 1 g is 1.000679e-3 kG. The macro's 9800
+#: applies to the macro's columns only.
+ACCEL_UNITS = dict(units.PEAK_UNITS)
+
+#: Spellings a recorder's file may state that the options do not take [kG per unit]: ``G``
+#: (a recorder's g, as shock labs write it; as an option it would sit a case away from kG),
+#: ``mm/ms^2`` (1,000 m/s^2), and ``**`` or ``sec`` for ``^`` and ``s``.
+FILE_ACCEL_UNITS = {**ACCEL_UNITS, "G": ACCEL_UNITS["g"],
+                    "mm/ms^2": 1e3 * ACCEL_UNITS["m/s^2"], "mm/ms**2": 1e3 * ACCEL_UNITS["m/s^2"],
+                    "m/s**2": ACCEL_UNITS["m/s^2"], "m/sec^2": ACCEL_UNITS["m/s^2"],
+                    "m/sec**2": ACCEL_UNITS["m/s^2"]}
+#: The time units a file may state [s per unit]: the options' and ``sec``, ``msec``.
+FILE_TIME_UNITS = {**TIME_UNITS, "sec": 1.0, "msec": 1e-3}
+
+
+def stated(header: str) -> str:
+    """The unit a header names in brackets or parentheses (``time [ms]`` -> ``ms``; '' for
+    none)."""
+    found = re.search(r"[\[(]\s*([^\])]+?)\s*[\])]", header)
+    return (found.group(1) if found else "").strip()
 
 
 @dataclass(frozen=True)

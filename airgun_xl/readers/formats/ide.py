@@ -40,6 +40,15 @@ TIME_RESOLUTION = 2e-6
 _NO_DEFAULTS: dict[str, Any] = {"sensors": {}, "channels": {}, "warnings": []}
 
 
+#: A file of several channels: ``--channel`` chooses one.
+SEVERAL = True
+
+
+def named(path: str | Path) -> bool:
+    """Whether the file's name is this format's: its suffix."""
+    return Path(path).suffix.lower() in SUFFIXES
+
+
 def sniff(head: bytes) -> bool:
     """An EBML header whose DocType is ``mide``."""
     return head.startswith(EBML_MAGIC) and b"\x42\x82\x84mide" in head[:64]

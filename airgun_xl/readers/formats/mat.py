@@ -54,6 +54,15 @@ NUMERIC = {"double", "single", "int8", "uint8", "int16", "uint16", "int32", "uin
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
+#: A file of several channels: ``--channel`` chooses one.
+SEVERAL = True
+
+
+def named(path: str | Path) -> bool:
+    """Whether the file's name is this format's: its suffix."""
+    return Path(path).suffix.lower() in SUFFIXES
+
+
 def sniff(head: bytes) -> bool:
     """A v5/v7/v7.3 file starts with MATLAB's 116-byte text header (a v4 file has none: it
     is told by its suffix)."""

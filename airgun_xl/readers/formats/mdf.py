@@ -40,6 +40,15 @@ WINDOWED = True
 TIMEOUT = 120.0
 
 
+#: A file of several channels: ``--channel`` chooses one.
+SEVERAL = True
+
+
+def named(path: str | Path) -> bool:
+    """Whether the file's name is this format's: its suffix."""
+    return Path(path).suffix.lower() in SUFFIXES
+
+
 def sniff(head: bytes) -> bool:
     """An MDF file starts with its identification block's ``MDF     ``."""
     return head[:8] == b"MDF     "

@@ -52,6 +52,16 @@ _HEADER_LINE = re.compile(r"^([A-Za-z][^:]{0,80}?)\s*:(.*)$")
 _CHANNEL_FILE = re.compile(r"\.\d{3}$")
 
 
+#: A file of several channels: ``--channel`` chooses one.
+SEVERAL = True
+
+
+def named(path: str | Path) -> bool:
+    """Whether the file's name is this format's: its suffix, or an MME channel file's
+    ``TEST.001``."""
+    return Path(path).suffix.lower() in SUFFIXES or channel_file(path)
+
+
 def sniff(head: bytes) -> bool:
     """An MME file or channel file starts with one of the format's header lines (an NHTSA
     export's test file with ``Data format``, its channel files with ``Channel code``)."""

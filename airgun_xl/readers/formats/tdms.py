@@ -31,6 +31,15 @@ EXPECTED = "expected a LabVIEW TDMS file with a waveform channel of acceleration
 WINDOWED = True
 
 
+#: A file of several channels: ``--channel`` chooses one.
+SEVERAL = True
+
+
+def named(path: str | Path) -> bool:
+    """Whether the file's name is this format's: its suffix."""
+    return Path(path).suffix.lower() in SUFFIXES
+
+
 def sniff(head: bytes) -> bool:
     """A TDMS segment starts with its lead-in tag."""
     return head[:4] == b"TDSm"

@@ -32,6 +32,15 @@ EXPECTED = ("expected a Universal File (UFF) with a dataset 58 time response of 
 TIME_RESPONSE = 1
 
 
+#: A file of several channels: ``--channel`` chooses one.
+SEVERAL = True
+
+
+def named(path: str | Path) -> bool:
+    """Whether the file's name is this format's: its suffix."""
+    return Path(path).suffix.lower() in SUFFIXES
+
+
 def sniff(head: bytes) -> bool:
     """A universal file starts with a ``-1`` delimiter line, then the dataset's number."""
     lines = head.lstrip(b"\r\n").splitlines()
