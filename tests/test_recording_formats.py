@@ -1018,3 +1018,39 @@ def test_an_ide_files_subchannels_are_listed_and_an_undescribed_file_refused(pul
     assert main(["recording", str(deep)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "deep.ide: has no recording properties" in err
+
+
+def test_every_format_joins_one_registry_behind_one_interface(pulse, tmp_path):
+    """Issue 61: the binary formats, CSV and a workbook's column range offer the same
+    interface (:class:`RecordingFormat`'s members, checked on each module), and ``detect``
+    chooses each from the one registry: a range by its text (no file opened), a file by its
+    content, else by its name, else CSV; the reference CSV and its range in a workbook list
+    the same one channel."""
+    import inspect
+
+    import openpyxl
+
+    from airgun_xl.readers import formats
+    from airgun_xl.readers.formats import delimited, mme, workbook_range
+    from airgun_xl.readers.recording import list_channels
+
+    members = {"NAME", "SUFFIXES", "EXPECTED", "SEVERAL", "sniff", "named", "channels", "read"}
+    assert members <= {n for n, _ in inspect.getmembers(formats.RecordingFormat)}
+    for fmt in (*formats.FORMATS, formats.FALLBACK, workbook_range):
+        assert all(hasattr(fmt, m) for m in members), fmt.NAME
+        assert fmt.SEVERAL == (fmt in formats.FORMATS), fmt.NAME
+    _folder, _trace, files = pulse
+    assert formats.detect(files["csv"]) is delimited
+    assert formats.detect("trace.xlsx:Sheet1!A:B") is workbook_range  # no such file: text
+    named = tmp_path / "TEST.001"  # an MME channel file told by its name, not content
+    named.write_bytes(b"\0" * 64)
+    assert formats.detect(named) is mme
+    book = openpyxl.Workbook()
+    rows = np.loadtxt(files["csv"], delimiter=",", skiprows=1)
+    header = files["csv"].read_text().splitlines()[0].split(",")
+    book.active.append(header)
+    for t, a in rows:
+        book.active.append([float(t), float(a)])
+    book.save(tmp_path / "r.xlsx")
+    (one,) = list_channels(f"{tmp_path / 'r.xlsx'}:Sheet!A:B")
+    assert one == list_channels(files["csv"])[0]
