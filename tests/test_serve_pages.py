@@ -449,7 +449,7 @@ def test_while_the_first_listing_is_read_the_pages_say_how_far_and_a_shot_answer
         status, _h, body = get(f"{url}/shot/1")
         assert status == 200 and b"shot1@1" in body
         gate.set()
-        app.state.listing.snapshot()  # waits for the read to end
+        app.state.view.listing.snapshot()  # waits for the read to end
         status, _h, body = get(f"{url}/shots")
         assert status == 200 and b"3 of 3 runs" in body
         # then the inputs the index does not hold: a page drawing by one says how far
@@ -458,7 +458,7 @@ def test_while_the_first_listing_is_read_the_pages_say_how_far_and_a_shot_answer
         assert status == 503 and b"reading the archive&#39;s runs&#39; inputs: 1 of 3" in body
         assert get(f"{url}/shots?x=E2")[0] == 200  # an input the index holds: at once
         inputs_gate.set()
-        while app.state.listing.inputs_progress is not None:  # a poll for the read's end
+        while app.state.view.listing.inputs_progress is not None:  # a poll for the read's end
             thread.join(0.01)
         status, _h, body = get(f"{url}/shots?x=E43")
         assert status == 200 and b"3 of 3 runs" in body

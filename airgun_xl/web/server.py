@@ -18,13 +18,19 @@ import csv
 import io
 import json
 import math
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import OptionError
 from ..units import PEAK_UNITS
 from .pages import finite as pages_finite
 from .pages import real
+
+if TYPE_CHECKING:
+    from starlette.requests import Request
+    from starlette.responses import Response
 
 #: Loopback names the server answers by default; ``--host`` adds its own.
 LOOPBACK = ("127.0.0.1", "localhost", "::1", "[::1]")
@@ -84,198 +90,261 @@ class Guard:
             await response(scope, receive, send_with_headers)
 
 
+@dataclass(frozen=True)
+class View:
+    """What every page of one archive's view reads: the archive (read-only), its listing
+    (read once, kept while the index is unchanged), the templates, the archive's label and
+    the input cells a page may name. Kept in ``app.state.view``."""
+
+    found: Any  # listing.read_only's archive
+    listing: Any  # listing.Listing
+    templates: Any  # starlette.templating.Jinja2Templates
+    label: str
+    known_cells: Any
+
+
+# The endpoints are module-level plain functions: Starlette runs each in its thread pool, so
+# a page that reads an entry from the disk does not hold another's request (the listing is
+# shared under its lock); each reads the archive's :class:`View` from the application.
+
+def _view(request: Request) -> View:
+    view: View = request.app.state.view
+    return view
+
+
+def _page(request: Request, name: str, context: dict[str, Any], status: int = 200) -> Any:
+    view = _view(request)
+    return view.templates.TemplateResponse(request, name, {"archive": view.label, **context},
+                                           status_code=status)
+
+
+def _missing(request: Request, message: str) -> Any:
+    return _page(request, "missing.html", {"message": message}, 404)
+
+
+def _reading(request: Request, inputs: bool = False) -> Any:
+    """While the first listing (or, with ``inputs``, the runs' inputs the index does not
+    hold) is read: how far it is, 503 and a retry in a second (the page reloads itself: a
+    meta refresh, no script)."""
+    from starlette.responses import Response
+
+    listing = _view(request).listing
+    done, total = (listing.inputs_progress if inputs else listing.progress) or (0, 0)
+    what = "the archive's runs' inputs" if inputs else "the archive's runs"
+    if request.url.path == "/shots.csv":
+        return Response(f"reading {what} ({done:,} of {total:,}): try again in a second\n",
+                        503, media_type="text/plain")
+    return _page(request, "reading.html", {"done": done, "total": total, "what": what}, 503)
+
+
+def _inputs_for(request: Request, snapshot: Any, cells: set[str]) -> Any:
+    """Every row's inputs ``cells`` read (None), or the page saying they are being read."""
+    from .listing import indexed_cells
+
+    needed = cells - {""} - set(indexed_cells())
+    if needed and _view(request).listing.inputs_progress is not None:
+        return _reading(request, inputs=True)
+    for cell in needed:
+        snapshot.with_inputs(cell)
+    return None
+
+
+def shots(request: Request) -> Response:
+    """The shots page: the archive's runs, filtered, sorted and paged, with a scatter."""
+    from . import pages
+    from .listing import FIGURES
+
+    view = _view(request)
+    snapshot = view.listing.snapshot(wait=False)
+    if snapshot is None:
+        return _reading(request)
+    f = pages.filters(request.query_params)
+    waiting = _inputs_for(request, snapshot, {f["x"], f["input"]})
+    if waiting is not None:
+        return waiting
+    rows = pages.selected(snapshot, f)
+    count = len(rows)
+    last = max(1, math.ceil(count / pages.PAGE))
+    at = min(max(1, int(pages.number(request.query_params.get("page")) or 1)), last)
+    shown = [{"id": r["id"], "cells": [(key, pages.shown(r.get(key), factor, digits, key))
+                                       for key, _h, _u, factor, digits in pages.COLUMNS],
+              "warnings": r.get("warnings") or []}
+             for r in rows[(at - 1) * pages.PAGE: at * pages.PAGE]]
+    return _page(request, "shots.html", {
+        "rows": shown, "columns": pages.COLUMNS, "count": count, "page": at,
+        "pages": last, "f": f, "lots": snapshot.lots, "bad": snapshot.bad,
+        "cells": view.known_cells, "figures": FIGURES, "colours": pages.COLOURS,
+        "total": len(snapshot.rows), "taken": snapshot.taken,
+        "scatter": json.dumps(pages.scatter(rows, f), allow_nan=False)})
+
+
+def shots_csv(request: Request) -> Response:
+    """What the shots page shows, as a CSV (every text a spreadsheet would run, as text)."""
+    from starlette.responses import Response
+
+    from . import pages
+
+    view = _view(request)
+    snapshot = view.listing.snapshot(wait=False)
+    if snapshot is None:
+        return _reading(request)
+    f = pages.filters(request.query_params)
+    waiting = _inputs_for(request, snapshot, {f["input"]})
+    if waiting is not None:
+        return waiting
+    rows = pages.selected(snapshot, f)
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow([f"{h} [{u}]" if u else h for _k, h, u, _f, _d in pages.COLUMNS]
+                    + ["warning texts"])
+    for r in rows:  # a text that a spreadsheet would run is written as text
+        writer.writerow([_csv_text(r.get(k)) if d is None else
+                         ("" if r.get(k) is None else repr(r[k] * factor))
+                         for k, _h, _u, factor, d in pages.COLUMNS]
+                        + [_csv_text("; ".join(r.get("warnings") or []))])
+    return Response(out.getvalue(), media_type="text/csv; charset=utf-8", headers={
+        "content-disposition": f'attachment; filename="{_file_name(view.label)}-shots.csv"'})
+
+
+def _entry_doc(view: View, snapshot: Any, ident: int) -> tuple[Any, Any]:
+    """An entry's records as ``show`` reads them, and its predicted pulse."""
+    from ..app.archive import predicted_pulse, show_entry
+
+    entry = snapshot.entries.get(ident)
+    if entry is None:
+        raise LookupError(f"#{ident}: no such entry in {view.label}, expected an id the "
+                          "shots page lists")
+    outcome = show_entry(view.found, entry, snapshot.index_rows)
+    return outcome.doc, predicted_pulse(entry)
+
+
+def shot(request: Request) -> Response:
+    """A shot's page: its figures, warnings, provenance, predicted pulse and verdicts."""
+    from ..app.archive import shown_figure
+    from ..errors import AirgunXlError
+    from . import pages
+
+    view = _view(request)
+    ident = request.path_params["ident"]
+    snapshot = view.listing.snapshot(wait=False) or view.listing.one(ident)
+    try:
+        doc, (time, accel) = _entry_doc(view, snapshot, ident)
+    except (AirgunXlError, LookupError) as exc:
+        return _missing(request, str(exc).strip("'\""))
+    summary = dict(doc["summary"])
+    warnings = summary.pop("warnings", None)
+    predicted = summary.pop("predicted_verdict", None)
+    figures = [shown_figure(k, v) for k, v in summary.items()]
+    t, a = pages.thinned(time, accel)
+    recorded = []
+    start = pages.finite(summary.get("pulse_start"), 1e3)
+    for v in snapshot.verdicts_of(snapshot.entries[ident]):
+        shown = _verdict(view.found.root, v)
+        chart = pages.verdict_chart((t, a), shown.pop("trace", None), start)
+        shown["chart"] = chart and {**chart, "json": json.dumps(chart, allow_nan=False)}
+        recorded.append(shown)
+    predicted = predicted if isinstance(predicted, dict) else None
+    band = _peak_band(predicted, recorded)
+    return _page(request, "shot.html", {
+        "doc": doc, "figures": figures, "warnings": warnings, "predicted": predicted,
+        "recorded": recorded, "samples": len(time), "drawn": len(t), "band": band,
+        "pulse": json.dumps({"time_ms": t, "accel_kg": a,
+                             "band": [band["low"], band["high"]] if band else None},
+                            allow_nan=False)})
+
+
+def compare(request: Request) -> Response:
+    """Shots side by side: the inputs that differ, their figures, their pulses overlaid."""
+    from ..app.archive import FIGURE_UNITS, shown_figure
+    from ..errors import AirgunXlError
+    from . import pages
+
+    view = _view(request)
+    snapshot = view.listing.snapshot(wait=False)
+    if snapshot is None:
+        return _reading(request)
+    ids = pages.compared_ids(request.query_params)
+    docs, pulses, refused = [], [], []
+    for ident in ids:
+        try:
+            doc, pulse = _entry_doc(view, snapshot, ident)
+        except (AirgunXlError, LookupError) as exc:
+            refused.append(str(exc).strip("'\""))
+            continue
+        docs.append(doc)
+        pulses.append(pulse)
+    kept = [d["id"] for d in docs]
+    differ, equal = pages.differing(docs)
+    keys = [k for k in FIGURE_UNITS if any(k in d["summary"] for d in docs)]
+    figures = [(shown_figure(k, None)[0], [shown_figure(k, d["summary"].get(k))[1]
+                                           for d in docs]) for k in keys]
+    drawn = pages.overlaid(pulses)
+    return _page(request, "compare.html", {
+        "docs": docs, "ids": kept, "refused": refused, "differ": differ, "equal": equal,
+        "figures": figures, "max": pages.MAX_COMPARED,
+        "candidates": [r for r in snapshot.rows if r["id"] not in kept][:500],
+        "pulses": json.dumps({**drawn, "names": [d["entry"] for d in docs]},
+                             allow_nan=False)})
+
+
+def laws(request: Request) -> Response:
+    """The laws page: each lot's law versions, its chain, P(PASS) against outcomes."""
+    from . import pages
+
+    view = _view(request)
+    snapshot = view.listing.snapshot(wait=False)
+    if snapshot is None:
+        return _reading(request)
+    return _page(request, "laws.html",
+                 _laws(view.found.root, snapshot, pages))
+
+
+async def home(_request: Request) -> Response:
+    from starlette.responses import RedirectResponse
+
+    return RedirectResponse("/shots", 302)
+
+
+def _counted(endpoint: Callable[[Request], Response]) -> Callable[[Request], Response]:
+    """``endpoint`` counted as a request in flight (:meth:`Listing.request`)."""
+    def answer(request: Request) -> Response:
+        with _view(request).listing.request():
+            return endpoint(request)
+    answer.__name__ = endpoint.__name__
+    return answer
+
+
 def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = True) -> Any:
     """The view of the archive at ``archive``, answering the loopback names and ``hosts``;
     ``warm``: its listing read in the background from the start."""
+    import jinja2
     from starlette.applications import Starlette
     from starlette.middleware import Middleware
     from starlette.middleware.trustedhost import TrustedHostMiddleware
-    from starlette.requests import Request
-    from starlette.responses import RedirectResponse, Response
     from starlette.routing import Mount, Route
     from starlette.staticfiles import StaticFiles
     from starlette.templating import Jinja2Templates
 
-    from ..app.archive import FIGURE_UNITS, predicted_pulse, show_entry, shown_figure
-    from ..errors import AirgunXlError
     from . import pages
-    from .listing import FIGURES, Listing, indexed_cells, read_only
+    from .listing import Listing, read_only
 
     found = read_only(archive)
     listing = Listing(found)
     if warm:
         listing.warm()
-    import jinja2
-
     templates = Jinja2Templates(env=jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(_HERE / "templates")), autoescape=True))
     templates.env.filters["safe_json"] = _script_json
     templates.env.globals.update(url=pages.url, compare_url=pages.compare_url)
-    label = found.root.name
-    known_cells = pages.cells()
-
-    # The pages are plain functions: Starlette runs each in its thread pool, so a page that
-    # reads an entry from the disk does not hold another's request (the listing is shared
-    # under its lock).
-    def page(request: Request, name: str, context: dict[str, Any], status: int = 200) -> Any:
-        return templates.TemplateResponse(request, name, {"archive": label, **context},
-                                          status_code=status)
-
-    def missing(request: Request, message: str) -> Any:
-        return page(request, "missing.html", {"message": message}, 404)
-
-    def reading(request: Request, inputs: bool = False) -> Any:
-        """While the first listing (or, with ``inputs``, the runs' inputs the index does not
-        hold) is read: how far it is, 503 and a retry in a second (the page reloads itself:
-        a meta refresh, no script)."""
-        done, total = (listing.inputs_progress if inputs else listing.progress) or (0, 0)
-        what = "the archive's runs' inputs" if inputs else "the archive's runs"
-        return page(request, "reading.html", {"done": done, "total": total, "what": what},
-                    503) if request.url.path != "/shots.csv" else Response(
-                        f"reading {what} ({done:,} of {total:,}): try again in a second\n",
-                        503, media_type="text/plain")
-
-    def inputs_for(request: Request, snapshot: Any, cells: set[str]) -> Any:
-        """Every row's inputs ``cells`` read (None), or the page saying they are being read."""
-        needed = cells - {""} - set(indexed_cells())
-        if needed and listing.inputs_progress is not None:
-            return reading(request, inputs=True)
-        for cell in needed:
-            snapshot.with_inputs(cell)
-        return None
-
-    def shots(request: Request) -> Response:
-        snapshot = listing.snapshot(wait=False)
-        if snapshot is None:
-            return reading(request)
-        f = pages.filters(request.query_params)
-        waiting = inputs_for(request, snapshot, {f["x"], f["input"]})
-        if waiting is not None:
-            return waiting
-        rows = pages.selected(snapshot, f)
-        count = len(rows)
-        last = max(1, math.ceil(count / pages.PAGE))
-        at = min(max(1, int(pages.number(request.query_params.get("page")) or 1)), last)
-        shown = [{"id": r["id"], "cells": [(key, pages.shown(r.get(key), factor, digits, key))
-                                           for key, _h, _u, factor, digits in pages.COLUMNS],
-                  "warnings": r.get("warnings") or []}
-                 for r in rows[(at - 1) * pages.PAGE: at * pages.PAGE]]
-        return page(request, "shots.html", {
-            "rows": shown, "columns": pages.COLUMNS, "count": count, "page": at,
-            "pages": last, "f": f, "lots": snapshot.lots, "bad": snapshot.bad,
-            "cells": known_cells, "figures": FIGURES, "colours": pages.COLOURS,
-            "total": len(snapshot.rows), "taken": snapshot.taken,
-            "scatter": json.dumps(pages.scatter(rows, f), allow_nan=False)})
-
-    def shots_csv(request: Request) -> Response:
-        snapshot = listing.snapshot(wait=False)
-        if snapshot is None:
-            return reading(request)
-        f = pages.filters(request.query_params)
-        waiting = inputs_for(request, snapshot, {f["input"]})
-        if waiting is not None:
-            return waiting
-        rows = pages.selected(snapshot, f)
-        out = io.StringIO()
-        writer = csv.writer(out, lineterminator="\n")
-        writer.writerow([f"{h} [{u}]" if u else h for _k, h, u, _f, _d in pages.COLUMNS]
-                        + ["warning texts"])
-        for r in rows:  # a text that a spreadsheet would run is written as text
-            writer.writerow([_csv_text(r.get(k)) if d is None else
-                             ("" if r.get(k) is None else repr(r[k] * factor))
-                             for k, _h, _u, factor, d in pages.COLUMNS]
-                            + [_csv_text("; ".join(r.get("warnings") or []))])
-        return Response(out.getvalue(), media_type="text/csv; charset=utf-8", headers={
-            "content-disposition": f'attachment; filename="{_file_name(label)}-shots.csv"'})
-
-    def entry_doc(snapshot: Any, ident: int) -> tuple[Any, Any]:
-        """An entry's records as ``show`` reads them, and its predicted pulse."""
-        entry = snapshot.entries.get(ident)
-        if entry is None:
-            raise LookupError(f"#{ident}: no such entry in {label}, expected an id the "
-                              "shots page lists")
-        outcome = show_entry(found, entry, snapshot.index_rows)
-        return outcome.doc, predicted_pulse(entry)
-
-    def shot(request: Request) -> Response:
-        ident = request.path_params["ident"]
-        snapshot = listing.snapshot(wait=False) or listing.one(ident)
-        try:
-            doc, (time, accel) = entry_doc(snapshot, ident)
-        except (AirgunXlError, LookupError) as exc:
-            return missing(request, str(exc).strip("'\""))
-        summary = dict(doc["summary"])
-        warnings = summary.pop("warnings", None)
-        predicted = summary.pop("predicted_verdict", None)
-        figures = [shown_figure(k, v) for k, v in summary.items()]
-        t, a = pages.thinned(time, accel)
-        recorded = []
-        start = pages.finite(summary.get("pulse_start"), 1e3)
-        for v in snapshot.verdicts_of(snapshot.entries[ident]):
-            shown = _verdict(found.root, v)
-            chart = pages.verdict_chart((t, a), shown.pop("trace", None), start)
-            shown["chart"] = chart and {**chart, "json": json.dumps(chart, allow_nan=False)}
-            recorded.append(shown)
-        predicted = predicted if isinstance(predicted, dict) else None
-        band = _peak_band(predicted, recorded)
-        return page(request, "shot.html", {
-            "doc": doc, "figures": figures, "warnings": warnings, "predicted": predicted,
-            "recorded": recorded, "samples": len(time), "drawn": len(t), "band": band,
-            "pulse": json.dumps({"time_ms": t, "accel_kg": a,
-                                 "band": [band["low"], band["high"]] if band else None},
-                                allow_nan=False)})
-
-    def compare(request: Request) -> Response:
-        snapshot = listing.snapshot(wait=False)
-        if snapshot is None:
-            return reading(request)
-        ids = pages.compared_ids(request.query_params)
-        docs, pulses, refused = [], [], []
-        for ident in ids:
-            try:
-                doc, pulse = entry_doc(snapshot, ident)
-            except (AirgunXlError, LookupError) as exc:
-                refused.append(str(exc).strip("'\""))
-                continue
-            docs.append(doc)
-            pulses.append(pulse)
-        kept = [d["id"] for d in docs]
-        differ, equal = pages.differing(docs)
-        keys = [k for k in FIGURE_UNITS if any(k in d["summary"] for d in docs)]
-        figures = [(shown_figure(k, None)[0], [shown_figure(k, d["summary"].get(k))[1]
-                                               for d in docs]) for k in keys]
-        drawn = pages.overlaid(pulses)
-        return page(request, "compare.html", {
-            "docs": docs, "ids": kept, "refused": refused, "differ": differ, "equal": equal,
-            "figures": figures, "max": pages.MAX_COMPARED,
-            "candidates": [r for r in snapshot.rows if r["id"] not in kept][:500],
-            "pulses": json.dumps({**drawn, "names": [d["entry"] for d in docs]},
-                                 allow_nan=False)})
-
-    def laws(request: Request) -> Response:
-        snapshot = listing.snapshot(wait=False)
-        if snapshot is None:
-            return reading(request)
-        return page(request, "laws.html", _laws(found.root, snapshot, pages))
-
-    async def home(_request: Request) -> Response:
-        return RedirectResponse("/shots", 302)
-
-    def counted(handler: Any) -> Any:
-        """``handler`` counted as a request in flight (:meth:`Listing.request`)."""
-        def answer(request: Request) -> Response:
-            with listing.request():
-                return handler(request)
-        return answer
-
-    routes = [Route("/", home), Route("/shots", counted(shots)),
-              Route("/shots.csv", counted(shots_csv)), Route("/shot/{ident:int}", counted(shot)),
-              Route("/compare", counted(compare)), Route("/laws", counted(laws)),
+    routes = [Route("/", home), Route("/shots", _counted(shots)),
+              Route("/shots.csv", _counted(shots_csv)),
+              Route("/shot/{ident:int}", _counted(shot)),
+              Route("/compare", _counted(compare)), Route("/laws", _counted(laws)),
               Mount("/static", StaticFiles(directory=str(_HERE / "static")), name="static")]
     allowed = [h.strip("[]") if h.count(":") > 1 else h for h in (*LOOPBACK, *hosts)]
     app = Starlette(routes=routes, middleware=[
         Middleware(Guard), Middleware(TrustedHostMiddleware, allowed_hosts=allowed)])
-    app.state.listing = listing
+    app.state.view = View(found, listing, templates, found.root.name, pages.cells())
     return app
 
 
