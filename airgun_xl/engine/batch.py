@@ -7,6 +7,7 @@ the single-shot figure (:func:`airgun_xl.engine.summary.summarize`) to the last 
 """
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -65,7 +66,7 @@ def run_batch(params, integrator="legacy", host="excel", threads=2, progress=Non
     figures = np.full((n, len(FIGURES)), np.nan)
     extras = None if extra is None else np.full((n, extra.width), np.nan)
     diverged = np.zeros(n, dtype=bool)
-    stats = [None] * n
+    stats: list[Any] = [None] * n
     groups: dict = {}
     for i, p in enumerate(params):
         groups.setdefault(_grid_key(p), []).append(i)

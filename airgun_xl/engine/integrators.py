@@ -6,9 +6,13 @@ None, neither computed nor stored. ``legacy`` is the faithful port of ArtSim's
 central-difference loop; ``newmark`` is a robust scheme. An integrator registers itself in
 :data:`INTEGRATORS` under its own name and is then selectable everywhere.
 """
+from __future__ import annotations
+
 import math
 import time
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -16,6 +20,9 @@ from .. import choices
 from ..errors import CellError, DivergenceError, OptionError
 from .interface import FINALS, SHOT_FIELDS
 from .kernel import legacy_kernel, newmark_kernel
+
+if TYPE_CHECKING:
+    from ..params import ShotParams
 
 #: The shot's fields the kernels take, in their order (:mod:`~airgun_xl.engine.interface`).
 KERNEL_PARAMS = SHOT_FIELDS
@@ -38,15 +45,16 @@ class KernelStats:
     second_onset: int = -1  # row index of the second (where the macro's force jumps), or -1
 
 
-def _chain_stable(p, integrator):
+def _chain_stable(p: ShotParams, integrator: str) -> bool:
     """Whether the OBR chain is stable at the shot's step (an unstable chain oscillates its
     way through loading and unloading, and no quirk is to blame)."""
     from .stability import critical_time_step
 
-    return critical_time_step(p, chain=integrator == "legacy").ratio <= 1
+    return bool(critical_time_step(p, chain=integrator == "legacy").ratio <= 1)
 
 
-def divergence_error(integrator, p, row, arrays):
+def divergence_error(integrator: str, p: ShotParams, row: int,
+                     arrays: Sequence[Any]) -> DivergenceError:
     """The :class:`~airgun_xl.errors.DivergenceError` for a run stopped at ``row``; when the
     macro's unloading-force quirk fired before it, the quirk is named as the cause."""
     from .watch import unloading_quirk
@@ -117,7 +125,8 @@ class History:
     stats: KernelStats | None = None
 
     @classmethod
-    def from_arrays(cls, arrays, final_m1, final_m31, kernel_seconds):
+    def from_arrays(cls, arrays: Sequence[Any], final_m1: float, final_m31: float,
+                    kernel_seconds: float) -> History:
         """From the kernel's 13 buffers in :data:`COLUMNS` order (time, the four
         displacements, then the tracked step values, None where not tracked)."""
         return cls(**dict(zip(COLUMNS, arrays, strict=True)), final_m1=final_m1,
@@ -131,7 +140,7 @@ TRACKED = choices.TRACKED
 COLUMNS = ("time", "y1", "y31", "y32", "y33") + tuple(TRACKED)
 
 
-def kernel_stats(finals, past_bound=None):
+def kernel_stats(finals: Mapping[str, Any], past_bound: int | None = None) -> KernelStats:
     """The :class:`KernelStats` of a run's finals (a mapping by name of
     :data:`~airgun_xl.engine.interface.FINALS`)."""
     return KernelStats(float(finals["x_plastic"]), float(finals["max_relative_velocity"]),
@@ -141,14 +150,14 @@ def kernel_stats(finals, past_bound=None):
                        int(finals["second_onset"]))
 
 
-def displacement_bound(p):
+def displacement_bound(p: ShotParams) -> float:
     """Largest |displacement| a physical run can reach [m]: ten times the free flight at the
     fastest initial speed plus the mitigator length, plus 1 m. Beyond it the scheme diverged."""
     v = max(abs(p.v1), abs(p.v31), abs(p.v32), abs(p.v33))
-    return 10 * (v * p.max_time + p.hcone + p.hcylinder) + 1.0
+    return float(10 * (v * p.max_time + p.hcone + p.hcylinder) + 1.0)
 
 
-def no_wedge_error(p, row):
+def no_wedge_error(p: ShotParams, row: int) -> CellError:
     """E16 = 0 and a loading step before the plastic front has moved: the wedge's area is
     0/0 there. The macro stops with "Division by zero"; the kernel gets NaN and stops."""
     from ..cells import BY_NAME
@@ -162,9 +171,10 @@ def no_wedge_error(p, row):
                      "first step")
 
 
-def _run(kernel, name, p, track):
+def _run(kernel: Callable[..., Any], name: str, p: ShotParams,
+         track: Collection[str]) -> History:
     rows = p.rows
-    arrays = [np.zeros(rows) for _ in range(5)] + [
+    arrays: list[Any] = [np.zeros(rows) for _ in range(5)] + [
         np.full(rows, np.nan) if key in track else None for key in TRACKED]
     values = kernel_params(p) + [displacement_bound(p)]
     started = time.perf_counter()
@@ -191,7 +201,7 @@ def _run(kernel, name, p, track):
     return blank_left_out(history, p)
 
 
-def run_legacy(p, track=TRACKED):
+def run_legacy(p: ShotParams, track: Collection[str] = TRACKED) -> History:
     """Time-step the shot with ArtSim's own scheme (the compiled port in ``_artsim.c``).
 
     Parameters
@@ -213,7 +223,7 @@ def run_legacy(p, track=TRACKED):
     return _run(legacy_kernel, "legacy", p, track)
 
 
-def run_newmark(p, track=TRACKED):
+def run_newmark(p: ShotParams, track: Collection[str] = TRACKED) -> History:
     """Time-step with the average-acceleration Newmark scheme (beta = 1/4, gamma = 1/2).
 
     Implicit, so unconditionally stable, for the OBR chain's springs and dampers; the
@@ -223,7 +233,7 @@ def run_newmark(p, track=TRACKED):
     return _run(newmark_kernel, "newmark", p, track)
 
 
-def kernel_params(p):
+def kernel_params(p: ShotParams) -> list[float]:
     """The kernel's parameter list, then the crush law's seven coefficients and the unloading
     variant (0 the macro's, 1 continuous); the caller appends the bound. A left-out mass
     (reduced model) gets a stand-in of 1 kg.
@@ -239,7 +249,7 @@ def kernel_params(p):
             + [float(p.unloading == "continuous")])
 
 
-def blank_left_out(history, p):
+def blank_left_out(history: History, p: ShotParams) -> History:
     """NaN for the displacements of masses the model leaves out."""
     if p.bird_masses < 3:
         history.y33[:] = np.nan
@@ -248,10 +258,18 @@ def blank_left_out(history, p):
     return history
 
 
-INTEGRATORS = {"legacy": run_legacy, "newmark": run_newmark}
+class Integrator(Protocol):
+    """An integrator: time-steps the checked shot ``p``, recording the displacements and,
+    for the names in ``track`` (of :data:`TRACKED`), the step values."""
+
+    def __call__(self, p: ShotParams, track: Collection[str] = ...) -> History: ...
 
 
-def get_integrator(name):
+#: The integrators by name (:data:`airgun_xl.choices.INTEGRATORS`, the options' choices).
+INTEGRATORS: dict[str, Integrator] = {"legacy": run_legacy, "newmark": run_newmark}
+
+
+def get_integrator(name: str) -> Integrator:
     """The integrator registered under ``name``.
 
     Raises
