@@ -2,7 +2,7 @@
 import numpy as np
 
 
-def minmax_indices(y, budget):
+def minmax_indices(y: np.ndarray, budget: int) -> np.ndarray:
     """Indices of at most ``budget`` points of ``y`` that keep every bucket's min and max.
 
     The series is cut into buckets of ``ceil(2 n / budget)`` consecutive points; each bucket

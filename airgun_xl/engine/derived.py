@@ -9,7 +9,8 @@ import numpy as np
 KG_DIVISOR = -9800
 
 
-def test_item_derivatives(y33, delta):
+def test_item_derivatives(y33: np.ndarray, delta: float
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Acceleration, velocity and kG of the test item by central differences.
 
     Parameters

@@ -38,11 +38,11 @@ _FINAL_INDEX = {name: i for i, (name, _) in enumerate(FINALS)}
 _PARAM_INDEX = {name: i for i, (name, _) in enumerate(PARAMS)}
 
 
-def final(name):
+def final(name: str) -> int:
     """The column of figure ``name`` in a run's finals (a batch's ``finals[:, final(...)]``)."""
     return _FINAL_INDEX[name]
 
 
-def param(name):
+def param(name: str) -> int:
     """The position of parameter ``name`` in the kernels' parameter list."""
     return _PARAM_INDEX[name]
