@@ -28,7 +28,7 @@ class Filtered:
     warnings: list = field(default_factory=list)
 
 
-def _offset(n, host):
+def _offset(n: float, host: str) -> int:
     """Rows a macro ``Offset(n, 0)`` moves by, in the given host."""
     if float(n).is_integer():
         return int(n)
@@ -37,7 +37,7 @@ def _offset(n, host):
     return round(n)  # Excel: nearest integer, halves to even (Python's round does the same)
 
 
-def sub_row_warning(samplerate, host):
+def sub_row_warning(samplerate: float, host: str) -> str:
     """The quirk of a filter step below one row, by name (the macro's column AB then holds
     zeros, or first differences divided by a second difference's step: no acceleration)."""
     both, back = _offset(2 * samplerate, host), _offset(-samplerate, host)
@@ -64,7 +64,7 @@ class Stencils:
     warnings: list
 
 
-def fractional_rows(samplerate):
+def fractional_rows(samplerate: float) -> str:
     """What a fractional 1/(E2*E34) does, in one sentence: the run's warning (this module's)
     and the check before it (:mod:`airgun_xl.studies.check`) say it in the same words, so a
     fill records it once."""
@@ -73,7 +73,7 @@ def fractional_rows(samplerate):
             "sample, LibreOffice writes zeros; --host chooses which is reproduced)")
 
 
-def filter_stencils(n, samplerate, host="excel"):
+def filter_stencils(n: int, samplerate: float, host: str = "excel") -> Stencils:
     """Follow the macro's cursor over ``n`` rows; see the module docstring.
 
     Returns
@@ -82,7 +82,7 @@ def filter_stencils(n, samplerate, host="excel"):
     """
     if host not in HOSTS:
         raise ValueError(f"host must be one of {HOSTS}")
-    warnings = []
+    warnings: list[str] = []
     if samplerate < 1:  # every visited row writes; Offset(-sr) is fractional in both hosts
         warnings.append(sub_row_warning(samplerate, host))
     elif not float(samplerate).is_integer():
@@ -92,7 +92,8 @@ def filter_stencils(n, samplerate, host="excel"):
     iterations = max(0, math.floor(last) - 3 + 1)
     period = math.floor(samplerate) + 1  # innercounter > samplerate, innercounter an Integer
     up, both = _offset(-samplerate, host), _offset(2 * samplerate, host)
-    written: dict = {}  # row written -> (centre, before, after); a later "" write empties it again
+    # row written -> (centre, before, after); a later "" write empties it again
+    written: dict[int, tuple[int, int, int]] = {}
     cursor = 0  # array index of the cursor
     done = 0
     top = -1  # highest row holding a sample
@@ -119,7 +120,8 @@ def filter_stencils(n, samplerate, host="excel"):
                     warnings)
 
 
-def filtered_values(y, delta, samplerate, stencils):
+def filtered_values(y: np.ndarray, delta: float, samplerate: float,
+                    stencils: Stencils) -> np.ndarray:
     """The samples' values [m/s^2] for displacement rows ``y`` (1-D, or 2-D: one run a row).
 
     ``scale * (un2 + un - 2 * un1)`` in the macro's order, so a 2-D batch gives each run's
@@ -130,14 +132,15 @@ def filtered_values(y, delta, samplerate, stencils):
     n = y.shape[-1]
     padded = np.concatenate((y, np.zeros(y.shape[:-1] + (1,))), axis=-1)  # row n reads 0
 
-    def at(rows):
+    def at(rows: np.ndarray) -> np.ndarray:
         return padded[..., np.minimum(rows, n)]
 
     un1, un2, un = at(stencils.centre), at(stencils.before), at(stencils.after)
     return scale * (un2 + un - 2 * un1)
 
 
-def filtered_acceleration(y33, delta, samplerate, host="excel"):
+def filtered_acceleration(y33: np.ndarray, delta: float, samplerate: float,
+                          host: str = "excel") -> Filtered:
     """Resample the test-item acceleration as ArtSim's last loop does.
 
     Parameters

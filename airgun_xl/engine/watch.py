@@ -12,9 +12,15 @@ unload, reload, unload sequence the second unloading therefore uses
 a jump of up to 1e10 N, or a drop to 0 when d < hcone. :func:`unloading_quirk` names the
 first such step; ``ShotParams(unloading="continuous")`` runs the shot without it.
 """
+from __future__ import annotations
+
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .integrators import History
 
 #: Consecutive unloading steps whose second difference of the deflection alternates in sign
 #: and grows, before the run is said to diverge: the central-difference scheme's unstable
@@ -23,7 +29,7 @@ import numpy as np
 DIVERGING_STEPS = 6
 
 
-def deflection(history):
+def deflection(history: History) -> np.ndarray:
     """The mitigator deflection each step used [m] (index k: step k; NaN for k < 2).
 
     The tracked column when there is one, else Y31 - Y1 of the row before, as the legacy
@@ -36,7 +42,7 @@ def deflection(history):
     return out
 
 
-def unloading(defl):
+def unloading(defl: np.ndarray) -> np.ndarray:
     """True at each step the macro takes its unloading branch: the deflection below the
     largest one so far (``maxmitdef``, from 0)."""
     d = np.where(np.isfinite(defl), defl, -np.inf)
@@ -45,7 +51,7 @@ def unloading(defl):
     return (d < before) & np.isfinite(defl)
 
 
-def unloading_onsets(defl):
+def unloading_onsets(defl: np.ndarray) -> np.ndarray:
     """Steps where an unloading phase begins (a loading step, or none, before it)."""
     u = unloading(defl)
     starts = u.copy()
@@ -76,10 +82,10 @@ class UnloadingQuirk:
     onsets: int
 
     @property
-    def row(self):
+    def row(self) -> int:
         return self.step + 2
 
-    def __str__(self):
+    def __str__(self) -> str:
         jump = ("" if not np.isfinite(self.force_after) else
                 f", and the force jumps from {self.force_before:.4g} N to "
                 f"{self.force_after:.4g} N")
@@ -89,7 +95,7 @@ class UnloadingQuirk:
                 "follow the quirk, not the physics")
 
 
-def unloading_quirk(history, stop=None):
+def unloading_quirk(history: History, stop: int | None = None) -> UnloadingQuirk | None:
     """The :class:`UnloadingQuirk` of a run (its steps before ``stop``), or None."""
     defl = deflection(history)[:stop]
     onsets = unloading_onsets(defl)
@@ -102,7 +108,7 @@ def unloading_quirk(history, stop=None):
     return UnloadingQuirk(k, float(history.time[k]), before, after, len(onsets))
 
 
-def unloading_divergence(history, steps=DIVERGING_STEPS):
+def unloading_divergence(history: History, steps: int = DIVERGING_STEPS) -> int | None:
     """The first step [index] by which the deflection has oscillated with growing amplitude,
     alternating each step, for ``steps`` unloading steps in a row (the unstable mode of an
     unloading spring too stiff for the step); None when it never does."""
