@@ -5,9 +5,12 @@ in a loop, the GIL released) on two threads; the derived figures are computed fo
 block of shots with the same numpy expressions as one shot's. Each figure therefore equals
 the single-shot figure (:func:`airgun_xl.engine.summary.summarize`) to the last bit.
 """
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -18,12 +21,26 @@ from .interface import FINAL_COUNT, FINALS, final
 from .kernel import batch_kernel
 from .summary import KG, PULSE_FRACTION
 
+if TYPE_CHECKING:
+    from ..params import ShotParams
+    from .filtered import Stencils
+
 #: The figures of each shot, in column order of :attr:`Batch.figures`.
 FIGURES = ("peak_kg", "time_of_peak", "filtered_peak_kg", "pulse_duration", "max_crush")
 
 _INTEGRATOR_ID = {"legacy": 0, "newmark": 1}
 N_FINALS = FINAL_COUNT  # the kernel's finals a shot (engine/interface.py)
 BLOCK = 128  # shots a block: bounds memory at rows x 128 doubles (12 MB for shot A)
+
+
+class Extra(Protocol):
+    """What a batch computes more of a block's pulses while they are in memory
+    (:class:`airgun_xl.studies.acceptance.BlockJudge`): ``width`` values a shot."""
+
+    @property
+    def width(self) -> int: ...
+
+    def __call__(self, t: np.ndarray, kg: np.ndarray) -> np.ndarray: ...
 
 
 @dataclass
@@ -33,19 +50,20 @@ class Batch:
 
     figures: np.ndarray
     diverged: np.ndarray
-    stats: list | None = None  # each shot's KernelStats (None where it diverged)
+    stats: list[Any] | None = None  # each shot's KernelStats (None where it diverged)
     extras: np.ndarray | None = None  # shots x extra.width: what ``extra`` computed
 
-    def column(self, name):
+    def column(self, name: str) -> np.ndarray:
         return self.figures[:, FIGURES.index(name)]
 
 
-def _grid_key(p):
+def _grid_key(p: ShotParams) -> tuple[float, float, float, int]:
     return p.delta, p.max_time, p.filter_frequency, p.bird_masses
 
 
-def run_batch(params, integrator="legacy", host="excel", threads=2, progress=None,
-              extra=None):
+def run_batch(params: Sequence[ShotParams], integrator: str = "legacy", host: str = "excel",
+              threads: int = 2, progress: Callable[[int], Any] | None = None,
+              extra: Extra | None = None) -> Batch:
     """Headline figures of each of ``params`` (a list of :class:`ShotParams`).
 
     Parameters
@@ -94,13 +112,15 @@ def run_batch(params, integrator="legacy", host="excel", threads=2, progress=Non
     return Batch(figures, diverged, stats, extras)
 
 
-def _run_block(block, integrator, stencils, pool, extra=None):
+def _run_block(block: Sequence[ShotParams], integrator: str, stencils: Stencils,
+               pool: ThreadPoolExecutor | None, extra: Extra | None = None
+               ) -> tuple[np.ndarray, ...]:
     p0 = block[0]
     rows, m = p0.rows, len(block)
     matrix = np.array([kernel_params(p) + [displacement_bound(p)] for p in block])
     halves = [(0, m // 2), (m // 2, m)] if pool is not None and m > 1 else [(0, m)]
 
-    def work(half):  # kernel and figures of half the block, on one thread
+    def work(half: tuple[int, int]) -> tuple[np.ndarray, ...]:  # half the block, one thread
         a, b = half
         y = np.empty((b - a, rows))
         finals = np.empty((b - a, N_FINALS))
@@ -116,11 +136,13 @@ def _run_block(block, integrator, stencils, pool, extra=None):
             more[bad] = np.nan
         return out, bad, finals, more
 
-    parts = list(pool.map(work, halves)) if len(halves) > 1 else [work(halves[0])]
+    parts = (list(pool.map(work, halves)) if pool is not None and len(halves) > 1
+             else [work(halves[0])])
     return tuple(np.concatenate([part[j] for part in parts]) for j in range(4))
 
 
-def _figures(y, t, finals, p0, stencils):
+def _figures(y: np.ndarray, t: np.ndarray, finals: np.ndarray, p0: ShotParams,
+             stencils: Stencils) -> tuple[np.ndarray, np.ndarray]:
     """FIGURES of each row of ``y`` (the bird's last mass), as one shot's are computed."""
     m, rows = y.shape
     bad = finals[:, final("bad_row")] >= 0

@@ -132,7 +132,8 @@ def _evaluate(p, varied, rows_values, integrator, model, progress, runner=None):
     figures[~invalid] = batch.figures
     diverged[~invalid] = batch.diverged
     flags: list = [[] for _ in rows_values]
-    for k, q, stats in zip(np.flatnonzero(~invalid), params, batch.stats, strict=True):
+    for k, q, stats in zip(np.flatnonzero(~invalid), params, batch.stats or [],
+                           strict=True):
         flags[k] = ([] if stats is None else [str(f) for f in shot_findings(q, stats)])
     return figures, diverged, invalid, flags
 
