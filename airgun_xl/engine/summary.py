@@ -3,10 +3,17 @@
 Pure functions of arrays in SI units; :func:`summarize` gathers them for a
 :class:`airgun_xl.result.Result`.
 """
+from __future__ import annotations
+
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ..result import Result
 
 #: Pulse duration: the span where the acceleration is at least this fraction of its peak.
 PULSE_FRACTION = 0.10
@@ -19,7 +26,7 @@ SPECTRUM_MAX_HZ = 15_000.0
 PEAK_MIN_HZ = 1_000.0
 
 
-def log_prominences(amplitude, peaks):
+def log_prominences(amplitude: np.ndarray, peaks: np.ndarray) -> np.ndarray:
     """Topographic prominence of each peak on a log scale: ln(peak / its higher base).
 
     The base on each side is the lowest point before the spectrum rises above the peak again
@@ -41,7 +48,7 @@ def log_prominences(amplitude, peaks):
     return out
 
 
-def natural_frequencies(masses, springs):
+def natural_frequencies(masses: Sequence[float], springs: Sequence[float]) -> list[float]:
     """Natural frequencies [Hz] of a free chain of masses joined by springs.
 
     Parameters
@@ -89,11 +96,12 @@ class Spectrum:
 
     frequency: np.ndarray
     amplitude: np.ndarray
-    peaks: list = field(default_factory=list)
+    peaks: list[float] = field(default_factory=list)
     band_start: float = PEAK_MIN_HZ
 
 
-def amplitude_spectrum(accel_kg, delta, max_hz=SPECTRUM_MAX_HZ, n_peaks=3):
+def amplitude_spectrum(accel_kg: np.ndarray, delta: float, max_hz: float = SPECTRUM_MAX_HZ,
+                       n_peaks: int = 3) -> Spectrum:
     """Amplitude spectrum of an acceleration history, by numpy's real FFT.
 
     Parameters
@@ -128,7 +136,7 @@ def amplitude_spectrum(accel_kg, delta, max_hz=SPECTRUM_MAX_HZ, n_peaks=3):
     return Spectrum(freq, amp, [float(freq[candidates[i]]) for i in order[:n_peaks]], start)
 
 
-def lobe_end(freq, amp, min_hz=PEAK_MIN_HZ):
+def lobe_end(freq: np.ndarray, amp: np.ndarray, min_hz: float = PEAK_MIN_HZ) -> float:
     """Where the pulse's own spectrum (the lobe from 0 Hz) ends [Hz]: past ``min_hz``, each
     local maximum whose nearest higher ground to its left lies below ``min_hz`` is a shoulder
     of that lobe, not a mode (shot A's 1.33 kHz); the band starts at the first local minimum
@@ -148,7 +156,8 @@ def lobe_end(freq, amp, min_hz=PEAK_MIN_HZ):
     return start
 
 
-def pulse(time, accel_kg, fraction=PULSE_FRACTION):
+def pulse(time: np.ndarray, accel_kg: np.ndarray, fraction: float = PULSE_FRACTION
+          ) -> tuple[float, float, float]:
     """Start, end and duration [s] of the span where acceleration >= fraction x peak."""
     if not np.isfinite(accel_kg).any():
         return np.nan, np.nan, np.nan
@@ -178,18 +187,18 @@ class Summary:
     obr_exit_velocity: float
     mem_final_velocity: float
     spectrum: Spectrum
-    natural_initial: list
-    natural_final: list
+    natural_initial: list[float]
+    natural_final: list[float]
 
 
-def _last_finite(values):
+def _last_finite(values: np.ndarray | None) -> float:
     if values is None:
         return np.nan
     finite = np.flatnonzero(np.isfinite(values))
     return float(values[finite[-1]]) if len(finite) else np.nan
 
 
-def summarize(result):
+def summarize(result: Result) -> Summary:
     """The :class:`Summary` of a :class:`airgun_xl.result.Result`."""
     h, p = result.history, result.params
     time = h.time
