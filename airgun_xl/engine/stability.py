@@ -39,10 +39,17 @@ mitigator unloads, and grows as it is crushed. So:
   diverges. A run that never unloads there is sane (a shot at 1.02 x ``dt_unloading`` that
   never unloads peaks within 0.3 % of the same shot at a step 8 times smaller).
 """
+from __future__ import annotations
+
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ..params import ShotParams
 
 #: Spectral radius above 1 by more than this is growth; below, the rigid-body modes' double
 #: eigenvalue 1, which floating-point eigenvalues split by about 1e-8.
@@ -87,7 +94,7 @@ class CriticalStep:
     dt_unloading: float | None = None
 
     @property
-    def verdict(self):
+    def verdict(self) -> str:
         """"unstable", "unstable while unloading", "marginal" or "stable"."""
         if self.ratio > 1:
             return "unstable"
@@ -96,18 +103,19 @@ class CriticalStep:
         return "marginal" if self.ratio > WARN_RATIO else "stable"
 
 
-def full_length(p):
+def full_length(p: ShotParams) -> float:
     """The mitigator's length before the shot, E16 + E19 [m]."""
-    return p.hcone + p.hcylinder
+    return float(p.hcone + p.hcylinder)
 
 
-def compacted_length(p):
+def compacted_length(p: ShotParams) -> float:
     """The mitigator's length fully compacted, (E16 + E19)(1 - E37) [m]; the wedge E16 when
     that is 0 (E37 = 1)."""
-    return full_length(p) * (1 - p.ec) or p.hcone or full_length(p)
+    return float(full_length(p) * (1 - p.ec) or p.hcone or full_length(p))
 
 
-def _matrices(p, m31, m1, chain=True, length=None):
+def _matrices(p: ShotParams, m31: float, m1: float, chain: bool = True,
+              length: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """M, C, K of the 4-DOF linear model (MEM, m31, m32, m33) with the unloading stiffness
     A E / ``length`` (fully compacted when None); with ``chain=False``, without the OBR
     springs and dampers (what Newmark treats explicitly)."""
@@ -126,7 +134,7 @@ def _matrices(p, m31, m1, chain=True, length=None):
     return np.diag(masses), C, K
 
 
-def spectral_radius(dt, M, C, K):
+def spectral_radius(dt: float, M: np.ndarray, C: np.ndarray, K: np.ndarray) -> float:
     """Spectral radius of the legacy scheme's step matrix G(dt)."""
     n = len(M)
     Minv = np.diag(1 / np.diag(M))
@@ -136,7 +144,7 @@ def spectral_radius(dt, M, C, K):
     return float(np.max(np.abs(np.linalg.eigvals(G))))
 
 
-def _stable(dt, M, C, K):
+def _stable(dt: float, M: np.ndarray, C: np.ndarray, K: np.ndarray) -> bool:
     return spectral_radius(dt, M, C, K) <= 1 + RADIUS_TOLERANCE
 
 
@@ -145,7 +153,7 @@ def _stable(dt, M, C, K):
 CROSSING_CHECK, REAL_ROOT = 1e-9, 1e-9
 
 
-def _crossing(M, C, K):
+def _crossing(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> float:
     """Smallest step [s] where an eigenvalue of G(dt) is -1, or inf.
 
     With y[n] = (-1)^n v the update gives (4 M - 2 dt C - dt^2 K) v = 0, so nu = 1/dt solves
@@ -163,7 +171,7 @@ def _crossing(M, C, K):
     return float(1 / real.max()) if real.size else math.inf
 
 
-def _critical(M, C, K):
+def _critical(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> tuple[float, float]:
     if not (np.isfinite(M).all() and np.isfinite(C).all() and np.isfinite(K).all()):
         return 0.0, math.inf  # the inputs overflow: no step is stable
     if not K.any():
@@ -176,7 +184,7 @@ def _critical(M, C, K):
     return _bisected(M, C, K, omega_max), omega_max
 
 
-def _bisected(M, C, K, omega_max):
+def _bisected(M: np.ndarray, C: np.ndarray, K: np.ndarray, omega_max: float) -> float:
     """The critical step [s] by bisection on the spectral radius."""
     lo, hi = 0.0, 4.0 / omega_max  # the damped bound is below 2/omega, so hi is unstable
     while _stable(hi, M, C, K):
@@ -190,29 +198,32 @@ def _bisected(M, C, K, omega_max):
     return lo
 
 
-def _mass_range(p, samples):
+def _mass_range(p: ShotParams, samples: int) -> Iterator[tuple[float, float]]:
     """(m31, M1) pairs over the range the run passes through."""
     for m31 in np.linspace(p.m31, p.m31 + p.mmitigator, samples):
         m1 = p.m1 + p.mmitigator - (m31 - p.m31)
         yield float(m31), max(float(m1), 1e-9)
 
 
-def _worst(p, samples, chain, length):
+def _worst(p: ShotParams, samples: int, chain: bool, length: float | None
+           ) -> tuple[float, float, float]:
     """(dt_crit, omega, m31) at the mass where the step is smallest, for one length."""
     best = None
     for m31, m1 in _mass_range(p, samples):
         dt, omega = _critical(*_matrices(p, m31, m1, chain, length))
         if best is None or dt < best[0]:
             best = (dt, omega, m31)
+    assert best is not None, samples  # samples >= 1: a mass at least
     return best
 
 
-def _stable_at(p, dt, length, samples, chain):
+def _stable_at(p: ShotParams, dt: float, length: float, samples: int, chain: bool) -> bool:
     return all(_stable(dt, *_matrices(p, m31, m1, chain, length))
                for m31, m1 in _mass_range(p, samples))
 
 
-def unstable_length(p, dt, samples=5, chain=True):
+def unstable_length(p: ShotParams, dt: float, samples: int = 5, chain: bool = True
+                    ) -> float | None:
     """The remaining mitigator length [m] below which ``dt`` is unstable.
 
     Bisection between the compacted and the full length (the unloading stiffness A E / L, and
@@ -230,7 +241,7 @@ def unstable_length(p, dt, samples=5, chain=True):
     return hi
 
 
-def critical_time_step(p, samples=5, chain=True):
+def critical_time_step(p: ShotParams, samples: int = 5, chain: bool = True) -> CriticalStep:
     """Predict the legacy scheme's critical time steps for a shot (both tiers).
 
     Parameters
@@ -254,8 +265,9 @@ def critical_time_step(p, samples=5, chain=True):
         dt, limiting = math.inf, "nothing: Newmark is implicit in the OBR chain"
     dt_unloading = _worst(p, samples, chain, full_length(p))[0]
     dt_compacted = _worst(p, samples, chain, compacted_length(p))[0]
-    length = crush = None
+    length: float | None = None
+    crush: float | None = None
     if dt_compacted < p.delta <= dt:
         length = unstable_length(p, p.delta, samples, chain)
-        crush = full_length(p) - length
+        crush = full_length(p) - length if length is not None else None
     return CriticalStep(dt, p.delta / dt, limiting, dt_compacted, length, crush, dt_unloading)
