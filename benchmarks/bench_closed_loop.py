@@ -187,7 +187,7 @@ def with_next(lot, law, first, work, draws, n_draws, calls, vary=None, gun=None,
     pooled over them (``next --gun``); ``calls`` gets (seconds, the gun's words, the law's
     update)."""
     shot = with_velocity(work / "next0.xlsx", first)
-    predicted, record, expected, error = None, [], {}, ""
+    predicted, record, expected, error, proposal = None, [], {}, "", {}
     # one lab, one archive: the lots' pairs of expected and measured figures are the model
     # error's record (issue 60); with a per-lot archive every lot drew the prior
     archive = work.parent / "archive"
@@ -213,11 +213,15 @@ def with_next(lot, law, first, work, draws, n_draws, calls, vary=None, gun=None,
                             "measured": [positions(f) for _, f in fired]})
             SHOTS.extend({"lot": lot, "shot": k + 1, "replicate": r > 0,
                           "predicted": predicted, "passed": passed, "model_error": error,
-                          "expected": expected, "measured": positions(f)}
+                          "expected": expected, "measured": positions(f), **proposal,
+                          "values": f}
                          for r, (passed, f) in enumerate(fired))
         if out.verdict.passed:
             return k + 1, record
         predicted, shot, error = out.best.probability, out.output, out.model_error
+        proposal = {"failures": dict(out.best.failures), "draws": out.best.shots,
+                    "figures": {k: list(v) for k, v in out.best.figures.items()},
+                    "model_figures": {k: list(v) for k, v in out.best.model_figures.items()}}
         expected = positions({name: v[1] * (1e3 if name == "duration" else 1.0)
                               for name, v in out.best.figures.items()})
     return MOST_SHOTS + 1, record
