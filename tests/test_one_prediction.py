@@ -520,3 +520,30 @@ def test_a_design_aims_what_the_lab_measures_at_the_middle(shot):
     assert aimed > plain + 3.0  # about 2.3 % faster: 3 % of peak at d ln peak / d ln v ~ 1.3
     # a centred error (the prior's, or an archive's without a bias) leaves the aim alone
     assert solve_middle(shot.params, spec, variable("A28"), model_error=prior).value == plain
+
+
+def test_the_error_at_a_setting_makes_the_pairs_whole_spread_there():
+    """40 pairs of a 6 % peak spread (seed 3), none explained: the pairs' whole variance
+    (numpy's, x (1 + 1/40)) is what a setting's inputs and error make together: where the
+    draws explain 2 %, the error's variance is the whole less 0.02^2 (to 1e-15: one
+    subtraction); where they explain more than the whole, the floor (the sampling error of
+    the pairs' variance, s^2 sqrt(2/39), x (1 + 1/40)); the correlation the pairs show is
+    kept; a figure never learnt, and a prior, are as they were."""
+    from airgun_xl.studies.model_error import FIGURES, ModelError
+
+    pairs = pairs_with(0.06, 40, 3)
+    logs = np.log([[p[f][1] / p[f][0] for f in FIGURES] for p in pairs])
+    var = np.var(logs, axis=0, ddof=1)
+    e = ModelError.from_pairs(pairs)
+    whole = var[0] * (1 + 1 / 40)
+    at = e.at([0.02, math.nan, math.nan])
+    assert at.covariance[0][0] == pytest.approx(whole - 0.02 ** 2, rel=1e-12)
+    assert at.covariance[1][1] == e.covariance[1][1]  # no spread known there: as it was
+    corr = np.corrcoef(logs, rowvar=False)[0, 1]
+    assert at.covariance[0][1] / math.sqrt(at.covariance[0][0] * at.covariance[1][1]) == \
+        pytest.approx(corr, rel=1e-9)
+    floored = e.at([1.0, 0.0, 0.0])
+    assert floored.covariance[0][0] == pytest.approx(
+        max(var[0] * math.sqrt(2 / 39), 0.005 ** 2) * (1 + 1 / 40), rel=1e-12)
+    prior = ModelError.prior()
+    assert prior.at([0.0, 0.0, 0.0]) is prior

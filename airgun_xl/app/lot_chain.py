@@ -158,19 +158,17 @@ def archive_pairs(root: str | Path) -> list[dict[str, tuple[float, ...]]]:
     return pairs
 
 
-#: A normal's 5th to 95th percentile, in standard deviations: 2 x 1.6449 (scipy.stats.norm).
-RANGE_SIGMAS = 3.2897072539029444
-
-
 def _model_range(values: Any) -> tuple[float, float] | None:
     """(median, standard deviation of the log) of a proposal's model figures ``[5th, 50th,
     95th]``, or None where they are not three positive, ordered finite numbers."""
+    from ..studies.model_error import explained_spread
+
     if not (isinstance(values, list) and len(values) == 3 and all(map(_number, values))):
         return None
     lo, mid, hi = (float(v) for v in values)
     if not 0 < lo <= mid <= hi:
         return None
-    return mid, math.log(hi / lo) / RANGE_SIGMAS
+    return mid, explained_spread(lo, hi)
 
 
 def _number(value: Any) -> TypeGuard[float]:

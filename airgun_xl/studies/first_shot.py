@@ -460,6 +460,7 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
     cautious, model_figures = None, {}
     if model_error is not None:
         model_figures = expected_figures(values, spec)
+        model_error = model_error.at(_explained(values))
         wide = _with_model_error(values, model_error.widened(), n, seed, invalid)
         wide_ok = np.ones(len(params), dtype=bool)
         for f in flags_of(wide, spec).values():
@@ -475,6 +476,24 @@ def pass_probability(p, spec, sds, n, seed=1, var=None, setting=None, integrator
                            int(ok.sum()), n, failures, int(batch.diverged.sum()),
                            int(invalid.sum()), float(second),
                            expected_figures(values, spec), cautious, model_figures)
+
+
+def _explained(values):
+    """Per figure of :data:`~airgun_xl.studies.model_error.FIGURES`, the spread of its log
+    over the drawn inputs at this setting (from its 5th to 95th percentile, as a normal's,
+    :func:`~airgun_xl.studies.model_error.explained_spread`): what the draws explain
+    there, the rest of the pairs' spread being the model's (NaN where a figure has no two
+    finite positive values)."""
+    from .model_error import FIGURES, explained_spread
+
+    out = []
+    for name in FIGURES:
+        column = np.asarray(values, dtype=float)[:, BLOCK_VALUES.index(name)]
+        column = column[np.isfinite(column) & (column > 0)]
+        lo, hi = (np.percentile(column, (5.0, 95.0)) if column.size >= 2
+                  else (math.nan, math.nan))
+        out.append(explained_spread(float(lo), float(hi)))
+    return out
 
 
 def _with_model_error(values, model_error, n, seed, invalid):
