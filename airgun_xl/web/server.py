@@ -149,15 +149,12 @@ def _inputs_for(request: Request, snapshot: Any, cells: set[str]) -> Any:
     return None
 
 
-def shots(request: Request) -> Response:
+def shots(request: Request, snapshot: Any) -> Response:
     """The shots page: the archive's runs, filtered, sorted and paged, with a scatter."""
     from . import pages
     from .listing import FIGURES
 
     view = _view(request)
-    snapshot = view.listing.snapshot(wait=False)
-    if snapshot is None:
-        return _reading(request)
     f = pages.filters(request.query_params)
     waiting = _inputs_for(request, snapshot, {f["x"], f["input"]})
     if waiting is not None:
@@ -178,16 +175,13 @@ def shots(request: Request) -> Response:
         "scatter": json.dumps(pages.scatter(rows, f), allow_nan=False)})
 
 
-def shots_csv(request: Request) -> Response:
+def shots_csv(request: Request, snapshot: Any) -> Response:
     """What the shots page shows, as a CSV (every text a spreadsheet would run, as text)."""
     from starlette.responses import Response
 
     from . import pages
 
     view = _view(request)
-    snapshot = view.listing.snapshot(wait=False)
-    if snapshot is None:
-        return _reading(request)
     f = pages.filters(request.query_params)
     waiting = _inputs_for(request, snapshot, {f["input"]})
     if waiting is not None:
@@ -253,16 +247,13 @@ def shot(request: Request) -> Response:
                             allow_nan=False)})
 
 
-def compare(request: Request) -> Response:
+def compare(request: Request, snapshot: Any) -> Response:
     """Shots side by side: the inputs that differ, their figures, their pulses overlaid."""
     from ..app.archive import FIGURE_UNITS, shown_figure
     from ..errors import AirgunXlError
     from . import pages
 
     view = _view(request)
-    snapshot = view.listing.snapshot(wait=False)
-    if snapshot is None:
-        return _reading(request)
     ids = pages.compared_ids(request.query_params)
     docs, pulses, refused = [], [], []
     for ident in ids:
@@ -287,14 +278,11 @@ def compare(request: Request) -> Response:
                              allow_nan=False)})
 
 
-def laws(request: Request) -> Response:
+def laws(request: Request, snapshot: Any) -> Response:
     """The laws page: each lot's law versions, its chain, P(PASS) against outcomes."""
     from . import pages
 
     view = _view(request)
-    snapshot = view.listing.snapshot(wait=False)
-    if snapshot is None:
-        return _reading(request)
     return _page(request, "laws.html",
                  _laws(view.found.root, snapshot, pages))
 
@@ -303,6 +291,16 @@ async def home(_request: Request) -> Response:
     from starlette.responses import RedirectResponse
 
     return RedirectResponse("/shots", 302)
+
+
+def _listed(endpoint: Callable[[Request, Any], Response]) -> Callable[[Request], Response]:
+    """``endpoint`` given the archive's listing (its snapshot), or, while the first listing
+    is read, the page saying how far it is."""
+    def answer(request: Request) -> Response:
+        snapshot = _view(request).listing.snapshot(wait=False)
+        return _reading(request) if snapshot is None else endpoint(request, snapshot)
+    answer.__name__ = endpoint.__name__
+    return answer
 
 
 def _counted(endpoint: Callable[[Request], Response]) -> Callable[[Request], Response]:
@@ -336,10 +334,11 @@ def build_app(archive: str | Path, hosts: tuple[str, ...] = (), warm: bool = Tru
         loader=jinja2.FileSystemLoader(str(_HERE / "templates")), autoescape=True))
     templates.env.filters["safe_json"] = _script_json
     templates.env.globals.update(url=pages.url, compare_url=pages.compare_url)
-    routes = [Route("/", home), Route("/shots", _counted(shots)),
-              Route("/shots.csv", _counted(shots_csv)),
+    routes = [Route("/", home), Route("/shots", _counted(_listed(shots))),
+              Route("/shots.csv", _counted(_listed(shots_csv))),
               Route("/shot/{ident:int}", _counted(shot)),
-              Route("/compare", _counted(compare)), Route("/laws", _counted(laws)),
+              Route("/compare", _counted(_listed(compare))),
+              Route("/laws", _counted(_listed(laws))),
               Mount("/static", StaticFiles(directory=str(_HERE / "static")), name="static")]
     allowed = [h.strip("[]") if h.count(":") > 1 else h for h in (*LOOPBACK, *hosts)]
     app = Starlette(routes=routes, middleware=[
