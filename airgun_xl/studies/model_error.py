@@ -224,7 +224,8 @@ class ModelError:
             # distance from the prior's none
             pooled = (w * PRIOR_SD[f] ** 2 + (m - 1) * net * (m >= 2)
                       + w * m * mean ** 2 / (w + m)) / (w + m)
-            sds.append(math.sqrt(pooled))
+            # no pair of the figure: the prior itself, to the last bit
+            sds.append(math.sqrt(pooled) if m else PRIOR_SD[f])
             means.append(m * mean / (w + m))
             spreads.append(math.sqrt(inputs))
         return cls._diagonal(sds, len(logs), tuple(spreads), tuple(means))
