@@ -36,7 +36,6 @@ GAP_TOLERANCE = 0.01
 MIN_SAMPLES = 16
 
 
-
 @dataclass
 class Trace:
     """A measured pulse, in the model's units.
