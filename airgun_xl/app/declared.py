@@ -147,6 +147,8 @@ def a_path(value: Any, who: str) -> Path:
         return value
     if isinstance(value, str) and value.strip():
         return Path(value)
+    if isinstance(value, str):  # "" would be the working folder: a path not given
+        raise OptionError(f"{who}: found an empty value, expected a path")
     try:
         return Path(os.fspath(value))
     except TypeError:

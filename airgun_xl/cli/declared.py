@@ -28,46 +28,52 @@ def add_declared(original: argparse.ArgumentParser, request: type, skip: tuple[s
                  only: tuple[str, ...] | None = None) -> None:
     """Each field of the dataclass ``request`` (but ``skip``; with ``only``, those alone) as
     ``original``'s argument, in the fields' order (a command whose help shows an option of its
-    own between them adds them in two calls)."""
+    own between them adds them in two calls); fields of one group exclude each other."""
     groups: dict[str, Any] = {}
     for field in dataclasses.fields(request):
         if field.name in skip or (only is not None and field.name not in only):
             continue
         spelt = option_of(field)
-        read = field.metadata["read"]
-        flag = spelt.flags[-1]
-        parser = original
+        parser: Any = original
         if spelt.group is not None:  # options that exclude each other
             if spelt.group not in groups:
                 groups[spelt.group] = original.add_mutually_exclusive_group()
             parser = groups[spelt.group]
-        if spelt.kind == "positional":
-            parser.add_argument(field.name, metavar=spelt.metavar, help=spelt.help,
-                                choices=spelt.choices or None)
-        elif spelt.kind == "positional?":
-            parser.add_argument(field.name, nargs="?", metavar=spelt.metavar, help=spelt.help)
-        elif spelt.kind == "switch":
-            parser.add_argument(*spelt.flags, action="store_true", help=spelt.help)
-        elif spelt.kind == "choice":
-            parser.add_argument(*spelt.flags, choices=spelt.choices, default=field.default,
-                                help=spelt.help)
-        elif spelt.kind == "integrators":  # each given once more, into a list
-            assert isinstance(field.default, tuple), field.name
-            parser.add_argument(*spelt.flags, action=Integrators, default=list(field.default),
-                                metavar=spelt.metavar, help=spelt.help, dest=field.name)
-        elif spelt.kind == "repeated":  # given once for each value, read together
-            parser.add_argument(*spelt.flags, action="append", default=[],
-                                metavar=spelt.metavar, help=spelt.help, dest=field.name)
-        elif spelt.kind == "cfc":  # argparse's own line, as every command's --cfc gives
-            parser.add_argument(*spelt.flags, type=cfc_value, default=field.default,
-                                metavar=spelt.metavar, action=CfcOption, help=spelt.help)
-        else:
-            parser.add_argument(*spelt.flags, type=_typed(read, flag), default=field.default,
-                                metavar=spelt.metavar, action=One, help=spelt.help,
-                                dest=field.name)
+        _add_field(parser, field, spelt)
+        flag = spelt.flags[-1]
         for alias, idea in spelt.aliases:
-            original.add_argument(alias, type=_typed(read, flag), dest=field.name,
-                                metavar=spelt.metavar, action=Alias, idea=idea)
+            original.add_argument(alias, type=_typed(field.metadata["read"], flag),
+                                  dest=field.name, metavar=spelt.metavar, action=Alias,
+                                  idea=idea)
+
+
+def _add_field(parser: Any, field: dataclasses.Field[Any], spelt: Any) -> None:
+    """One field as ``parser``'s argument, by the kind of option it is spelt as."""
+    flag = spelt.flags[-1]
+    if spelt.kind == "positional":
+        parser.add_argument(field.name, metavar=spelt.metavar, help=spelt.help,
+                            choices=spelt.choices or None)
+    elif spelt.kind == "positional?":
+        parser.add_argument(field.name, nargs="?", metavar=spelt.metavar, help=spelt.help)
+    elif spelt.kind == "switch":
+        parser.add_argument(*spelt.flags, action="store_true", help=spelt.help)
+    elif spelt.kind == "choice":
+        parser.add_argument(*spelt.flags, choices=spelt.choices, default=field.default,
+                            help=spelt.help)
+    elif spelt.kind == "integrators":  # each given once more, into a list
+        assert isinstance(field.default, tuple), field.name
+        parser.add_argument(*spelt.flags, action=Integrators, default=list(field.default),
+                            metavar=spelt.metavar, help=spelt.help, dest=field.name)
+    elif spelt.kind == "repeated":  # given once for each value, read together
+        parser.add_argument(*spelt.flags, action="append", default=[],
+                            metavar=spelt.metavar, help=spelt.help, dest=field.name)
+    elif spelt.kind == "cfc":  # argparse's own line, as every command's --cfc gives
+        parser.add_argument(*spelt.flags, type=cfc_value, default=field.default,
+                            metavar=spelt.metavar, action=CfcOption, help=spelt.help)
+    else:
+        parser.add_argument(*spelt.flags, type=_typed(field.metadata["read"], flag),
+                            default=field.default, metavar=spelt.metavar, action=One,
+                            help=spelt.help, dest=field.name)
 
 
 def request_of(request: type, args: argparse.Namespace, **given: Any) -> Any:

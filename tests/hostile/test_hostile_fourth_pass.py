@@ -308,6 +308,9 @@ def test_43_13_srs_q_has_one_grammar_everywhere(tmp_path, capsys):
     ["fill", TEMPLATE, "--archive="],
     ["history", "--archive="],
     ["fill", TEMPLATE, "-o", ""],
+    ["serve", "--archive="],  # the declared commands' paths: "" is no working folder
+    ["show", "x", "--archive="],
+    ["sweep", TEMPLATE, "--vary", "A28=1:2:2", "-o", ""],
 ])
 def test_43_13_an_empty_option_value_is_refused(tmp_path, capsys, argv):
     """fill --archive= archived nothing, silently: an empty value is one line."""
