@@ -547,3 +547,7 @@ def test_the_error_at_a_setting_makes_the_pairs_whole_spread_there():
         max(var[0] * math.sqrt(2 / 39), 0.005 ** 2) * (1 + 1 / 40), rel=1e-12)
     prior = ModelError.prior()
     assert prior.at([0.0, 0.0, 0.0]) is prior
+    # what a study says of it: the pairs' whole spread it keeps at every setting
+    assert e.words().endswith(f"makes the pairs' whole spread (peak {100 * math.sqrt(whole):.1f} "
+                              f"%, duration {100 * math.sqrt(var[1] * (1 + 1 / 40)):.1f} %, "
+                              f"velocity change {100 * math.sqrt(var[2] * (1 + 1 / 40)):.1f} %)")

@@ -337,9 +337,13 @@ class ModelError:
                              for f, m in zip(FIGURES, self.mean, strict=True)
                              if f in self.learnt)
             prior = [f for f in FIGURES if f not in self.learnt]
+            whole = ", ".join(f"{f} {100 * math.sqrt(t):.1f} %"
+                              for f, t in zip(FIGURES, self.total, strict=True) if t > 0)
             return (f"the model's own error from the archive's {self.pairs} pairs of expected "
                     f"and measured shots: spread (1 sigma) {spread}{net}; bias {bias}"
-                    + (f"; {', '.join(prior)}: the prior (no pairs enough)" if prior else ""))
+                    + (f"; {', '.join(prior)}: the prior (no pairs enough)" if prior else "")
+                    + (f"; at each setting, with the spread its drawn inputs give, as much as "
+                       f"makes the pairs' whole spread ({whole})" if whole else ""))
         if not self.pairs:
             return ("the model's own error, the prior (the archive holds no pair of expected "
                     f"and measured shots): spread (1 sigma) {spread}, centred")
