@@ -88,6 +88,10 @@ BAD = [
     ({"seed": -1, "mc": 8, "sd": "E40=3%"}, "seed: found -1, expected a whole number from 0",
      ["--seed", "-1", "--mc", "8", "--sd", "E40=3%"],
      "--seed: found '-1', expected a whole number from 0"),
+    ({"mc": "²", "sd": "E40=3%"}, "mc: found '²', expected a number of shots", ["--mc", "²",
+     "--sd", "E40=3%"], "--mc: found '²', expected a number of shots"),
+    ({"seed": "9" * 5000, "mc": 8, "sd": "E40=3%"}, "seed: found '99999",
+     ["--seed", "9" * 5000, "--mc", "8", "--sd", "E40=3%"], "--seed: found '99999"),
     ({"workers": "two", "vary": "A28=1:2:2"}, "workers: found 'two', expected a whole number",
      ["--workers", "two", "--vary", "A28=1:2:2"], "--workers: found 'two', expected a whole "
      "number"),

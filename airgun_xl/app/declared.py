@@ -32,6 +32,7 @@ from typing import Any, TypeVar
 
 from ..choices import INTEGRATORS, MODELS
 from ..errors import OptionError
+from ..units import quoted
 
 #: A field's grammar: (what the caller gave, who gave it) -> the value.
 Read = Callable[[Any, str], Any]
@@ -224,7 +225,10 @@ def a_whole(value: Any, who: str, lo: int | None = None, hi: int | None = None) 
     if isinstance(value, int) and not isinstance(value, bool):
         found = value
     elif isinstance(value, str) and value.strip().lstrip("+-").isdigit():
-        found = int(value)
+        try:  # "²" is a digit int() does not read; 4,301 digits pass Python's limit
+            found = int(value)
+        except ValueError:
+            found = None
     else:
         try:
             number = a_number(value, who)
@@ -235,7 +239,7 @@ def a_whole(value: Any, who: str, lo: int | None = None, hi: int | None = None) 
     span = ("" if lo is None and hi is None else f" from {lo:,}" if hi is None
             else f" from {lo:,} to {hi:,}" if lo is not None else f" up to {hi:,}")
     if found is None or (lo is not None and found < lo) or (hi is not None and found > hi):
-        raise OptionError(f"{who}: found {value!r}, expected a whole number{span}")
+        raise OptionError(f"{who}: found {quoted(value)}, expected a whole number{span}")
     return found
 
 
@@ -249,7 +253,7 @@ def a_seed(value: Any, who: str) -> int:
     try:
         return a_whole(value, who, 0, 2**128 - 1)
     except OptionError:
-        raise OptionError(f"{who}: found {value!r}, expected a whole number from 0 to "
+        raise OptionError(f"{who}: found {quoted(value)}, expected a whole number from 0 to "
                           "2**128 - 1") from None
 
 
