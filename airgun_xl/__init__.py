@@ -109,6 +109,12 @@ def _paths_checked(function: _F) -> _F:
     return checked  # type: ignore[return-value]
 
 
+def _event(fields: Any) -> dict[str, Any]:
+    """``event`` and ``at`` as a request's keywords, read and checked
+    (:class:`airgun_xl.app.declared.EventFields`)."""
+    return {"event": fields.event, "at": fields.at}
+
+
 @_paths_checked
 def load(path: str | os.PathLike[str]) -> Shot:
     """Read a :class:`Shot` from a workbook (see :meth:`Shot.from_workbook`)."""
@@ -123,7 +129,8 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
            archive: str | os.PathLike[str] | None = None, channel: str | None = None,
            sign: float = 1.0, time_unit: str | None = None, accel_unit: str | None = None,
            crush_law: str = "workbook", pdf: str | os.PathLike[str] | None = None,
-           reproducible: bool = False, **spec: Unpack[SpecKeywords]) -> AcceptOutcome:
+           reproducible: bool = False, event: int | None = None, at: float | str | None = None,
+           **spec: Unpack[SpecKeywords]) -> AcceptOutcome:
     """Judge a recording against the shot's specification, as ``airgun-xl accept`` does.
 
     The specification is the ``profile``'s, then the shot's Specification sheet's, then
@@ -146,6 +153,10 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
         Keep the verdict in this archive (needs ``output``, which the record names).
     sign : float
         1, or -1 when the recorder's axis is opposite to the macro's [-].
+    event, at : int or float, optional
+        Of a recording of several shocks, the one judged: its number (from 1, as
+        :func:`recording` with ``events`` lists them) or an instant of it [s] (``1.25``,
+        ``"1250ms"``); the largest by default.
     crush_law : str
         The law the shot's prediction runs: ``workbook`` (its Crush law sheet's, else the
         macro's), ``legacy`` (the macro's, Eq. 8) or ``NAME[@N]`` of ``archive``'s library.
@@ -166,6 +177,7 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
     from pathlib import Path
 
     from .app.accept import AcceptRequest, run
+    from .app.declared import EventFields
     from .app.specifying import keyword_fields
 
     fields = keyword_fields("accept", dict(spec), accel_unit)
@@ -173,7 +185,8 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
         Path(shot), os.fspath(recording), fields, Path(output) if output is not None else None,
         force, Path(archive) if archive is not None else None, channel,
         _sign(sign), time_unit, accel_unit, ("accept",), crush_law,
-        _path("--pdf", pdf) if pdf is not None else None, bool(reproducible)))
+        _path("--pdf", pdf) if pdf is not None else None, bool(reproducible),
+        **_event(EventFields.given(event=event, at=at))))
 
 
 @_paths_checked
@@ -184,7 +197,8 @@ def calibrate(*files: str | os.PathLike[str], law: bool = False,
               channel: str | None = None, anti_alias: str | float = "auto",
               integrator: str = "legacy", output: str | os.PathLike[str] | None = None,
               force: bool = False, archive: str | os.PathLike[str] | None = None,
-              name: str | None = None) -> CalibrateOutcome:
+              name: str | None = None, event: int | None = None,
+              at: float | str | None = None) -> CalibrateOutcome:
     """Fit the model to the shots that were fired, as ``airgun-xl calibrate`` does:
     ``files`` are each shot's workbook followed by its recording (``"shot_01.xlsx",
     "rec_01.csv", "shot_02.xlsx", "rec_02.csv"``).
@@ -208,6 +222,7 @@ def calibrate(*files: str | os.PathLike[str], law: bool = False,
     from pathlib import Path
 
     from .app.calibrate import CalibrateRequest, run
+    from .app.declared import EventFields
     from .app.specifying import record_filter
 
     texts = [os.fspath(f) for f in files]
@@ -221,7 +236,8 @@ def calibrate(*files: str | os.PathLike[str], law: bool = False,
         _whole("--degree", degree), record, _sign(sign), time_unit, accel_unit,
         channel, anti_alias, integrator,
         Path(output) if output is not None else None, force,
-        Path(archive) if archive is not None else None, name, ("calibrate",)))
+        Path(archive) if archive is not None else None, name, ("calibrate",),
+        **_event(EventFields.given(event=event, at=at))))
 
 
 @_paths_checked
@@ -320,7 +336,8 @@ def compare_measured(shot: str | os.PathLike[str], recording: str | os.PathLike[
                      channel: str | None = None, integrator: str = "legacy",
                      model: str = "4-mass", output: str | os.PathLike[str] | None = None,
                      force: bool = False, crush_law: str = "workbook",
-                     archive: str | os.PathLike[str] | None = None) -> CompareMeasuredOutcome:
+                     archive: str | os.PathLike[str] | None = None, event: int | None = None,
+                     at: float | str | None = None) -> CompareMeasuredOutcome:
     """The shot's predicted pulse against a measured one, as ``airgun-xl compare-measured``
     does: both through ``cfc`` (a J211 class, or ``"none"``, the default), aligned at the
     impact (``align``: threshold or xcorr), scored.
@@ -342,7 +359,7 @@ def compare_measured(shot: str | os.PathLike[str], recording: str | os.PathLike[
         shot=shot, recording=recording, cfc=cfc, align=align, anti_alias=anti_alias,
         sign=sign, time_unit=time_unit, accel_unit=accel_unit, channel=channel,
         integrator=integrator, model=model, output=output, force=force, crush_law=crush_law,
-        archive=archive))
+        archive=archive, event=event, at=at))
 
 
 @_paths_checked
@@ -417,11 +434,18 @@ def diff(legacy: str | os.PathLike[str], new: str | os.PathLike[str], *,
 
 
 @_paths_checked
-def recording(path: str | os.PathLike[str]) -> RecordingOutcome:
+def recording(path: str | os.PathLike[str], *, events: bool = False, channel: str | None = None,
+              time_unit: str | None = None,
+              accel_unit: str | None = None) -> RecordingOutcome:
     """What a recording file holds, as ``airgun-xl recording`` lists it: its ``format`` and
     its ``channels`` (each one's ``name``, ``unit`` as the file states it, ``rate`` [Hz],
     ``samples`` and ``start`` [s]), in the file's order: ``channel="2"`` in the reading
     functions is the second, ``channel=NAME`` the one of that name. No samples judged.
+    With ``events``, also the shocks of ``channel`` (by default the first acceleration
+    channel; ``time_unit`` and ``accel_unit`` where the file states none): ``events`` holds
+    the channel's name, its unit, its times [s] and the events found
+    (:class:`airgun_xl.readers.events.Events`), numbered for ``event=N`` in the reading
+    functions.
 
     Raises
     ------
@@ -430,7 +454,8 @@ def recording(path: str | os.PathLike[str]) -> RecordingOutcome:
     """
     from .app.recording import RecordingRequest, run
 
-    return run(RecordingRequest.given(path=path))
+    return run(RecordingRequest.given(path=path, events=events, channel=channel,
+                                      time_unit=time_unit, accel_unit=accel_unit))
 
 
 @_paths_checked
@@ -685,8 +710,8 @@ def next_shot(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *
               vary: str | None = None, scheduler: str | None = None,
               workers: int | None = None, chunk: int | None = None,
               pdf: str | os.PathLike[str] | None = None, gun: str | None = None,
-              step: str | Sequence[str] = (),
-              **spec: Unpack[SpecKeywords]) -> NextOutcome:
+              step: str | Sequence[str] = (), event: int | None = None,
+              at: float | str | None = None, **spec: Unpack[SpecKeywords]) -> NextOutcome:
     """The closed loop, as ``airgun-xl next`` runs it: judge the fired ``shot``'s
     ``recording``, update ``lot``'s law in ``archive`` on every shot of the lot, choose the
     A28 (with ``vary``, also a second knob: ``"E13"``, ``"E16"`` or ``"A2"``) most likely to
@@ -712,6 +737,7 @@ def next_shot(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *
     """
     from pathlib import Path
 
+    from .app.declared import EventFields
     from .app.next_shot import NextRequest, run
     from .app.specifying import keyword_fields
 
@@ -725,7 +751,7 @@ def next_shot(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *
         None if workers is None else _whole("--workers", workers),
         None if chunk is None else _whole("--chunk", chunk),
         None if pdf is None else _path("--pdf", pdf), None if gun is None else str(gun),
-        _texts(step)))
+        _texts(step), **_event(EventFields.given(event=event, at=at))))
 
 
 __all__ = [

@@ -116,6 +116,24 @@ def parse_duration(text, option="--target-duration"):
                     floor=1e-9, floor_text="1 ns")
 
 
+def instant(text: Any, where: str) -> float:
+    """An instant of a recording [s] (``--at``): a number of seconds or a time with its unit
+    (``"1.25"``, ``"1250ms"``, ``"-2ms"`` before a trigger), read by the grammar; finite, of
+    either sign."""
+    expected = "an instant of the recording such as 1.25 or 1250ms (units s, ms, us, ns)"
+    if isinstance(text, (int, float)) and not isinstance(text, bool):
+        value = float(text)
+    else:
+        sign, magnitude, unit = split_quantity(str(text), where, expected)
+        if sign == "±":
+            raise refuse(where, text, expected)
+        value = scaled(magnitude, unit_of(unit or "s", TIME_UNITS, str(text), where, expected))
+        value = -value if sign == "-" else value
+    if not math.isfinite(value):
+        raise refuse(where, text, expected)
+    return value
+
+
 #: The units a verdict reports the peak and the duration in, as their nominal was given:
 #: unit typed -> (unit shown, factor from the inside unit, kG or s).
 SHOWN_UNITS = {

@@ -143,7 +143,9 @@ SCHEMAS: dict[str, dict] = {
                                "sign": {"enum": [1, -1, 1.0, -1.0]},
                                "time_unit": {"type": ["string", "null"]},
                                "accel_unit": {"type": ["string", "null"]},
-                               "channel": {"type": ["string", "null"]}}},
+                               "channel": {"type": ["string", "null"]},
+                               "event": {"type": ["integer", "null"], "minimum": 1},
+                               "at": {"type": ["number", "null"]}}},
                 "description": "the lot's shots: each workbook and recording, with hashes"},
             "warnings": _TEXTS, "created": _TEXT, "command": _TEXTS}},
     "summary": {

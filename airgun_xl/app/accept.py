@@ -47,6 +47,8 @@ class AcceptRequest:
     crush_law: str = "workbook"  # workbook, legacy or NAME[@N] of the archive's library
     pdf: Path | None = None  # the client's test report, as a PDF
     reproducible: bool = False  # the PDF without a date: the same run, the same bytes
+    event: int | None = None  # of a recording of several shocks, the one judged (from 1)
+    at: float | None = None  # [s] or the one at this instant of the recording
 
 
 @dataclass(frozen=True)
@@ -162,7 +164,7 @@ def run(request: AcceptRequest) -> AcceptOutcome:
     spec = require(resolve(shot, request.spec), request.shot)
     cfc = spec.judged.cfc  # --cfc is the specification's record field, over the sheet's
     trace = read_trace(request.recording, request.time_unit, request.accel_unit, request.sign,
-                       request.channel)
+                       request.channel, request.event, request.at)
     filtering = check_cfc(cfc, trace.dt) if cfc else []
     expected, notes = expectations(shot, spec)
     # zeroed and its quality read; the record judged is made below

@@ -41,6 +41,8 @@ class CalibrateRequest:
     archive: Path | None = None
     name: str | None = None
     argv: tuple[str, ...] = ()  # the command, as the law's record keeps it
+    event: int | None = None  # of each recording of several shocks, the one judged (from 1)
+    at: float | None = None  # [s] or the one at this instant of each recording
 
 
 @dataclass(frozen=True)
@@ -161,7 +163,7 @@ def run(request: CalibrateRequest) -> CalibrateOutcome:
                      inputs=[input_file(f) for pair in request.pairs for f in pair])
     shots = [Shot.from_workbook(s) for s, _ in request.pairs]
     traces = [read_trace(m, request.time_unit, request.accel_unit, request.sign,
-                         request.channel) for _, m in request.pairs]
+                         request.channel, request.event, request.at) for _, m in request.pairs]
     cal = calibrate([s.params for s in shots], traces, law=law, fit=names, cfc=request.cfc,
                     degree=request.degree, objective=request.objective,
                     integrator=request.integrator, anti_alias=request.anti_alias)

@@ -31,6 +31,8 @@ class CompareMeasuredRequest(declared.Checked):
     output: Path | None = declared.output("scores and traces", "SHOT.measured.xlsx")
     force: bool = declared.force()
     channel: str | None = declared.channel()
+    event: int | None = declared.event()
+    at: float | None = declared.at()
     cfc: int | None = declared.cfc()
     sign: float = declared.sign()
     time_unit: str | None = declared.time_unit()
@@ -102,7 +104,7 @@ def run(request: CompareMeasuredRequest) -> CompareMeasuredOutcome:
         check_output(request.output, request.force,
                      inputs=[request.shot, input_file(request.recording)])
     trace = read_trace(request.recording, request.time_unit, request.accel_unit,
-                       request.sign, request.channel)
+                       request.sign, request.channel, request.event, request.at)
     shot = shot_with_law(request.shot, request.crush_law, request.archive)
     result = dataclasses.replace(shot, params=apply_model(shot.params, request.model)).run(
         integrator=request.integrator, track=())

@@ -137,6 +137,16 @@ class Checked:
             if read is not None:
                 object.__setattr__(self, field.name, read(getattr(self, field.name),
                                                           field.name))
+        given: dict[str, str] = {}
+        for field in dataclasses.fields(self):  # type: ignore[arg-type]
+            spelt = field.metadata.get("option")
+            if not isinstance(spelt, Option) or spelt.group is None \
+                    or getattr(self, field.name) == field.default:
+                continue
+            if spelt.group in given:  # what the command line's exclusive group refuses
+                raise refusal("{0}: found it with {1}, expected one of them", field.name,
+                              given[spelt.group])
+            given[spelt.group] = field.name
 
 
 # -- grammars --------------------------------------------------------------------------
@@ -372,6 +382,45 @@ CFC_BOTH_HELP = ("filter both pulses: SAE J211 class 60, 180, 600 or 1000, or no
 def channel(help: str = CHANNEL_HELP) -> Any:
     """``--channel NAME|N``: which channel of a file of several (None: the first)."""
     return option(None, "--channel", metavar="NAME|N", help=help, read=a_text_or_none)
+
+
+EVENT_HELP = ("the event judged in a recording of several shocks: its number as "
+              "'airgun-xl recording FILE --events' lists it (default: the largest, "
+              "said)")
+AT_HELP = ("the event judged: the one whose stretch holds TIME [s] of the recording (1.25, "
+           "1250ms); in a recording of no event, the samples within 0.5 s of it")
+
+
+def an_event(value: Any, who: str) -> int | None:
+    """An event's number, from 1, or None."""
+    return None if value is None else a_whole(value, who, 1)
+
+
+def an_instant(value: Any, who: str) -> float | None:
+    """An instant of a recording [s], or None."""
+    from ..units import instant
+
+    return None if value is None else instant(value, who)
+
+
+def event() -> Any:
+    """``--event N``: which event of a recording of several is judged (None: the largest)."""
+    return option(None, "--event", metavar="N", help=EVENT_HELP, read=an_event,
+                  group="event")
+
+
+def at() -> Any:
+    """``--at TIME``: the event at an instant of the recording [s]."""
+    return option(None, "--at", metavar="TIME", help=AT_HELP, read=an_instant, group="event")
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class EventFields(Checked):
+    """Which event of a recording of several shocks is judged (the commands that read a
+    recording without declaring every option yet take these two: accept, calibrate, next)."""
+
+    event: int | None = event()
+    at: float | None = at()
 
 
 def cfc(help: str = CFC_BOTH_HELP) -> Any:

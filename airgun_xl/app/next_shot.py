@@ -82,6 +82,8 @@ class NextRequest:
     pdf: Path | None = None  # the next shot's report as a PDF too
     gun: str | None = None  # the gun's name: its scatter pooled over the lots it fired
     step: tuple[str, ...] = ()  # what the knobs can be set to: A28=0.5 (m/s), E13=...
+    event: int | None = None  # of a recording of several shocks, the one judged (from 1)
+    at: float | None = None  # [s] or the one at this instant of the recording
 
 
 #: The second knobs ``next --vary`` takes: the mitigator's geometry and the exchange mass
@@ -245,8 +247,7 @@ def run(request: NextRequest) -> NextOutcome:
             "recording": str(request.recording),
             "recording_sha256": _sha256(input_file(request.recording), "recording"),
             **_reading(request)}
-    counted_once = any((s["shot_sha256"], s["recording_sha256"]) ==
-                       (this["shot_sha256"], this["recording_sha256"]) for s in earlier)
+    counted_once = any(_same_shot(s, this) for s in earlier)
     lot_shots = earlier if counted_once else [*earlier, this]
     others, read_warnings = _gun_lots(request, lot_shots)
     freedom = sum(len(launch) - 1 for _lot, launch in others) + len(lot_shots) - 1
@@ -577,9 +578,17 @@ def _recording_file(text: str) -> str:
     return str(input_file(text))
 
 
+def _same_shot(one: dict[str, Any], other: dict[str, Any]) -> bool:
+    """The same workbook and recording, and the same event of it (a session's recording
+    holds several shots)."""
+    return all(one.get(k) == other.get(k)
+               for k in ("shot_sha256", "recording_sha256", "event", "at"))
+
+
 def _reading(request: NextRequest) -> dict[str, Any]:
     return {"sign": request.sign, "time_unit": request.time_unit,
-            "accel_unit": request.accel_unit, "channel": request.channel}
+            "accel_unit": request.accel_unit, "channel": request.channel,
+            "event": request.event, "at": request.at}
 
 
 def _judge(request: NextRequest, spec: Any) -> Verdict:
@@ -590,7 +599,8 @@ def _judge(request: NextRequest, spec: Any) -> Verdict:
     outcome = accept(AcceptRequest(request.shot, request.recording, request.spec,
                                    channel=request.channel, sign=request.sign,
                                    time_unit=request.time_unit,
-                                   accel_unit=request.accel_unit, argv=request.argv))
+                                   accel_unit=request.accel_unit, argv=request.argv,
+                                   event=request.event, at=request.at))
     return outcome.verdict
 
 
@@ -601,7 +611,8 @@ def _read_lot(lot_shots: list[dict[str, Any]]) -> tuple[list[Any], list[Any]]:
 
     params = [Shot.from_workbook(s["shot"]).params for s in lot_shots]
     traces = [read_trace(s["recording"], s.get("time_unit"), s.get("accel_unit"),
-                         float(s.get("sign", 1.0)), s.get("channel")) for s in lot_shots]
+                         float(s.get("sign", 1.0)), s.get("channel"), s.get("event"),
+                         s.get("at")) for s in lot_shots]
     return params, traces
 
 

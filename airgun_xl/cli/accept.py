@@ -52,7 +52,8 @@ def request_of(args):
     return AcceptRequest(shot_path, args.recording, SpecFields.of(args), output, args.force,
                          Path(args.archive) if args.archive else None, args.channel, args.sign,
                          args.time_unit, args.accel_unit, tuple(args.argv), args.crush_law,
-                         Path(args.pdf) if args.pdf else None, args.reproducible)
+                         Path(args.pdf) if args.pdf else None, args.reproducible,
+                         event=args.event, at=args.at)
 
 
 def run(args):

@@ -66,7 +66,7 @@ def request_of(args):
                             args.sign, args.time_unit, args.accel_unit, args.channel,
                             args.anti_alias, args.integrator, output, args.force,
                             Path(args.archive) if args.archive else None, args.name,
-                            tuple(args.argv))
+                            tuple(args.argv), event=args.event, at=args.at)
 
 
 def run(args):

@@ -11,7 +11,7 @@ from typing import Any
 
 from ..app.declared import option_of
 from ..errors import OptionError
-from .recording_options import CfcOption, cfc_value
+from .cfc_option import CfcOption, cfc_value
 from .run_options import Integrators
 from .vocabulary import Alias, One
 

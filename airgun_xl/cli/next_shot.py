@@ -85,7 +85,7 @@ def request_of(args):
                        Path(args.output) if args.output else None, args.force,
                        tuple(args.argv), args.vary, args.scheduler, args.workers,
                        args.chunk, Path(args.pdf) if args.pdf else None, args.gun,
-                       tuple(args.step or ()))
+                       tuple(args.step or ()), event=args.event, at=args.at)
 
 
 def run(args):

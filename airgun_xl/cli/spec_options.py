@@ -17,7 +17,7 @@ RECORD_HELP = ("the record judged: N through SAE J211 CFC N (60, 180, 600 or 100
 def add_spec_options(p, cfc=True):
     """The specification's options; ``cfc`` False where the command's recording options
     already give ``--cfc`` (accept), the record judged all the same."""
-    from .recording_options import CfcOption, RecordAlias, cfc_value, record_value
+    from .cfc_option import CfcOption, RecordAlias, cfc_value, record_value
     from .vocabulary import Once
 
     g = p.add_argument_group("specification (override the shot's Specification sheet and the"

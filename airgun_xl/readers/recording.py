@@ -17,6 +17,7 @@ from .. import limits
 from ..errors import OptionError, WorkbookError
 from ..transaction import display
 from . import formats
+from .events import EVENT_SHARE, EVENT_SIGMAS
 from .formats import delimited, workbook_range
 from .formats.channels import (  # noqa: F401 (the readers' tables, kept at their old path)
     ACCEL_UNITS,
@@ -183,28 +184,10 @@ def read_spectrum(path, accel_unit=None, option="--target-srs"):
     return f, values[:, 1] * ACCEL_UNITS[a_unit]
 
 
-def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
-    """Read a measured pulse: a CSV file, a column range of a workbook
-    (``trace.xlsx:Sheet1!A:B``, time then acceleration, a header row first), or a LabVIEW
-    TDMS file (a waveform channel; needs the ``tdms`` extra, npTDMS).
-
-    Parameters
-    ----------
-    path : str or path
-    channel : str, optional
-        TDMS only: ``GROUP/CHANNEL``; the first waveform channel by default.
-    time_unit, accel_unit : str, optional
-        Keys of :data:`TIME_UNITS` / :data:`ACCEL_UNITS`; read from the header when None.
-    sign : float
-        +1 or -1: multiplies the acceleration (the recorder's axis against the macro's).
-
-    Raises
-    ------
-    WorkbookError
-        For the file or a row, naming it.
-    OptionError
-        For a unit that cannot be told or is not known.
-    """
+def _samples(path, time_unit, accel_unit, channel):
+    """The recording's name as shown, its (time, acceleration) units, its times [s]
+    (increasing, at a step within the recorders' range) and its raw values (in the
+    acceleration unit), and what the reading said."""
     for option, given, table in (("--time-unit", time_unit, TIME_UNITS),
                                  ("--accel-unit", accel_unit, ACCEL_UNITS)):
         if given is not None and given not in table:
@@ -239,17 +222,71 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
         raise WorkbookError(f"{shown}: its sample step is {dt:.4g} s ({1 / dt:.4g} Hz), "
                             f"expected a step of {limits.MIN_SAMPLE_STEP:g} to "
                             f"{limits.MAX_SAMPLE_STEP:g} s (a recorder of 1 Hz to 1 GHz)")
-    raw = values[:, 1]
+    return shown, (t_unit, a_unit), time, values[:, 1], notes
+
+
+def list_events(path, channel=None, time_unit=None, accel_unit=None):
+    """The events of a recording's channel (:mod:`.events`), as :func:`read_trace` chooses
+    among them: (its name as shown, its acceleration unit, its times [s], the events)."""
+    from .events import find_events
+
+    shown, (_t_unit, a_unit), time, raw, _notes = _samples(path, time_unit, accel_unit,
+                                                           channel)
+    return shown, a_unit, time, find_events(time, raw)
+
+
+def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None, event=None,
+               at=None):
+    """Read a measured pulse: a CSV file, a column range of a workbook
+    (``trace.xlsx:Sheet1!A:B``, time then acceleration, a header row first), or a LabVIEW
+    TDMS file (a waveform channel; needs the ``tdms`` extra, npTDMS).
+
+    Parameters
+    ----------
+    path : str or path
+    channel : str, optional
+        TDMS only: ``GROUP/CHANNEL``; the first waveform channel by default.
+    time_unit, accel_unit : str, optional
+        Keys of :data:`TIME_UNITS` / :data:`ACCEL_UNITS`; read from the header when None.
+    sign : float
+        +1 or -1: multiplies the acceleration (the recorder's axis against the macro's).
+    event : int, optional
+        Of a recording of several shocks (:mod:`.events`), the one judged, from 1: the
+        stretch of the recording that holds it is read. None: the largest (said when there
+        are several).
+    at : float, optional
+        [s] Instead of ``event``: the event whose stretch holds this instant of the
+        recording; in a recording of no event, the samples within
+        :data:`~.formats.channels.WINDOW_SECONDS` of it.
+
+    Raises
+    ------
+    WorkbookError
+        For the file or a row, naming it.
+    OptionError
+        For a unit that cannot be told or is not known.
+    """
+    shown, (t_unit, a_unit), time, raw, notes = _samples(path, time_unit, accel_unit, channel)
+    dt = float(np.median(np.diff(time)))
+    first, stop, centre, said = _event_stretch(shown, time, raw, event, at, a_unit)
+    notes += said
+    steps = np.diff(time)
     if (np.abs(steps - dt) > GAP_TOLERANCE * dt).any():  # a recorder's clock: fitted
         from .time_base import fit_clock
 
-        clock = fit_clock(shown, time, raw)
-        time, raw, dt = clock.time, raw[clock.first:clock.stop], clock.dt
+        # over the whole recording (the recorder's one clock), centred on the event judged
+        clock = fit_clock(shown, time, raw, centre, named=event is not None or at is not None)
         notes += list(clock.notes)
-        if len(raw) < MIN_SAMPLES:
-            raise WorkbookError(f"{shown}: holds {len(raw)} samples on one clock around its "
-                                f"largest excursion (between the gaps in its time), expected "
-                                f"at least {MIN_SAMPLES}")
+        time = np.concatenate([np.full(clock.first, np.nan), clock.time,
+                               np.full(len(raw) - clock.stop, np.nan)])
+        first, stop = max(first, clock.first), min(stop, clock.stop)
+        dt = clock.dt
+    time, raw = time[first:stop], raw[first:stop]
+    if len(raw) < MIN_SAMPLES:
+        where = said[0] if said else "on one clock around its largest excursion (between " \
+            "the gaps in its time)"
+        raise WorkbookError(f"{shown}: holds {len(raw)} samples {where}, expected at least "
+                            f"{MIN_SAMPLES}")
     accel = sign * raw * FILE_ACCEL_UNITS[a_unit]
     peak = float(np.max(np.abs(accel)))
     if not peak >= limits.MIN_RECORDED_PEAK_KG:
@@ -259,6 +296,69 @@ def read_trace(path, time_unit=None, accel_unit=None, sign=1.0, channel=None):
     return Trace(time, accel, dt, shown,
                  (t_unit, a_unit),
                  notes)
+
+
+def _event_stretch(shown, time, raw, event, at, unit):
+    """Where the event judged lies in the recording ``shown`` (its stamps ``time`` [s], its
+    ``raw`` values in ``unit``; :mod:`.events`): the samples ``first`` to ``stop`` (from 0,
+    ``stop`` excluded) that hold it, the sample a recorder's clock is fitted round (None: the
+    largest excursion), and what to say of it. The whole recording when it holds one event,
+    or none and no ``at``."""
+    from .events import find_events, stretch
+    from .formats.channels import WINDOW_SECONDS
+
+    found = find_events(time, raw)
+    events = found.events
+    size = (f"past {found.threshold:.4g} {unit} from its rest of {found.rest:.4g} {unit}, "
+            f"the larger of {EVENT_SIGMAS:g} x its noise and {EVENT_SHARE:.0%} of its largest "
+            "excursion")
+    if at is not None and not time[0] <= at <= time[-1]:
+        raise OptionError(f"--at: found {at:g} s, expected an instant of {shown}, which runs "
+                          f"{float(time[0]):.6g} to {float(time[-1]):.6g} s")
+    if event is not None and event > len(events):
+        held = (f"holds {len(events)} event{'s' * (len(events) != 1)} ({size})" if events
+                else f"holds no event (no sample {size})")
+        raise OptionError(f"--event: found {event}, expected an event of {shown}, which "
+                          f"{held}: airgun-xl recording --events lists them")
+    if not events:
+        if at is None:
+            return 0, len(raw), None, [
+                f"{shown}: holds no event standing out of its noise (no sample {size}): its "
+                "largest excursion is judged, which may be noise"]
+        keep = np.flatnonzero(np.abs(time - at) <= WINDOW_SECONDS)
+        if len(keep) < MIN_SAMPLES:
+            raise WorkbookError(f"{shown}: holds {len(keep)} samples within "
+                                f"{WINDOW_SECONDS:g} s of --at {at:g} s, expected at least "
+                                f"{MIN_SAMPLES}")
+        first, stop = int(keep[0]), int(keep[-1]) + 1
+        centre = first + int(np.argmax(np.abs(raw[first:stop] - found.rest)))
+        return first, stop, centre, [
+            f"{shown}: holds no event standing out of its noise (no sample {size}): the "
+            f"samples within {WINDOW_SECONDS:g} s of --at {at:g} s, {float(time[first]):.6g} "
+            f"to {float(time[stop - 1]):.6g} s, are judged"]
+    if at is not None:
+        chosen = next(e for e in events
+                      if at < time[stretch(found, e, len(raw))[1] - 1] or e is events[-1])
+    elif event is not None:
+        chosen = events[event - 1]
+    else:
+        largest = found.largest()
+        assert largest is not None  # the recording holds events
+        chosen = largest
+    centre = chosen.peak  # the clock is fitted round it
+    if len(events) == 1:
+        return 0, len(raw), centre, []
+    first, stop = stretch(found, chosen, len(raw))
+    how = ("the largest" if event is None and at is None
+           else f"--event {event}" if event is not None else f"--at {at:g} s")
+    if chosen.cut:
+        how += (", cut by the recording's " + ("start" if chosen.first == 0 else "end")
+                + ": its rest there is missing")
+    peak = f"{chosen.height:+.5g} {unit} as recorded at {float(time[chosen.peak]):.6g} s"
+    return first, stop, centre, [
+        f"{shown}: holds {len(events)} events ({size}): event {chosen.number} ({how}), "
+        f"peak {peak}, is judged on {float(time[first]):.6g} to {float(time[stop - 1]):.6g} "
+        "s as stamped (airgun-xl recording --events lists them; --event N judges another)"]
 
 
 def _override(shown, option, given, header, table):

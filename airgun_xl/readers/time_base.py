@@ -87,9 +87,12 @@ def _line(time: np.ndarray, first: int, stop: int) -> tuple[float, float, float]
     return float(time[first]) + offset, step, worst
 
 
-def fit_clock(shown: str, time: np.ndarray, values: np.ndarray) -> ClockFit:
+def fit_clock(shown: str, time: np.ndarray, values: np.ndarray, centre: int | None = None,
+              named: bool = False) -> ClockFit:
     """The recording ``shown`` (its stamps ``time`` [s], increasing, and its raw ``values``)
-    on one fitted clock around its largest excursion (see the module's notes).
+    on one fitted clock around its largest excursion, or the sample ``centre`` (the peak of
+    the event judged, :mod:`airgun_xl.readers.events`; ``named`` when the user named it: the
+    messages say so; see the module's notes).
 
     Raises
     ------
@@ -101,7 +104,8 @@ def fit_clock(shown: str, time: np.ndarray, values: np.ndarray) -> ClockFit:
     steps = np.diff(time)
     median = float(np.median(steps))
     rest = float(np.median(values[:REST_SAMPLES]))
-    peak = int(np.argmax(np.abs(values - rest)))
+    peak = int(np.argmax(np.abs(values - rest))) if centre is None else centre
+    what = "the peak of the event judged" if named else "its largest excursion"
     gaps = np.flatnonzero(steps > GAP_STEPS * median)  # a gap after sample g
     before, after = gaps[gaps < peak], gaps[gaps >= peak]
     first = int(before[-1]) + 1 if len(before) else 0
@@ -112,8 +116,8 @@ def fit_clock(shown: str, time: np.ndarray, values: np.ndarray) -> ClockFit:
             raise WorkbookError(
                 f"{shown}: a gap of {float(steps[g]):.4g} s ({float(steps[g]) / median:.1f} "
                 f"steps) in its time after {float(time[g]):.6g} s, "
-                f"{abs(float(time[edge] - time[peak])) * 1e3:.3g} ms from its largest "
-                f"excursion at {float(time[peak]):.6g} s, expected no missing samples within "
+                f"{abs(float(time[edge] - time[peak])) * 1e3:.3g} ms from {what} at "
+                f"{float(time[peak]):.6g} s, expected no missing samples within "
                 f"{GAP_MARGIN_SECONDS * 1e3:g} ms of the pulse (its rest, the pulse and its "
                 "tail are judged there)")
     lo, hi = first, stop
@@ -125,16 +129,16 @@ def fit_clock(shown: str, time: np.ndarray, values: np.ndarray) -> ClockFit:
         if 2 * half < shortest:
             raise WorkbookError(
                 f"{shown}: its time stamps stray up to {worst:.2g} of a step from one clock "
-                f"even over the {(time[hi - 1] - time[lo]) * 1e3:.3g} ms around its largest "
-                f"excursion at {float(time[peak]):.6g} s, expected a recorder's time base: "
+                f"even over the {(time[hi - 1] - time[lo]) * 1e3:.3g} ms around {what} at "
+                f"{float(time[peak]):.6g} s, expected a recorder's time base: "
                 f"a rate and an offset that every stamp lies within {JITTER_STEPS:g} of a "
                 "step of (a changed rate or a damaged time column?)")
         lo, hi = max(first, peak - half), min(stop, peak + half + 1)
         start, step, worst = _line(time, lo, hi)
     if abs(median / step - 1) > RATE_TOLERANCE:
         raise WorkbookError(
-            f"{shown}: its time stamps around its largest excursion at {float(time[peak]):.6g} "
-            f"s ({float(time[lo]):.6g} to {float(time[hi - 1]):.6g} s) run at {1 / step:.6g} "
+            f"{shown}: its time stamps around {what} at {float(time[peak]):.6g} s "
+            f"({float(time[lo]):.6g} to {float(time[hi - 1]):.6g} s) run at {1 / step:.6g} "
             f"Hz, {(median / step - 1):+.2%} from the {1 / median:.6g} Hz of its median step, "
             f"expected one clock within {RATE_TOLERANCE:.1%} (a block stamped apart from the "
             "others, as a recorder's first often is): its time there cannot be trusted")
@@ -150,12 +154,12 @@ def fit_clock(shown: str, time: np.ndarray, values: np.ndarray) -> ClockFit:
     if (lo, hi) != (first, stop):
         notes.append(f"{shown}: its clock wanders more than {JITTER_STEPS:g} of a step from "
                      f"one rate over the whole recording: only the {hi - lo:,} samples around "
-                     f"its largest excursion, {float(time[lo]):.6g} to "
+                     f"{what}, {float(time[lo]):.6g} to "
                      f"{float(time[hi - 1]):.6g} s, are read")
     if len(gaps):
         notes.append(f"{shown}: {len(gaps)} gap{'s' * (len(gaps) > 1)} in its time (missing "
                      f"samples; the first after {float(time[gaps[0]]):.6g} s), none within "
-                     f"{GAP_MARGIN_SECONDS * 1e3:g} ms of its largest excursion: the "
+                     f"{GAP_MARGIN_SECONDS * 1e3:g} ms of {what}: the "
                      f"stretch from {float(time[first]):.6g} to {float(time[stop - 1]):.6g} s "
                      "that holds it is read")
     return ClockFit(lo, hi, start + step * np.arange(hi - lo, dtype=float), step,
