@@ -259,7 +259,8 @@ def test_few_pairs_are_weighed_with_the_prior_as_a_conjugate_normal_model():
     same model updated one pair at a time (kappa, mu, nu, nu sigma^2: an independent route,
     equal to the batch formula by algebra, so to 1e-12); no pair: the prior itself; pairs of
     a 20 % spread move the peak's spread above the prior's, pairs of 0.5 % below it, and a
-    bias of +2 % is shrunk by 3 / (3 + n)."""
+    bias of +2 % is shrunk by 3 / (3 + n). The whole spread (the prior's, a whole one, with
+    the pairs' own, not net of their inputs) is weighed the same way."""
     from airgun_xl.studies.model_error import (
         FIGURES,
         MIN_SD,
@@ -289,6 +290,14 @@ def test_few_pairs_are_weighed_with_the_prior_as_a_conjugate_normal_model():
                 kappa, nu = kappa + 1, nu + 1
             assert e.mean[j] == pytest.approx(mu, abs=1e-12)
             assert e.sd[j] == pytest.approx(math.sqrt(ss / nu), rel=1e-12)
+            # the whole spread a setting makes up to: the same weighing (the pairs here
+            # carry no spread of their inputs, so whole and net agree)
+            assert e.total[j] == pytest.approx(ss / nu, rel=1e-12)
+            # pairs whose inputs explained 3 %: the error is net of it, the whole is not
+            shared = ModelError.from_pairs([{g: (*p[g], 0.03) for g in FIGURES}
+                                            for p in pairs])
+            assert shared.total[j] == pytest.approx(ss / nu, rel=1e-12)
+            assert shared.sd[j] < e.sd[j]
     assert checked >= 7
     loud = ModelError.from_pairs(pairs_with(0.2, 5, 4))
     quiet = ModelError.from_pairs(pairs_with(0.005, 3, 1))
@@ -528,7 +537,8 @@ def test_the_error_at_a_setting_makes_the_pairs_whole_spread_there():
     draws explain 2 %, the error's variance is the whole less 0.02^2 (to 1e-15: one
     subtraction); where they explain more than the whole, the floor (the sampling error of
     the pairs' variance, s^2 sqrt(2/39), x (1 + 1/40)); the correlation the pairs show is
-    kept; a figure never learnt, and a prior, are as they were."""
+    kept; a figure never learnt is as it was; the prior, a whole spread too, gives the
+    inputs' share of it (0.05^2 - 0.03^2 where they explain 3 %), never below 0.5 %."""
     from airgun_xl.studies.model_error import FIGURES, ModelError
 
     pairs = pairs_with(0.06, 40, 3)
@@ -546,7 +556,13 @@ def test_the_error_at_a_setting_makes_the_pairs_whole_spread_there():
     assert floored.covariance[0][0] == pytest.approx(
         max(var[0] * math.sqrt(2 / 39), 0.005 ** 2) * (1 + 1 / 40), rel=1e-12)
     prior = ModelError.prior()
-    assert prior.at([0.0, 0.0, 0.0]) is prior
+    assert prior.at([0.0, 0.0, 0.0]).covariance == prior.covariance
+    # the prior is a whole spread too: the inputs' share is taken out of it, down to MIN_SD
+    shared = prior.at([0.03, 0.02, 0.2])
+    assert np.diag(shared.covariance) == pytest.approx(
+        [0.05 ** 2 - 0.03 ** 2, 0.03 ** 2 - 0.02 ** 2, 0.005 ** 2], rel=1e-12)
+    assert ModelError._diagonal([0.02, 0.02, 0.02], 0).at([0.0, 0.0, 0.0]).covariance == \
+        ModelError._diagonal([0.02, 0.02, 0.02], 0).covariance
     # what a study says of it: the pairs' whole spread it keeps at every setting
     assert e.words().endswith(f"makes the pairs' whole spread (peak {100 * math.sqrt(whole):.1f} "
                               f"%, duration {100 * math.sqrt(var[1] * (1 + 1 / 40)):.1f} %, "
