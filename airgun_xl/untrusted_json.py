@@ -46,7 +46,8 @@ _CRITERION = {
     "properties": {"name": _TEXT, "value": _NUMBER_OR_NULL, "unit": _TEXT,
                    "low": _NUMBER_OR_NULL, "high": _NUMBER_OR_NULL,
                    "margin": _NUMBER_OR_NULL, "margin_unit": _TEXT,
-                   "passed": {"type": "boolean"}, "detail": _TEXT},
+                   "passed": {"type": "boolean"}, "detail": _TEXT,
+                   "judged": {"type": "boolean"}},
     "description": "a criterion: name, value, unit, margin, margin_unit and passed"}
 
 #: The schema of each kind of record, as the tool writes it.
@@ -75,7 +76,7 @@ SCHEMAS: dict[str, dict] = {
         "type": "object", "required": ["shot", "verdict", "criteria"],
         "description": "a verdict record",
         "properties": {"shot": _TEXT, "shot_sha256": {"type": ["string", "null"]},
-                       "verdict": {"enum": ["PASS", "FAIL"]},
+                       "verdict": {"enum": ["PASS", "FAIL", "NOT JUDGED"]},
                        "criteria": {"type": "array", "items": _CRITERION},
                        "tolerances": _TEXTS, "definitions": _TEXTS, "specification": _TEXT,
                        "notes": _TEXTS, "warnings": _TEXTS, "recording": _TEXT,
@@ -100,7 +101,7 @@ SCHEMAS: dict[str, dict] = {
                      "shots", "next_sha256"],
         "properties": {
             "lot": _TEXT, "shot": _TEXT, "recording": _TEXT,
-            "verdict": {"enum": ["PASS", "FAIL"]}, "law": _TEXT, "scale": _NUMBER,
+            "verdict": {"enum": ["PASS", "FAIL", "NOT JUDGED"]}, "law": _TEXT, "scale": _NUMBER,
             "scale_error": _NUMBER_OR_NULL, "setting_A28": _NUMBER,
             "second_cell": _TEXT, "second_value": _NUMBER, "tilt": _NUMBER,
             "tilt_error": _NUMBER_OR_NULL, "tilt_about": _NUMBER,
@@ -155,7 +156,8 @@ SCHEMAS: dict[str, dict] = {
             "dominant_frequencies_hz": {"type": "array", "items": _NUMBER},
             "predicted_verdict": {
                 "type": "object", "required": ["verdict", "criteria"],
-                "properties": {"verdict": {"enum": ["PASS", "FAIL"]}, "specification": _TEXT,
+                "properties": {"verdict": {"enum": ["PASS", "FAIL", "NOT JUDGED"]},
+                               "specification": _TEXT,
                                "criteria": {"type": "array", "items": _CRITERION},
                                "tolerances": _TEXTS, "definitions": _TEXTS}}},
         "additionalProperties": {"type": ["number", "null", "array"],

@@ -119,7 +119,7 @@ def verdict_lines(verdict: Verdict, what: str) -> list[str]:
         f" (with {n} warning{'s' * (n != 1)}: read them before relying on it)" if n else "")]
     for c in verdict.criteria:
         margin = f"{c.margin:+.2f} {c.margin_unit}"
-        lines.append(f"  {'PASS' if c.passed else 'FAIL'}  {c.name}: {c.value:.5g} {c.unit} "
+        lines.append(f"  {c.word}  {c.name}: {c.value:.5g} {c.unit} "
                      f"(limits {limits_text(c)}; margin {margin})"
                      + (f"; {c.detail}" if c.detail else ""))
     lines += [f"  {line}" for line in verdict.definitions]

@@ -393,8 +393,8 @@ def _verdict_lines(verdict: dict[str, Any]) -> list[str]:
     for c in verdict.get("criteria") or []:
         value = "not measured" if c["value"] is None else f"{c['value']:.6g} {c['unit']}"
         margin = "none" if c["margin"] is None else f"{c['margin']:+.2f} {c['margin_unit']}"
-        lines.append(f"  {c['name']:<24} {value}, margin {margin}, "
-                     f"{'PASS' if c['passed'] else 'FAIL'}")
+        word = "PASS" if c["passed"] else "NOT JUDGED" if c.get("judged") is False else "FAIL"
+        lines.append(f"  {c['name']:<24} {value}, margin {margin}, {word}")
     return lines
 
 

@@ -541,7 +541,7 @@ def _verdict_lines(v: Verdict, warnings: list[str]) -> list[str]:
     lines = [f"  specification ({v.spec.source or 'options'}), predicted: {v.word}"
              + (f" (DOUBTED: see the warnings on {', '.join(doubted)})" if doubted else "")
              + ": " + "; ".join(f"{c.name} {c.value:.5g} {c.unit} {c.margin:+.2f} "
-                                f"{c.margin_unit} {'PASS' if c.passed else 'FAIL'}"
+                                f"{c.margin_unit} {c.word}"
                                 for c in v.criteria)]
     lines += [f"    {line}" for line in v.sources()]
     lines += [f"    note: {line}" for line in v.spec.notes]  # a profile's caveats

@@ -902,9 +902,17 @@ class PredictionRecord:
     brier: float
     files: tuple[Path, ...]
 
+    @property
+    def not_judged(self) -> int:
+        """Shots whose record could not show a criterion (NOT JUDGED): no outcome, left out
+        of the bands and the score."""
+        return sum(s["verdict"] not in ("PASS", "FAIL") for s in self.shots)
+
     def lines(self) -> list[str]:
-        said = [f"{len(self.shots)} shots fired from next's proposals; Brier score "
-                + (f"{self.brier:.4f}" if self.shots else "none yet")]
+        apart = (f" ({self.not_judged} NOT JUDGED, left out of the bands and the score)"
+                 if self.not_judged else "")
+        said = [f"{len(self.shots)} shots fired from next's proposals{apart}; Brier score "
+                + (f"{self.brier:.4f}" if len(self.shots) > self.not_judged else "none yet")]
         for band in self.bands:
             if band.shots:
                 lo, hi = band.interval
@@ -919,7 +927,8 @@ class PredictionRecord:
     def to_json(self) -> str:
         from .documents import dumps
 
-        return dumps({"shots": self.shots, "brier": self.brier, "bands": [
+        return dumps({"shots": self.shots, "brier": self.brier,
+                      "not_judged": self.not_judged, "bands": [
             {"low": b.low, "high": b.high, "shots": b.shots, "passed": b.passed,
              "mean_predicted": b.mean_predicted, "interval": list(b.interval),
              "honest": b.honest} for b in self.bands], "files": self.files})
@@ -931,7 +940,7 @@ def prediction_record(root: str | Path | None, output: str | None = None,
     shot's verdict; ``output`` also writes the record's workbook (a reliability chart)."""
     from ..archive import Archive, archive_dir
     from ..archive.lots import lot_names
-    from ..studies.closed_loop import brier, reliability
+    from ..studies.closed_loop import brier, outcomes, reliability
     from ..transaction import check_output, display
 
     if output is not None:
@@ -941,8 +950,7 @@ def prediction_record(root: str | Path | None, output: str | None = None,
               "predicted": float(row["predicted_before"]), "verdict": row["verdict"]}
              for lot in lot_names(found.root) for row in chain(found.root, lot)
              if isinstance(row["predicted_before"], (int, float))]
-    predicted = [s["predicted"] for s in shots]
-    passed = [s["verdict"] == "PASS" for s in shots]
+    predicted, passed = outcomes(shots)  # a shot NOT JUDGED counted apart
     bands = reliability(predicted, passed)
     score = brier(predicted, passed)
     files: tuple[Path, ...] = ()

@@ -1,6 +1,7 @@
 """``airgun-xl accept SHOT.xlsx RECORDING``: did the fired shot meet its specification?
 
-Exit 0 on PASS, 3 on FAIL (:data:`FAIL_EXIT`), 2 for bad input."""
+Exit 0 on PASS, 3 on FAIL (:data:`FAIL_EXIT`), 4 on NOT JUDGED (:data:`NOT_JUDGED_EXIT`: the
+record cannot show a criterion and none failed), 2 for bad input."""
 from pathlib import Path
 
 from .recording_options import RECORDING_HELP, add_recording_options
@@ -11,6 +12,9 @@ from .vocabulary import One
 #: The exit status of a shot that fails its specification (2 stays for bad input).
 FAIL_EXIT = 3
 
+#: The exit status of a recording that cannot show a criterion, none failing (issue 63).
+NOT_JUDGED_EXIT = 4
+
 
 def add_parser(sub):
     p = sub.add_parser("accept", help="judge a recording against the shot's specification: "
@@ -19,7 +23,8 @@ def add_parser(sub):
                                    "against the specification (the shot's Specification "
                                    "sheet, a --profile, the options): peak, duration, velocity"
                                    " change, the corridor round the ideal pulse and the SRS; "
-                                   "write the verdict workbook. Exit 0 on PASS, 3 on FAIL.")
+                                   "write the verdict workbook. Exit 0 on PASS, 3 on FAIL, 4 "
+                                   "on NOT JUDGED.")
     p.add_argument("shot", metavar="SHOT.xlsx", help=SHOT_HELP)
     p.add_argument("recording", metavar="RECORDING", help="the recorded pulse: " + RECORDING_HELP)
     add_output(p, "verdict workbook", "SHOT.accept.xlsx")
@@ -63,5 +68,6 @@ def run(args):
 
     request = request_of(args)
     outcome = accept(request)
+    word = outcome.verdict.word
     return report(outcome, lines(request, outcome), args.json,
-                  0 if outcome.passed else FAIL_EXIT)
+                  0 if word == "PASS" else FAIL_EXIT if word == "FAIL" else NOT_JUDGED_EXIT)

@@ -59,7 +59,7 @@ def write_verdict_table(wb, ws, verdict, row, bold):
             ws.write_number(row, 5, c.margin, db if c.margin_unit == "dB" else pct)
         else:
             ws.write_string(row, 5, "none")
-        ws.write_string(row, 6, "PASS" if c.passed else "FAIL", good if c.passed else bad)
+        ws.write_string(row, 6, c.word, good if c.passed else bad)
         ws.write_string(row, 7, c.detail, wrap)
         if len(c.detail) > DETAIL_CHARS:  # as tall as its lines: it printed over the rows below
             ws.set_row(row, 15 * math.ceil(len(c.detail) / DETAIL_CHARS))

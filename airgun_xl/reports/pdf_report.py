@@ -45,6 +45,10 @@ LINE = 0.0135
 
 #: Colours of the verdict's word.
 PASS_COLOUR, FAIL_COLOUR = "#006100", "#9C0006"
+#: NOT JUDGED (the record cannot show a criterion): neither the pass's nor the fail's colour.
+NOT_JUDGED_COLOUR = "#9C5700"
+#: Each word's colour.
+WORD_COLOURS = {"PASS": PASS_COLOUR, "FAIL": FAIL_COLOUR, "NOT JUDGED": NOT_JUDGED_COLOUR}
 
 
 #: The font every text is drawn in (matplotlib's own: on every platform matplotlib runs).
@@ -159,8 +163,8 @@ def _criteria_rows(verdict: Any) -> tuple[list[list[str]], list[str | None]]:
         value = f"{c.value:.5g}" if np.isfinite(c.value) else "n/a"
         margin = f"{c.margin:+.2f} {c.margin_unit}" if np.isfinite(c.margin) else "n/a"
         rows.append([c.name, value, c.unit, limits_text(c), margin,
-                     "PASS" if c.passed else "FAIL"])
-        colours.append(PASS_COLOUR if c.passed else FAIL_COLOUR)
+                     c.word])
+        colours.append(WORD_COLOURS[c.word])
     return rows, colours
 
 
@@ -172,7 +176,7 @@ def _text_pages(pages: _Pages, verdict: Any, about: list[tuple[str, str]],
     pages.text("Shock test report", size=16, bold=True)
     pages.gap(1.0)
     pages.text(f"Verdict: {verdict.word}", size=14, bold=True,
-               colour=PASS_COLOUR if verdict.passed else FAIL_COLOUR)
+               colour=WORD_COLOURS[verdict.word])
     pages.gap()
     pages.table(["Item", "Value"], [[label, value] for label, value in about], [0.0, 0.2])
     pages.gap()
@@ -186,7 +190,7 @@ def _text_pages(pages: _Pages, verdict: Any, about: list[tuple[str, str]],
     for c in verdict.criteria:
         if c.detail:
             pages.text(f"- {c.name}: {c.detail}", indent=0.02,
-                       colour="black" if c.passed else FAIL_COLOUR)
+                       colour="black" if c.passed else WORD_COLOURS[c.word])
     pages.gap()
     pages.text(f"Warnings ({len(warnings)})" if warnings else "Warnings: none", size=11,
                bold=True, colour=FAIL_COLOUR if warnings else "black")
@@ -443,7 +447,7 @@ def write_fill_pdf(path: str | Path, rows: list[tuple[str, str, str, str]],
         pages.gap(1.0)
         if verdict is not None:
             pages.text(f"Predicted verdict: {verdict.word}", size=13, bold=True,
-                       colour=PASS_COLOUR if verdict.passed else FAIL_COLOUR)
+                       colour=WORD_COLOURS[verdict.word])
             if doubted:
                 pages.text(f"DOUBTED: see the warnings on {', '.join(doubted)}",
                            bold=True, colour=FAIL_COLOUR)

@@ -168,6 +168,14 @@ class Criterion:
     margin_unit: str  # "%" (of the nominal) or "dB"
     passed: bool
     detail: str = ""
+    #: False when the record cannot show it (not measurable, and not shown outside its
+    #: limits either): the verdict is NOT JUDGED unless another criterion failed
+    judged: bool = True
+
+    @property
+    def word(self) -> str:
+        """PASS, FAIL or NOT JUDGED, as the verdict's line shows it."""
+        return "PASS" if self.passed else "FAIL" if self.judged else "NOT JUDGED"
 
 
 @dataclass
@@ -189,11 +197,19 @@ class Verdict:
 
     @property
     def passed(self) -> bool:
+        """Every criterion judged and passed (False for NOT JUDGED too)."""
         return all(c.passed for c in self.criteria)
 
     @property
+    def failed(self) -> bool:
+        """A criterion judged and failed: FAIL, whatever the others."""
+        return any(c.judged and not c.passed for c in self.criteria)
+
+    @property
     def word(self) -> str:
-        return "PASS" if self.passed else "FAIL"
+        """PASS (every criterion passed), FAIL (one judged failed) or NOT JUDGED (none
+        failed, and the record cannot show one: re-record or re-test; issue 63)."""
+        return "PASS" if self.passed else "FAIL" if self.failed else "NOT JUDGED"
 
     def sources(self) -> list[str]:
         """Where each field of the specification came from, the defaults it used, and what a
@@ -656,11 +672,57 @@ def judge(t: np.ndarray, kg: np.ndarray, spec: Specification,
     reasons = _unmeasured(row, spec, (lo_t, hi_t))
     for c in criteria:
         if not math.isfinite(c.value):
-            why = reasons.get(c.name, "it could not be measured on this pulse")
-            c.passed, c.margin = False, -math.inf
-            c.detail = f"not measurable: {why}" + (f"; {c.detail}" if c.detail else "")
-            verdict.warnings.append(f"{c.name}: not measurable: {why}: judged FAIL")
+            unmeasurable(verdict, c, reasons.get(c.name, "it could not be measured on this "
+                                                 "pulse"),
+                         _outlasts(t, kg, c) if c.name == "duration" else None)
     return verdict
+
+
+def _outlasts(t: np.ndarray, kg: np.ndarray, c: Criterion) -> str | None:
+    """Of a duration the record cannot measure because the pulse outlasts it (its start at
+    10 % recorded, the record ending above 10 % of the peak): the words saying it is longer
+    than its upper limit all the same, when the record already shows that; else None."""
+    if c.high is None or not len(kg):
+        return None
+    top = int(np.argmax(kg))
+    level = DURATION_LEVEL * float(kg[top])
+    below = np.flatnonzero(kg[:top] < level)
+    if not len(below) or kg[-1] < level or float(kg[top]) <= 0:
+        return None
+    from ..units import SHOWN_UNITS
+
+    scale = dict(SHOWN_UNITS["duration"].values()).get(c.unit, math.nan)  # unit per second
+    least = (float(t[-1]) - float(t[below[-1] + 1])) * scale
+    if not least > c.high:
+        return None
+    return (f"the pulse outlasts the record, which shows it at least {least:.5g} {c.unit} "
+            f"long, past its upper limit of {c.high:.5g} {c.unit}")
+
+
+#: What to change so that a criterion the record cannot show can be judged.
+REMEDY = {"peak": "record the whole pulse (a longer record, an earlier trigger)",
+          "duration": "record the pulse's start and end (more pre-trigger, a longer record)",
+          "velocity change": "a pre-trigger and a record after the pulse as long as its "
+                             "window, or a shorter --dv-window",
+          "corridor": "more pre-trigger and a longer record, or a shorter --monitor",
+          "SRS": "record the whole pulse and its rest"}
+
+
+def unmeasurable(verdict: Verdict, c: Criterion, why: str, proven: str | None = None,
+                 say: bool = True) -> None:
+    """``c`` cannot be measured on the record (``why``): NOT JUDGED, its remedy said, unless
+    the record shows it outside its limits all the same (``proven``, in words): FAIL.
+    ``say`` False where a warning of the recording's already says it."""
+    c.passed, c.value, c.margin, c.judged = False, math.nan, -math.inf, proven is not None
+    c.detail = f"not measurable: {why}" + (f"; {c.detail}" if c.detail else "")
+    if not say:
+        return
+    if proven is not None:
+        verdict.warnings.append(f"{c.name}: not measurable: {why}; {proven}: judged FAIL")
+    else:
+        verdict.warnings.append(
+            f"{c.name}: not measurable: {why}: NOT JUDGED (the record cannot show it; to "
+            f"judge it, {REMEDY.get(c.name, 'record it whole')})")
 
 
 def _span_words(lo: float, hi: float) -> str:
@@ -877,8 +939,11 @@ def judge_record(t: np.ndarray, kg: np.ndarray, spec: Specification, what: str,
         why = damaged or ("the record starts or ends inside the pulse: the spectrum of a "
                           "pulse cut short" if cut and c.name == "SRS" else None)
         if why and math.isfinite(c.value):
-            c.passed, c.value, c.margin = False, math.nan, -math.inf
-            c.detail = f"not measurable: {why}"
+            # a clipped record shows the pulse reached the recorder's range: FAIL (issue
+            # 63); a dropout or a spectrum cut short shows nothing: NOT JUDGED
+            clipped = quality is not None and quality.clip is not None and why == damaged
+            unmeasurable(verdict, c, why, "the pulse reached the recorder's range"
+                         if clipped else None, say=why != damaged)
     if math.isfinite(noise) and noise > 0:
         verdict.warnings += noise_could_flip(verdict, tj, kj, spec, noise, what)
     return verdict

@@ -402,6 +402,14 @@ def _drawable(covariance):
     return (vectors * np.clip(values, 0.0, None)) @ vectors.T
 
 
+def outcomes(shots):
+    """(predicted P(PASS), passed) of the ``shots`` ({"predicted", "verdict"} each) that have
+    an outcome: a shot NOT JUDGED (its record could not show a criterion; issue 63) has
+    none, and is left out of the bands and the score."""
+    judged = [s for s in shots if s["verdict"] in ("PASS", "FAIL")]
+    return [s["predicted"] for s in judged], [s["verdict"] == "PASS" for s in judged]
+
+
 def brier(predicted, passed):
     """The Brier score of probabilities ``predicted`` against outcomes ``passed`` (0 best)."""
     p, o = np.asarray(predicted, float), np.asarray(passed, float)

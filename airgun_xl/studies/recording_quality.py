@@ -727,7 +727,8 @@ def _warnings(q: RecordingQuality) -> list[str]:
     for r in q.dropouts:
         out.append(f"{q.name}: a dropout: {r.words(t)} hold one value, {r.value:.4g} kG "
                    "(zeroed), inside the pulse, which neither the signal nor its noise "
-                   "makes: every criterion is not measurable and judged FAIL")
+                   "makes: every criterion is not measurable: NOT JUDGED unless one fails "
+                   "(record again)")
     if q.starts_inside:
         out.append(f"{q.name}: it starts inside the pulse (its first sample, zeroed, is "
                    f"{q.first:.4g} kG, above its noise and {INSIDE_FRACTION:.0%} of its "

@@ -80,7 +80,7 @@ def filters(query: Any) -> dict[str, Any]:
     return {"shot": query.get("shot", "").strip()[:200],
             "lot": query.get("lot", "").strip()[:200],
             "verdict": query.get("verdict", "") if query.get("verdict", "") in (
-                "", "PASS", "FAIL", "none") else "",
+                "", "PASS", "FAIL", "NOT JUDGED", "none") else "",
             "since": query.get("since", "").strip()[:10],
             "v0_min": number(query.get("v0_min")), "v0_max": number(query.get("v0_max")),
             "peak_min": number(query.get("peak_min")),

@@ -306,7 +306,7 @@ def write_predicted_verdict(wb, ws, verdict, row, style, doubted=()):
         if np.isfinite(c.value):
             ws.write_number(row, 1, c.value, number)
         ws.write_string(row, 2, c.unit)
-        ws.write_string(row, 3, f"{'PASS' if c.passed else 'FAIL'}: limits {limits_text(c)}"
+        ws.write_string(row, 3, f"{c.word}: limits {limits_text(c)}"
                         f", margin {c.margin:+.2f} {c.margin_unit}"
                         + (f"; {c.detail}" if c.detail else ""))
         row += 1
