@@ -130,7 +130,9 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
            sign: float = 1.0, time_unit: str | None = None, accel_unit: str | None = None,
            crush_law: str = "workbook", pdf: str | os.PathLike[str] | None = None,
            reproducible: bool = False, event: int | None = None, at: float | str | None = None,
-           **spec: Unpack[SpecKeywords]) -> AcceptOutcome:
+           client: str | None = None, test_id: str | None = None, item: str | None = None,
+           serial: str | None = None, operator: str | None = None, lab: str | None = None,
+           decision_rule: str = "simple", **spec: Unpack[SpecKeywords]) -> AcceptOutcome:
     """Judge a recording against the shot's specification, as ``airgun-xl accept`` does.
 
     The specification is the ``profile``'s, then the shot's Specification sheet's, then
@@ -157,6 +159,12 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
         Of a recording of several shocks, the one judged: its number (from 1, as
         :func:`recording` with ``events`` lists them) or an instant of it [s] (``1.25``,
         ``"1250ms"``); the largest by default.
+    client, test_id, item, serial, operator, lab : str, optional
+        The test's identification on the report (:mod:`airgun_xl.identification`), over
+        the shot's Specification sheet's Test block field by field.
+    decision_rule : {"simple", "guarded"}
+        How a value within its expanded uncertainty U of a limit is called (ILAC-G8):
+        as measured, or not accepted.
     crush_law : str
         The law the shot's prediction runs: ``workbook`` (its Crush law sheet's, else the
         macro's), ``legacy`` (the macro's, Eq. 8) or ``NAME[@N]`` of ``archive``'s library.
@@ -177,7 +185,7 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
     from pathlib import Path
 
     from .app.accept import AcceptRequest, run
-    from .app.declared import EventFields
+    from .app.declared import EventFields, ReportFields
     from .app.specifying import keyword_fields
 
     fields = keyword_fields("accept", dict(spec), accel_unit)
@@ -186,7 +194,9 @@ def accept(shot: str | os.PathLike[str], recording: str | os.PathLike[str], *,
         force, Path(archive) if archive is not None else None, channel,
         _sign(sign), time_unit, accel_unit, ("accept",), crush_law,
         _path("--pdf", pdf) if pdf is not None else None, bool(reproducible),
-        **_event(EventFields.given(event=event, at=at))))
+        **_event(EventFields.given(event=event, at=at)),
+        test=ReportFields.given(client=client, test_id=test_id, item=item, serial=serial,
+                                  operator=operator, lab=lab, decision_rule=decision_rule)))
 
 
 @_paths_checked

@@ -58,12 +58,16 @@ class Shot:
         What reading the workbook found worth saying (e.g. stale cached formula values).
     spec : airgun_xl.specification.Specification or None
         What the shot must meet: its workbook's Specification sheet (issue 25), or None.
+    test : dict
+        The test it is (:mod:`airgun_xl.identification`): its Specification sheet's Test
+        block, field -> text.
     """
 
     params: ShotParams
     source: Any = None
     warnings: list[str] = field(default_factory=list)
     spec: Any = None
+    test: dict[str, str] = field(default_factory=dict)
 
     @classmethod
     def from_workbook(cls, path: str | os.PathLike[str], read_law: bool = True) -> Shot:
@@ -79,18 +83,18 @@ class Shot:
         from .readers.shot_workbook import read_params, read_spec
 
         params, source, warnings = read_params(path, read_law)
-        spec, found = read_spec(source)
-        return cls(params, source, warnings + found, spec)
+        spec, test, found = read_spec(source)
+        return cls(params, source, warnings + found, spec, test)
 
     def with_params(self, **changes: float) -> Shot:
         """The same shot with some parameters changed (checked again)."""
         return Shot(self.params.replace(**changes), self.source, list(self.warnings),
-                    self.spec)
+                    self.spec, dict(self.test))
 
     def with_law(self, law: CrushLaw | None) -> Shot:
         """The same shot with another crush-factor law (None: the macro's, Eq. 8)."""
         return Shot(self.params.replace(crush_law=law or LEGACY_LAW), self.source,
-                    list(self.warnings), self.spec)
+                    list(self.warnings), self.spec, dict(self.test))
 
     def run(self, integrator: str = "legacy", host: str = "excel",
             track: Collection[str] = TRACKED) -> Result:

@@ -47,7 +47,7 @@ _CRITERION = {
                    "low": _NUMBER_OR_NULL, "high": _NUMBER_OR_NULL,
                    "margin": _NUMBER_OR_NULL, "margin_unit": _TEXT,
                    "passed": {"type": "boolean"}, "detail": _TEXT,
-                   "judged": {"type": "boolean"}},
+                   "judged": {"type": "boolean"}, "uncertainty": _NUMBER_OR_NULL},
     "description": "a criterion: name, value, unit, margin, margin_unit and passed"}
 
 #: The schema of each kind of record, as the tool writes it.
@@ -86,6 +86,8 @@ SCHEMAS: dict[str, dict] = {
                                           "description": "what the recording said of "
                                                          "itself, text by label"},
                        "created": _TEXT, "command": _TEXTS, "lot": _TEXT,
+                       "test": {"type": "object", "additionalProperties": _TEXT,
+                                "description": "the test's identification, text by field"},
                        "trace": {"type": ["object", "null"],
                                  "description": "the record judged, thinned for a drawing",
                                  "properties": {"time_ms": {"type": "array"},

@@ -2,6 +2,7 @@
 extractor (poppler's pdftotext) and rendered (pdftoppm): the verdict, every criterion with
 its value, limits and margin, the warnings, the specification's sources, the charts drawn,
 and the same bytes twice with --reproducible."""
+import math
 import re
 import shutil
 import subprocess
@@ -83,10 +84,13 @@ def test_the_pdf_reads_back_the_verdict_criteria_warnings_and_sources(fired, cas
     flat = " ".join(text.split())
     assert f"Verdict: {case}" in flat
     for c in outcome.criteria:  # the value, limits, margin and result as the terminal's
-        row = re.search(rf"^{re.escape(c.name)}\s+(\S+)\s+{re.escape(c.unit)}\s+(.+?)\s{{2,}}"
+        row = re.search(rf"^{re.escape(c.name)}\s+(\S+(?: ± \S+)?)\s+{re.escape(c.unit)}\s+"
+                        rf"(.+?)\s{{2,}}"
                         rf"(\S+ \S+)\s+(PASS|FAIL)$", text, re.M)
         assert row is not None, (c.name, text)
-        assert row.group(1) == f"{c.value:.5g}"
+        # the value and its expanded uncertainty U (k = 2), as the terminal shows them
+        assert row.group(1) == f"{c.value:.5g}" + (
+            f" ± {c.expanded:.2g}" if math.isfinite(c.expanded) else "")
         assert row.group(2) == airgun_xl.studies.acceptance.limits_text(c)
         assert row.group(3) == f"{c.margin:+.2f} {c.margin_unit}"
         assert row.group(4) == ("PASS" if c.passed else "FAIL")
@@ -151,7 +155,7 @@ def test_a_corridor_and_an_srs_requirement_are_on_the_pdf(tmp_path):
                  "-40dB,+40dB", "--pdf", str(pdf), "--reproducible", "--quiet"])
     assert code in (0, 3)
     flat = " ".join(_text(pdf).split())
-    assert re.search(r"corridor \S+ % the record inside the band", flat), flat
+    assert re.search(r"corridor \S+(?: ± \S+)? % the record inside the band", flat), flat
     assert re.search(r"\bSRS \S+ dB -40 to 40 dB ", flat), flat
     # each criterion's detail under the table, as the terminal and the workbook say it
     # (issue 63: an SRS failure located by its frequencies, not its worst figure alone)

@@ -49,6 +49,7 @@ class AcceptRequest:
     reproducible: bool = False  # the PDF without a date: the same run, the same bytes
     event: int | None = None  # of a recording of several shocks, the one judged (from 1)
     at: float | None = None  # [s] or the one at this instant of the recording
+    test: Any = None  # declared.ReportFields: the test's fields over the sheet's Test block
 
 
 @dataclass(frozen=True)
@@ -119,7 +120,8 @@ def verdict_lines(verdict: Verdict, what: str) -> list[str]:
         f" (with {n} warning{'s' * (n != 1)}: read them before relying on it)" if n else "")]
     for c in verdict.criteria:
         margin = f"{c.margin:+.2f} {c.margin_unit}"
-        lines.append(f"  {c.word}  {c.name}: {c.value:.5g} {c.unit} "
+        u = f" ± {c.expanded:.2g}" if math.isfinite(c.expanded) else ""
+        lines.append(f"  {c.word}  {c.name}: {c.value:.5g}{u} {c.unit} "
                      f"(limits {limits_text(c)}; margin {margin})"
                      + (f"; {c.detail}" if c.detail else ""))
     lines += [f"  {line}" for line in verdict.definitions]
@@ -137,8 +139,9 @@ def run(request: AcceptRequest) -> AcceptOutcome:
     """
     from ..archive.laws import shot_with_law
     from ..archive.verdicts import verdict_record
+    from ..identification import Identification
     from ..readers.recording import input_file, read_trace
-    from ..studies.acceptance import expectations, judge_record
+    from ..studies.acceptance import apply_decision_rule, expectations, judge_record
     from ..studies.measured import prepare
     from ..studies.shock import check_cfc
     from ..transaction import check_output
@@ -176,6 +179,9 @@ def run(request: AcceptRequest) -> AcceptOutcome:
                            warnings=shot.warnings + filtering + rec.warnings,
                            quality=rec.quality)
     verdict.definitions += notes
+    apply_decision_rule(verdict, request.test.decision_rule if request.test else "simple")
+    test = Identification.merged(shot.test, request.test.fields() if request.test else {})
+    verdict.test, verdict.definitions = test.given(), verdict.definitions + list(test.notes)
     assert verdict.record is not None
     time, kg = verdict.record
     pulse, spectra = report_data(time, kg, spec, verdict)
@@ -191,22 +197,30 @@ def run(request: AcceptRequest) -> AcceptOutcome:
                          record)
 
 
-def _about(request: AcceptRequest, verdict: Verdict, trace: Any, rec: Any) -> list[
+def _about(request: AcceptRequest, shot: Shot, verdict: Verdict, trace: Any, rec: Any
+           ) -> list[
         tuple[str, str]]:
-    """What the verdict's pages say of the shot and the recording read."""
-    return [("Shot", str(request.shot)), ("Recording", trace.name),
+    """What the verdict's pages say of the test (its identification, every field, a blank
+    line where none was given; the gun's setting), the shot and the recording read."""
+    from ..cells import address
+    from ..identification import Identification
+
+    return [*Identification(verdict.test).rows(),
+            ("Gun setting", f"{address('v31')} = {float(shot.params.v31):.6g} m/s"),
+            ("Shot", str(request.shot)), ("Recording", trace.name),
             ("Units read", f"time {trace.units[0]}, acceleration {trace.units[1]}"),
             ("Record judged", verdict.definitions[0].removeprefix("record judged: ")),
             ("Baseline", rec.base.words()), ("Verdict", verdict.word)]
 
 
-def _write_pdf(request: AcceptRequest, verdict: Verdict, trace: Any, rec: Any,
+def _write_pdf(request: AcceptRequest, shot: Shot, verdict: Verdict, trace: Any, rec: Any,
                pulse: dict[str, Any], spectra: dict[str, Any], path: Path) -> None:
     """The client's test report (``--pdf``), written at ``path`` (a staged temp file)."""
     from ..reports.pdf_report import write_verdict_pdf
     from ..untrusted_json import printable
 
-    about = [(label, printable(text)) for label, text in _about(request, verdict, trace, rec)]
+    about = [(label, printable(text))
+             for label, text in _about(request, shot, verdict, trace, rec)]
     heading = (printable(Path(request.shot).name), printable(Path(trace.name).name),
                printable(verdict.spec.source or "options"))  # the names: a page's width
     write_verdict_pdf(path, verdict, about, pulse, spectra,
@@ -235,11 +249,11 @@ def _write(request: AcceptRequest, shot: Shot, verdict: Verdict, trace: Any, rec
                                                request.recording, request.output,
                                                request.argv)
                 write_acceptance(request.output, verdict,
-                                 _about(request, verdict, trace, rec), pulse, spectra,
+                                 _about(request, shot, verdict, trace, rec), pulse, spectra,
                                  request.force, shot=Path(request.shot).name, publication=pub)
             if request.pdf is not None:  # in another folder: published after the workbook
                 later = for_file(pub, request.pdf, request.force)
-                _write_pdf(request, verdict, trace, rec, pulse, spectra,
+                _write_pdf(request, shot, verdict, trace, rec, pulse, spectra,
                            later.stage(request.pdf))
             pub.commit()
     except BaseException:

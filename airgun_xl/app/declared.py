@@ -423,6 +423,56 @@ class EventFields(Checked):
     at: float | None = at()
 
 
+def a_test_text(value: Any, who: str) -> str | None:
+    """A test's field (:mod:`airgun_xl.identification`): text on one line, at most its
+    length, or None; an empty one refused."""
+    from ..identification import MAX_CHARS, text_of
+
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (str, int, float)) \
+            or not str(value).strip():
+        raise OptionError(f"{who}: found {quoted(value)}, expected a text (the test's "
+                          "identification)")
+    text = text_of(value)
+    if len(str(value)) > MAX_CHARS:
+        raise OptionError(f"{who}: found a text of {len(str(value)):,} characters, expected "
+                          f"at most {MAX_CHARS}")
+    return text
+
+
+def _test_option(flag: str, what: str) -> Any:
+    return option(None, flag, metavar="TEXT", read=a_test_text,
+                  help=f"the test's {what}, on the report (over the Specification sheet's "
+                       "Test block)")
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class ReportFields(Checked):
+    """What a verdict's report says beyond the criteria: the test it is of, as options give
+    it (:mod:`airgun_xl.identification`: over the Specification sheet's Test block, field by
+    field), and the decision rule applied (ILAC-G8)."""
+
+    client: str | None = _test_option("--client", "client")
+    test_id: str | None = _test_option("--test-id", "number")
+    item: str | None = _test_option("--item", "item (what was tested)")
+    serial: str | None = _test_option("--serial", "item's serial number")
+    operator: str | None = _test_option("--operator", "operator (who fired it)")
+    lab: str | None = _test_option("--lab", "laboratory")
+    decision_rule: str = option(
+        "simple", "--decision-rule", kind="choice", choices=("simple", "guarded"),
+        read=one_of(("simple", "guarded")),
+        help="how a value near a limit is called (ILAC-G8): simple (the default: on or "
+             "inside its limits passes, its expanded uncertainty U stated) or guarded (it "
+             "passes only inside its limits by U)")
+
+    def fields(self) -> dict[str, str | None]:
+        """Each identification field, by its name in
+        :data:`airgun_xl.identification.FIELDS`."""
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)
+                if f.name != "decision_rule"}
+
+
 def cfc(help: str = CFC_BOTH_HELP) -> Any:
     """``--cfc N|none``: a SAE J211 class, or None for none."""
     return option(None, "--cfc", metavar="N|none", kind="cfc", help=help, read=a_cfc)

@@ -100,7 +100,8 @@ def verdict_record(verdict, shot, recording, report, command=(), lot=None):
             "recording_sha256": digest, "report": str(report),
             "trace": judged_trace(verdict),
             "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
-            "command": list(command), **({"lot": str(lot)} if lot is not None else {})}
+            "command": list(command), "test": dict(verdict.test),
+            **({"lot": str(lot)} if lot is not None else {})}
 
 
 def store_verdict(root, shot, verdict, recording, report, command=(), lot=None):

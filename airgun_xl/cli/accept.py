@@ -4,6 +4,8 @@ Exit 0 on PASS, 3 on FAIL (:data:`FAIL_EXIT`), 4 on NOT JUDGED (:data:`NOT_JUDGE
 record cannot show a criterion and none failed), 2 for bad input."""
 from pathlib import Path
 
+from ..app.declared import ReportFields
+from .declared import add_declared
 from .recording_options import RECORDING_HELP, add_recording_options
 from .run_options import SHOT_HELP, add_crush_law, add_force, add_json, add_output, add_pdf
 from .spec_options import RECORD_HELP, add_spec_options
@@ -33,6 +35,7 @@ def add_parser(sub):
     p.add_argument("--reproducible", action="store_true",
                    help="leave the date out of the PDF: the same run gives the same bytes")
     add_force(p)
+    add_declared(p, ReportFields)
     add_recording_options(p, anti_alias=False, cfc_help=(
         RECORD_HELP + ", over the sheet's and the profile's (refused where the filter is "
         "unstable, below 4.155 x the class in samples a second; a warning below J211's 10 x)"))
@@ -50,6 +53,7 @@ def request_of(args):
     default output beside the shot)."""
     from ..app.accept import AcceptRequest
     from ..app.specifying import SpecFields
+    from .declared import request_of as declared_request
 
     shot_path = Path(args.shot)
     output = Path(args.output) if args.output else shot_path.with_name(
@@ -58,7 +62,8 @@ def request_of(args):
                          Path(args.archive) if args.archive else None, args.channel, args.sign,
                          args.time_unit, args.accel_unit, tuple(args.argv), args.crush_law,
                          Path(args.pdf) if args.pdf else None, args.reproducible,
-                         event=args.event, at=args.at)
+                         event=args.event, at=args.at,
+                         test=declared_request(ReportFields, args))
 
 
 def run(args):

@@ -31,7 +31,7 @@ from .law_sheet import law_from_cells
 from .spec_sheet import KEY as SPEC_KEY
 from .spec_sheet import LAST_ROW as SPEC_LAST_ROW
 from .spec_sheet import SHEET_NAME as SPEC_SHEET
-from .spec_sheet import SRS_COLUMNS, spec_from_cells
+from .spec_sheet import SRS_COLUMNS, spec_from_cells, test_from_cells
 
 #: Columns read from a sheet other than the parameter sheet (Outputs, or one a formula names).
 OTHER_COLUMNS = 26
@@ -337,12 +337,13 @@ def law_values(source):
 
 
 def read_spec(source):
-    """The Specification sheet's specification (None when the sheet is missing or empty), and
-    the warnings its formulas raised."""
+    """The Specification sheet's specification (None when the sheet is missing or empty), its
+    Test block's fields (:func:`~.spec_sheet.test_from_cells`), and the warnings its formulas
+    raised."""
     if source is None or source.spec_block is None:
-        return None, []
+        return None, {}, []
     cells, warnings = sheet_values(source, SPEC_KEY, SPEC_SHEET, "specification")
-    return spec_from_cells(cells, source.percent_cells), warnings
+    return spec_from_cells(cells, source.percent_cells), test_from_cells(cells), warnings
 
 
 def check_time_header(source):

@@ -53,6 +53,11 @@ UNITS_SHOWN = {"corridor": "% of peak", "time_slack": "% of duration", "window":
                "decay": "% of duration"}
 SRS_COLUMNS = (6, 7)  # F, G
 
+#: The Test block (issue 63): a label a row in I, its value in J, from row 2, in the order of
+#: :data:`airgun_xl.identification.FIELDS`.
+TEST_COLUMNS = (9, 10)  # I, J
+TEST_FIRST_ROW = 2
+
 
 #: The last row the sheet is read to: the field rows, or the SRS rows up to
 #: :data:`~airgun_xl.specification.MAX_SRS_ROWS`; a cell past it is refused, not dropped.
@@ -140,3 +145,23 @@ def _srs_rows(cells: dict) -> SrsRequirement | None:
 
 def _blank(value) -> bool:
     return value is None or (isinstance(value, str) and not value.strip())
+
+
+def test_from_cells(cells: dict) -> dict[str, str]:
+    """The Test block's fields (:mod:`airgun_xl.identification`) a sheet's cells give, each
+    as text; a blank cell gives none. A formula the tool cannot evaluate is refused, naming
+    its cell."""
+    from ..identification import FIELDS, text_of
+
+    found = {}
+    for k, (name, label) in enumerate(FIELDS):
+        row = TEST_FIRST_ROW + k
+        value = cells.get((row, TEST_COLUMNS[1]), (None, None))[0]
+        if isinstance(value, Found):
+            raise CellError(_where("J", row), label, str(value), "a value (a formula the tool "
+                            "can evaluate)")
+        if _blank(value):
+            continue
+        numeric = isinstance(value, (int, float)) and not isinstance(value, bool)
+        found[name] = text_of(value) + (" m/s" if name == "velocity" and numeric else "")
+    return found

@@ -60,9 +60,12 @@ def write_verdict_table(wb, ws, verdict, row, bold):
         else:
             ws.write_string(row, 5, "none")
         ws.write_string(row, 6, c.word, good if c.passed else bad)
-        ws.write_string(row, 7, c.detail, wrap)
-        if len(c.detail) > DETAIL_CHARS:  # as tall as its lines: it printed over the rows below
-            ws.set_row(row, 15 * math.ceil(len(c.detail) / DETAIL_CHARS))
+        detail = "; ".join(filter(None, (
+            f"U = {c.expanded:.3g} {c.unit} (k = 2)" if math.isfinite(c.expanded) else "",
+            c.detail)))
+        ws.write_string(row, 7, detail, wrap)
+        if len(detail) > DETAIL_CHARS:  # as tall as its lines: it printed over the rows below
+            ws.set_row(row, 15 * math.ceil(len(detail) / DETAIL_CHARS))
         row += 1
     ws.write_string(row, 0, "Overall")
     ws.write_string(row, 6, verdict.word, good if verdict.passed else bad)

@@ -118,10 +118,13 @@ class _Pages:
 
     def text(self, text: str, size: float = 9.0, bold: bool = False, colour: str = "black",
              indent: float = 0.0, width: int = LINE_CHARS) -> None:
-        """``text`` wrapped to the page's width, line by line."""
+        """``text`` wrapped to the page's width, line by line, a paragraph kept on one page
+        (one that fits a page is never split by a page break)."""
         lines = textwrap.wrap(drawable(text), width - int(indent * 120)) or [""]
+        height = LINE * size / 9.0
+        if height * len(lines) < TOP - BOTTOM:
+            self.room(height * len(lines))
         for line in lines:
-            height = LINE * size / 9.0
             self.room(height)
             self.figure.text(LEFT + indent, self.y, line, fontsize=size, color=colour,
                              fontweight="bold" if bold else "normal", va="top", ha="left",
@@ -161,6 +164,8 @@ def _criteria_rows(verdict: Any) -> tuple[list[list[str]], list[str | None]]:
     colours: list[str | None] = []
     for c in verdict.criteria:
         value = f"{c.value:.5g}" if np.isfinite(c.value) else "n/a"
+        if np.isfinite(c.value) and np.isfinite(c.expanded):  # U, k = 2
+            value += f" ± {c.expanded:.2g}"
         margin = f"{c.margin:+.2f} {c.margin_unit}" if np.isfinite(c.margin) else "n/a"
         rows.append([c.name, value, c.unit, limits_text(c), margin,
                      c.word])
@@ -178,7 +183,17 @@ def _text_pages(pages: _Pages, verdict: Any, about: list[tuple[str, str]],
     pages.text(f"Verdict: {verdict.word}", size=14, bold=True,
                colour=WORD_COLOURS[verdict.word])
     pages.gap()
-    pages.table(["Item", "Value"], [[label, value] for label, value in about], [0.0, 0.2])
+    # the test's identification two fields a row (a blank line each where none was given)
+    from ..identification import LABELS
+
+    test = [[label, value] for label, value in about if label in LABELS.values()]
+    if test:
+        pairs = [test[k] + (test[k + 1] if k + 1 < len(test) else ["", ""])
+                 for k in range(0, len(test), 2)]
+        pages.table(["Test", "", "", ""], pairs, [0.0, 0.17, 0.5, 0.67])
+        pages.gap(0.5)
+    pages.table(["Item", "Value"], [[label, value] for label, value in about
+                                    if label not in LABELS.values()], [0.0, 0.2])
     pages.gap()
     pages.text("Criteria", size=11, bold=True)
     rows, colours = _criteria_rows(verdict)
@@ -213,7 +228,22 @@ def _text_pages(pages: _Pages, verdict: Any, about: list[tuple[str, str]],
     for line in sources:
         pages.text(f"- {line}", indent=0.02)
     pages.gap(1.5)
-    pages.room(LINE * 10)  # the block whole on one page: its title and three lines
+    if pages.y - LINE * 10 < BOTTOM:  # the block whole on one page: its title, three lines
+        # never alone on a page (issue 63): the verdict's summary repeated above it
+        pages.new()
+        pages.text(f"Verdict: {verdict.word} (summary, repeated for the signature)",
+                   size=14, bold=True, colour=WORD_COLOURS[verdict.word])
+        pages.gap()
+        identity = [f"{label}: {value}" for label, value in about
+                    if label in ("Client", "Test number", "Test item", "Serial number",
+                                 "Shot", "Recording")]
+        for line in identity:
+            pages.text(line)
+        pages.gap()
+        rows, colours = _criteria_rows(verdict)
+        pages.table(["Criterion", "Value", "Unit", "Limits", "Margin", "Result"], rows,
+                    [0.0, 0.17, 0.29, 0.37, 0.67, 0.80], colours)
+        pages.gap(1.5)
     pages.text("Test engineer", size=11, bold=True)
     pages.gap(1.2)
     from ..xlsx.report import SIGNATURE_LINES

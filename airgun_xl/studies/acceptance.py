@@ -102,6 +102,16 @@ CLIPPED_RUN = 3
 #: moved across it by the pre-trigger noise: the verdict warns.
 NOISE_FLIP_SIGMAS = 2.0
 
+#: The coverage factor of a figure's expanded uncertainty U = k u (about 95 % of a normal's;
+#: GUM, ILAC-G8). The same as :data:`NOISE_FLIP_SIGMAS`: a value within U of a limit is one
+#: the noise could move across it.
+COVERAGE_K = 2.0
+
+#: The decision rules a verdict applies (ILAC-G8): ``simple`` acceptance (a value on or
+#: inside its limits passes, its U stated) or ``guarded`` (a value passes only when it lies
+#: inside its limits by at least U: a guard band of U).
+DECISION_RULES = ("simple", "guarded")
+
 
 def ideal(shape: str | None, t: np.ndarray, amplitude: float, duration: float,
           decay: float = 0.0) -> np.ndarray:
@@ -171,6 +181,23 @@ class Criterion:
     #: False when the record cannot show it (not measurable, and not shown outside its
     #: limits either): the verdict is NOT JUDGED unless another criterion failed
     judged: bool = True
+    #: its standard uncertainty u [its unit] from what the recording shows (the noise at
+    #: rest through the record's filter, the quantisation step, the sampling; NaN: not
+    #: stated, a prediction's); its expanded one is :data:`COVERAGE_K` x u
+    uncertainty: float = math.nan
+
+    @property
+    def expanded(self) -> float:
+        """U = k u [its unit] (NaN where no uncertainty is stated)."""
+        return COVERAGE_K * self.uncertainty
+
+    def gap(self) -> float:
+        """The distance [its unit] from its value to its nearest limit (the corridor's
+        margin itself), NaN where it has none."""
+        if self.name == "corridor":
+            return abs(self.value)
+        gaps = [abs(self.value - lim) for lim in (self.low, self.high) if lim is not None]
+        return min(gaps) if gaps else math.nan
 
     @property
     def word(self) -> str:
@@ -194,6 +221,10 @@ class Verdict:
     srs_record: tuple[np.ndarray, np.ndarray] | None = None
     span: tuple[float, float] = (math.nan, math.nan)  # [s], the velocity change's window
     quality: RecordingQuality | None = None  # a recording's, as read before it was judged
+    #: the test it is of (airgun_xl.identification: field -> text, those given)
+    test: dict[str, str] = field(default_factory=dict)
+    #: the decision rule applied (:data:`DECISION_RULES`; "" before one is)
+    decision_rule: str = ""
 
     @property
     def passed(self) -> bool:
@@ -944,50 +975,119 @@ def judge_record(t: np.ndarray, kg: np.ndarray, spec: Specification, what: str,
             clipped = quality is not None and quality.clip is not None and why == damaged
             unmeasurable(verdict, c, why, "the pulse reached the recorder's range"
                          if clipped else None, say=why != damaged)
-    if math.isfinite(noise) and noise > 0:
-        verdict.warnings += noise_could_flip(verdict, tj, kj, spec, noise, what)
+    if math.isfinite(noise) and noise > 0 and not prediction:
+        lsb = quality.lsb if quality is not None and math.isfinite(quality.lsb) else 0.0
+        u = standard_uncertainties(verdict, tj, kj, spec, noise, lsb)
+        for c in verdict.criteria:
+            if c.name in u and math.isfinite(c.value):
+                c.uncertainty = u[c.name]
+        verdict.warnings += noise_could_flip(verdict, spec, noise, what)
     return verdict
 
 
-def noise_could_flip(verdict: Verdict, t: np.ndarray, kg: np.ndarray, spec: Specification,
-                     noise: float, what: str) -> list[str]:
-    """Warnings for the criteria that the rest's noise (``noise`` [kG], 1 sigma, unfiltered)
-    could move across a limit: within :data:`NOISE_FLIP_SIGMAS` of its effect on each."""
+def standard_uncertainties(verdict: Verdict, t: np.ndarray, kg: np.ndarray,
+                           spec: Specification, noise: float, lsb: float = 0.0
+                           ) -> dict[str, float]:
+    """Each criterion's standard uncertainty [its unit] from what the recording shows, on the
+    record judged ``kg`` [kG] at ``t`` [s]: the noise at rest (``noise`` [kG], 1 sigma,
+    unfiltered) through the record's filter (:func:`noise_gain`, exact for white noise),
+    the quantisation step ``lsb`` [kG] (uniform: lsb / sqrt(12)), and
+    for the peak the sampling (the crest between samples: up to c dt^2 / 8 below it, c the
+    curvature there; uniform); the duration's two crossings move by that noise over the
+    record's slope at 10 % (its linear interpolation errs by a second-order term, under 1e-4
+    of D at 20 samples across D: left out); the velocity change by the noise integrated over
+    its window. docs/acceptance.md gives the derivation and its Monte Carlo check."""
     dt = float(t[1] - t[0])
     peak = float(np.max(kg))
-    record = spec.judged
-    if record.is_unfiltered:
-        hz = None  # judged as it is
-    else:  # J211's -3 dB point is 1.65 x its class; the low-pass's is its cut-off
-        hz = record.cfc * 1.65 if record.cfc else lowpass_hz(
-            spec, float(_reference_duration(t, np.atleast_2d(kg), spec)[0]) or math.inf)
-    sigma = noise * math.sqrt(min(1.0, 2 * hz * dt)) if hz else noise  # after the filter
+    duration = float(_reference_duration(t, np.atleast_2d(kg), spec)[0])
+    sigma = math.hypot(noise * noise_gain(spec, dt, duration), lsb / math.sqrt(12.0))
+    top = int(np.argmax(kg))
+    curvature = abs(float(kg[top - 1] - 2 * kg[top] + kg[top + 1])) / dt ** 2 \
+        if 0 < top < len(kg) - 1 else 0.0
+    sampling = curvature * dt ** 2 / 8 / math.sqrt(3.0)
     slope = np.abs(np.gradient(kg, dt))
     level = DURATION_LEVEL * peak
     near = np.abs(kg - level) < 0.05 * peak
     steep = float(np.median(slope[near])) if near.any() else math.inf
     lo, hi = verdict.span  # the velocity change's window, as judged
     n_dv = max(1, int(round((hi - lo) / dt))) if math.isfinite(hi - lo) else len(kg)
-    effects = {"peak": sigma * shown_unit(spec, "peak")[1],  # in the criterion's unit
-               "duration": (math.sqrt(2) * sigma / steep * shown_unit(spec, "duration")[1]
-                            if steep > 0 else math.inf),
-               "velocity change": noise * dt * math.sqrt(n_dv) * KG_MS2,
-               "corridor": 100 * sigma / (spec.peak.nominal if spec.peak else peak)}
+    return {"peak": math.hypot(sigma, sampling) * shown_unit(spec, "peak")[1],
+            "duration": (math.sqrt(2) * sigma / steep * shown_unit(spec, "duration")[1]
+                         if steep > 0 else math.inf),
+            "velocity change": math.hypot(noise * math.sqrt(n_dv), lsb / math.sqrt(12.0))
+            * dt * KG_MS2,
+            "corridor": 100 * sigma / (spec.peak.nominal if spec.peak else peak)}
+
+
+def noise_gain(spec: Specification, dt: float, duration: float) -> float:
+    """The share [-] of a white noise's standard deviation the record's filter (both ways,
+    at the step ``dt`` [s]; the default low-pass's cut-off from ``duration`` [s]) leaves:
+    sqrt(sum h^2) of its impulse response, the filter run on a unit impulse (exact for
+    white noise; 1 for the unfiltered record)."""
+    from scipy.signal import bessel, sosfiltfilt
+
+    from .shock import cfc_filter
+
+    record = spec.judged
+    if record.is_unfiltered:
+        return 1.0
+    # J211's -3 dB point is 1.65 x its class; the low-pass's is its cut-off
+    # a duration unknown (0) leaves the default record unfiltered, as judged_record does
+    hz = record.cfc * 1.65 if record.cfc else (
+        lowpass_hz(spec, duration) if duration > 0 else math.inf)
+    if not record.cfc and not hz <= LOWPASS_MAX_RATE / dt:
+        return 1.0  # the default record unfiltered at this rate
+    n = int(min(200_000, max(256, math.ceil(40 / (hz * dt)))))  # 40 periods each side
+    impulse = np.zeros(2 * n + 1)
+    impulse[n] = 1.0
+    out = cfc_filter(impulse, dt, record.cfc) if record.cfc else sosfiltfilt(
+        bessel(LOWPASS_ORDER, hz, fs=1 / dt, output="sos", norm="mag"), impulse)
+    return float(np.sqrt(np.sum(out ** 2)))
+
+
+def noise_could_flip(verdict: Verdict, spec: Specification, noise: float, what: str
+                     ) -> list[str]:
+    """Warnings for the criteria that the rest's noise (``noise`` [kG], 1 sigma, unfiltered)
+    could move across a limit: within :data:`NOISE_FLIP_SIGMAS` of their uncertainty."""
     said = []
     for c in verdict.criteria:
-        effect = effects.get(c.name)
-        if effect is None or not math.isfinite(c.value):
+        effect = c.uncertainty
+        if not (math.isfinite(effect) and math.isfinite(c.value)):
             continue
-        if c.name == "corridor":
-            gap = abs(c.value)
-        else:
-            gap = min(abs(c.value - lim) for lim in (c.low, c.high) if lim is not None)
+        gap = c.gap()
         if gap <= NOISE_FLIP_SIGMAS * effect:
             said.append(f"{what}: the noise at rest ({noise:.3g} kG, 1 sigma; about "
                         f"{effect:.3g} {c.unit} on the {c.name} of the record judged) could "
                         f"move the {c.name} across its limit: it is {gap:.3g} {c.unit} from "
                         f"it; the {c.name}'s {'PASS' if c.passed else 'FAIL'} is not sure")
     return said
+
+
+def apply_decision_rule(verdict: Verdict, rule: str = "simple") -> None:
+    """Apply ``rule`` (:data:`DECISION_RULES`) and state it: under ``guarded`` a criterion
+    passed within its U of a limit is not accepted (FAIL, said); under ``simple`` it stands,
+    marked. The rule and the coverage factor are a line of the verdict's definitions."""
+    verdict.decision_rule = rule
+    verdict.definitions.append(
+        "decision rule: " + ("simple acceptance (ILAC-G8): a value on or inside its limits "
+                             "passes; each figure's expanded uncertainty U (k = 2, about 95 %) "
+                             "is stated beside it" if rule == "simple" else
+                             "guarded acceptance (ILAC-G8): a value passes only inside its "
+                             "limits by its expanded uncertainty U (k = 2, about 95 %), a "
+                             "guard band of U"))
+    for c in verdict.criteria:
+        u = c.expanded
+        if not (math.isfinite(u) and math.isfinite(c.value) and c.judged):
+            continue
+        if c.gap() < u:
+            within = f"within its U ({u:.3g} {c.unit}) of a limit"
+            if rule == "guarded" and c.passed:
+                c.passed = False
+                c.detail = (f"{within}: not accepted (guarded acceptance)"
+                            + (f"; {c.detail}" if c.detail else ""))
+            else:
+                c.detail = (f"{within}: judged as measured (simple acceptance)"
+                            + (f"; {c.detail}" if c.detail else ""))
 
 
 def predicted_verdict(result, spec: Specification) -> Verdict:
