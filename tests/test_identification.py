@@ -100,3 +100,19 @@ def test_a_bad_field_is_refused_in_one_line(tmp_path, capsys):
     line = refused(capsys, ["accept", shot, RECORDING, "--sign", "-1", "--peak", "9kG:20%",
                             "-o", tmp_path / "w.xlsx"], tmp_path, ("'Specification'!J4",))
     assert "Test item" in line
+
+
+@pytest.mark.skipif(not shutil.which("pdftotext"), reason="needs poppler-utils (pdftotext)")
+def test_the_fill_report_names_the_test_too(tmp_path):
+    """fill --pdf: the prediction's report heads with the sheet's Test block, a blank line
+    for each field not given."""
+    pytest.importorskip("matplotlib")
+    shot = _shot(tmp_path / "shot.xlsx", client="Acme Aerospace", serial="SN-0007")
+    pdf = tmp_path / "f.pdf"
+    assert main(["fill", str(shot), "-o", str(tmp_path / "f.xlsx"), "--pdf", str(pdf),
+                 "--quiet"]) == 0
+    first = subprocess.run(["pdftotext", "-layout", "-f", "1", "-l", "1", str(pdf), "-"],
+                           capture_output=True, text=True, check=True).stdout
+    for label, value in (("Client", "Acme Aerospace"), ("Serial number", "SN-0007"),
+                         ("Test number", BLANK), ("Operator", BLANK)):
+        assert re.search(rf"{label}\s+{re.escape(value)}", first), (label, first)

@@ -350,6 +350,7 @@ def _write_pdf(shot: Shot, filled: Filled, path: Path, info: Provenance, options
                record: list[str]) -> None:
     """The shot's report as a PDF: its Summary's figures as the sheet shows them, the
     predicted verdict, every warning, and the Charts page's charts."""
+    from ..identification import Identification
     from ..reports.pdf_report import summary_text, write_fill_pdf
     from ..untrusted_json import printable
     from ..xlsx.charts import CHARTS, series_data, spectrum_range
@@ -375,7 +376,8 @@ def _write_pdf(shot: Shot, filled: Filled, path: Path, info: Provenance, options
                     "integrator", f"Specification: {printable(source or 'none given')}"),
                    options.reproducible, tuple(printable(n) for n in options.study_notes),
                    tuple(flagged_figures(record).get("Peak acceleration (raw)", [])),
-                   inputs)
+                   inputs, [(label, printable(text))
+                            for label, text in Identification(shot.test).rows()])
 
 
 # -- the command -------------------------------------------------------------------------

@@ -173,6 +173,18 @@ def _criteria_rows(verdict: Any) -> tuple[list[list[str]], list[str | None]]:
     return rows, colours
 
 
+def _test_table(pages: _Pages, test: Sequence[tuple[str, str]]) -> None:
+    """The test's identification (:mod:`airgun_xl.identification`), two fields a row, a
+    blank line each where none was given (issue 63)."""
+    if not test:
+        return
+    cells = [[label, value] for label, value in test]
+    pairs = [cells[k] + (cells[k + 1] if k + 1 < len(cells) else ["", ""])
+             for k in range(0, len(cells), 2)]
+    pages.table(["Test", "", "", ""], pairs, [0.0, 0.17, 0.5, 0.67])
+    pages.gap(0.5)
+
+
 def _text_pages(pages: _Pages, verdict: Any, about: list[tuple[str, str]],
                 warnings: list[str]) -> None:
     """The verdict, the criteria, the warnings, the recording, the sources, the signature."""
@@ -183,15 +195,10 @@ def _text_pages(pages: _Pages, verdict: Any, about: list[tuple[str, str]],
     pages.text(f"Verdict: {verdict.word}", size=14, bold=True,
                colour=WORD_COLOURS[verdict.word])
     pages.gap()
-    # the test's identification two fields a row (a blank line each where none was given)
     from ..identification import LABELS
 
-    test = [[label, value] for label, value in about if label in LABELS.values()]
-    if test:
-        pairs = [test[k] + (test[k + 1] if k + 1 < len(test) else ["", ""])
-                 for k in range(0, len(test), 2)]
-        pages.table(["Test", "", "", ""], pairs, [0.0, 0.17, 0.5, 0.67])
-        pages.gap(0.5)
+    _test_table(pages, [(label, value) for label, value in about
+                        if label in LABELS.values()])
     pages.table(["Item", "Value"], [[label, value] for label, value in about
                                     if label not in LABELS.values()], [0.0, 0.2])
     pages.gap()
@@ -460,12 +467,14 @@ def write_fill_pdf(path: str | Path, rows: list[tuple[str, str, str, str]],
                    charts: list[tuple[Any, dict[str, Any], tuple[float, float]]],
                    heading: tuple[str, str, str], reproducible: bool = False,
                    notes: tuple[str, ...] = (), doubted: tuple[str, ...] = (),
-                   inputs: Sequence[tuple[str, str, str, str]] = ()) -> None:
+                   inputs: Sequence[tuple[str, str, str, str]] = (),
+                   test: Sequence[tuple[str, str]] = ()) -> None:
     """A fill's report at ``path``: ``rows`` the Summary's (quantity, value as shown, unit,
     definition), the predicted ``verdict`` (or None; ``doubted`` the cells whose warnings
     put it in doubt), what the study behind the shot found (``notes``: a design's, the
     closed loop's P(PASS)), the warnings, the shot's ``inputs`` (cell, quantity, value as
-    shown, unit: the velocity, the masses, the mitigator; issue 63) and ``charts``
+    shown, unit: the velocity, the masses, the mitigator; issue 63), the ``test`` it is (its
+    identification's rows: label, text) and ``charts``
     (:class:`~airgun_xl.xlsx.charts.ChartSpec`, its series' data, its x range)."""
     import matplotlib
 
@@ -475,6 +484,7 @@ def write_fill_pdf(path: str | Path, rows: list[tuple[str, str, str, str]],
         pages = _Pages()
         pages.text("Shot report: the prediction", size=16, bold=True)
         pages.gap(1.0)
+        _test_table(pages, test)
         if verdict is not None:
             pages.text(f"Predicted verdict: {verdict.word}", size=13, bold=True,
                        colour=WORD_COLOURS[verdict.word])
