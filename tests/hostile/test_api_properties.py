@@ -2,6 +2,8 @@
 command's option and to the function's keyword is read the same or refused in the same
 words (one grammar, one place); any keyword of any function given random text gives an
 outcome or one AirgunXlError line, never another exception, and writes nothing."""
+import math
+
 import pytest
 from conftest import TEMPLATE
 from hypothesis import HealthCheck, given, settings
@@ -39,8 +41,9 @@ def test_an_option_and_its_keyword_read_the_same_text_alike(option, text, tmp_pa
         assert err == f"airgun-xl: error: {exc}\n"
         return
     assert code in (0, 3), err
-    for c in outcome.criteria:  # the command printed the function's figures
-        assert f"{'PASS' if c.passed else 'FAIL'}  {c.name}: {c.value:.5g} {c.unit}" in out
+    for c in outcome.criteria:  # the command printed the function's figures (and U, k = 2)
+        u = f" ± {c.expanded:.2g}" if math.isfinite(c.expanded) else ""
+        assert f"{c.word}  {c.name}: {c.value:.5g}{u} {c.unit}" in out
 
 
 NOISE = st.one_of(st.text(max_size=10), st.integers(-10, 10**6),
