@@ -20,7 +20,8 @@ The rule (:func:`find_events`), on a channel's samples as the file holds them:
    its **start** that run's first sample.
 
 A recording of several events is judged on one: the *stretch* from the middle of the rest
-before it to the middle of the rest after it (:func:`stretch`), by default the largest (one
+before it to the middle of the rest after it (:func:`stretch`), cut to 50 ms plus the event's
+own length on each side of it (:func:`judged_span`), by default the largest (one
 the recording cuts is said to be cut: its rest before or after is missing). A recording
 whose samples never pass 8 sigma of its noise holds no event: it is judged whole, as
 before, and the reading says so.
@@ -130,6 +131,19 @@ def find_events(time: np.ndarray, values: np.ndarray) -> Events:
         events.append(Event(number, first, last, peak, height, float(time[a]),
                             float(time[b] - time[a]), first == 0 or last == len(values) - 1))
     return Events(rest, noise, threshold, tuple(events))
+
+
+def judged_span(found: Events, event: Event, time: np.ndarray) -> tuple[int, int]:
+    """The samples (``first``, ``stop``) of ``event``'s :func:`stretch` that are judged: at
+    most :data:`HOLD_SECONDS` plus the event's own length before its first sample past the
+    threshold and as much after its last (at least 25 ms of rest each side, as the stretch
+    holds; the judge's windows, of a few D, lie well inside), so that a long rest between
+    shots is not filtered, scanned and charted for nothing."""
+    first, stop = stretch(found, event, len(time))
+    span = HOLD_SECONDS + float(time[event.last] - time[event.first])
+    lo = int(np.searchsorted(time, time[event.first] - span, side="left"))
+    hi = int(np.searchsorted(time, time[event.last] + span, side="right"))
+    return max(first, lo), min(stop, hi)
 
 
 def stretch(found: Events, event: Event, count: int) -> tuple[int, int]:

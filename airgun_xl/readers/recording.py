@@ -304,7 +304,7 @@ def _event_stretch(shown, time, raw, event, at, unit):
     ``stop`` excluded) that hold it, the sample a recorder's clock is fitted round (None: the
     largest excursion), and what to say of it. The whole recording when it holds one event,
     or none and no ``at``."""
-    from .events import find_events, stretch
+    from .events import find_events, judged_span, stretch
     from .formats.channels import WINDOW_SECONDS
 
     found = find_events(time, raw)
@@ -348,7 +348,7 @@ def _event_stretch(shown, time, raw, event, at, unit):
     centre = chosen.peak  # the clock is fitted round it
     if len(events) == 1:
         return 0, len(raw), centre, []
-    first, stop = stretch(found, chosen, len(raw))
+    first, stop = judged_span(found, chosen, time)
     how = ("the largest" if event is None and at is None
            else f"--event {event}" if event is not None else f"--at {at:g} s")
     if chosen.cut:

@@ -322,7 +322,7 @@ def on_measured_grid(time, pred_time, pred_kg, dt, cfc, anti_alias=None):
 
 
 def _figures(time, accel, impact):
-    from scipy.integrate import trapezoid
+    from .integrals import trapezoid
 
     peak_index = int(np.argmax(accel))
     _, _, duration = pulse(time, accel)

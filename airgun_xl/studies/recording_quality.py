@@ -506,7 +506,7 @@ class Expected:
     @classmethod
     def of_pulse(cls, time, accel, source: str = "the shot's prediction") -> Expected:
         """What a pulse (``accel`` [kG] at ``time`` [s], from rest) shows."""
-        from scipy.integrate import trapezoid
+        from .integrals import trapezoid
 
         time = np.asarray(time, dtype=float)
         accel = np.asarray(accel, dtype=float)
@@ -679,7 +679,7 @@ def unit_errors(q: RecordingQuality, x: np.ndarray, dt: float, expected: Expecte
     peak, or without one expected by the velocity change where the duration is not off; a
     time unit (:data:`TIME_FACTORS`) by the duration, or without one by the velocity change
     where the peak is not off."""
-    from scipy.integrate import trapezoid
+    from .integrals import trapezoid
 
     def ratio(value, wanted):
         ok = wanted is not None and wanted > 0 and value > 0 and math.isfinite(value)
