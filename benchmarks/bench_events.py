@@ -13,11 +13,12 @@ workbook written; the median wall time over N runs after one warm-up, and the pe
   of 256 samples, each block's time code off by up to 0.2 of a step, the clock 200 ppm fast),
   so that the events are found and the clock fitted: `recording --events`, then `accept`
   judging the largest event (the default) and the first (`--event 1`);
-- a real recorder's channel of 500,000 samples: test1.IDE's 100 g piezoelectric X (enDAQ's
+- a real recorder's channel of 500,000 samples: test1.IDE's 100 g piezoelectric Y (enDAQ's
   own recording, tests/data/real), its 49,924 samples and their stamps (the real block jitter)
   repeated end to end ten times (each copy after the last by one median step), read by
-  idelib, written as a CSV in g, judged by accept against 1 g +/- 90 % (it passes, 0.32 g:
-  a FAIL exits 3). Needs idelib (the `ide` extra).
+  idelib, written as a CSV in g, judged by accept against 0.3 g +/- 90 % (it passes, 0.21 g,
+  whether once or ten times: a FAIL exits 3; the X channel's sign flips between the two, and
+  a refusal measures nothing). Needs idelib (the `ide` extra).
 
 Target (issue 62): a 500,000-sample channel read and judged in under 3 s and 300 MB. --quick:
 50,000 samples, one repeat.
@@ -56,13 +57,13 @@ def session(path, samples, rate=50_000.0, block=256, ppm=200.0):
 
 
 def real_channel(path, copies=10):
-    """test1.IDE's 100 g X repeated ``copies`` times (see the module's notes), as a CSV."""
+    """test1.IDE's 100 g Y repeated ``copies`` times (see the module's notes), as a CSV."""
     import idelib
 
     doc = idelib.importFile(str(REAL / "test1.IDE"))
     try:
         sub = next(s for ch in doc.channels.values() for s in ch.subchannels
-                   if s.name == "X (100g)")
+                   if s.name == "Y (100g)")
         data = np.asarray(sub.getSession().arraySlice(), float)
     finally:
         doc.close()
@@ -96,8 +97,8 @@ def bench(repeat, tmp):
     rows = []
     try:
         long_real, n_real = real_channel(tmp / "real.csv", 1 if quick() else 10)
-        rows = _row(f"accept, test1.IDE's 100 g X repeated: {n_real:,} real samples", [
-            *base, "accept", str(TEMPLATE), str(long_real), "--peak", "1g:90%", *out],
+        rows = _row(f"accept, test1.IDE's 100 g Y repeated: {n_real:,} real samples", [
+            *base, "accept", str(TEMPLATE), str(long_real), "--peak", "0.3g:90%", *out],
             repeat, target=not quick())
     except ImportError:
         rows = [("accept, the real 500,000-sample channel", "", "needs idelib", "")]
